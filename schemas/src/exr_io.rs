@@ -1,0 +1,398 @@
+//! EXR artifacts: everything that grows with the scene. A file is a set of
+//! named layers; a layer is either an image (pixels) or a table (records).
+//!
+//! Tables: records fill scan lines of [`TABLE_WIDTH`] pixels in order
+//! (record `i` at `x = i % width`, `y = i / width`); each field is a named
+//! channel, `f32` or `u32`. A single row of a million pixels would be a valid
+//! EXR but one no viewer opens, hence the fixed width. The record count, and
+//! what every channel means, are written into the header.
+//!
+//! The header: one text attribute, `pipeline`, holds [`ExrMeta`] as RON
+//! (format tag, schema, version, provenance, per-layer channel meanings).
+//! One attribute only, because `exr` stores extra attributes in a hash map
+//! whose iteration order is random: several would break byte-identical
+//! reruns. Chunks are written in increasing line order for the same reason.
+
+use crate::error::{Error, Result};
+use crate::header::{Header, HeaderTag, Input, Schema};
+use crate::ron_io::{parse_ron, read_bytes, to_ron_text};
+use crate::atomic::write_atomically;
+use exr::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Records per scan line of a table layer.
+pub const TABLE_WIDTH: usize = 1024;
+
+/// Name of the EXR header attribute that holds [`ExrMeta`].
+pub const META_ATTRIBUTE: &str = "pipeline";
+
+/// The samples of one channel.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Samples {
+    /// Physical quantities.
+    F32(Vec<f32>),
+    /// Indices and counts.
+    U32(Vec<u32>),
+}
+
+impl Samples {
+    fn len(&self) -> usize {
+        match self {
+            Samples::F32(v) => v.len(),
+            Samples::U32(v) => v.len(),
+        }
+    }
+}
+
+/// One named channel and what it means.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channel {
+    /// Channel name, layered as EXR viewers expect (`B.R`, `P.X`).
+    pub name: String,
+    /// What the values are, with units.
+    pub meaning: String,
+    /// Row-major samples.
+    pub samples: Samples,
+}
+
+impl Channel {
+    /// An `f32` channel.
+    pub fn f32(name: &str, meaning: &str, samples: Vec<f32>) -> Self {
+        Channel { name: name.into(), meaning: meaning.into(), samples: Samples::F32(samples) }
+    }
+    /// A `u32` channel.
+    pub fn u32(name: &str, meaning: &str, samples: Vec<u32>) -> Self {
+        Channel { name: name.into(), meaning: meaning.into(), samples: Samples::U32(samples) }
+    }
+}
+
+/// What a layer holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerKind {
+    /// Pixels of a `width` x `height` image.
+    Image {
+        /// Pixels per row.
+        width: usize,
+        /// Rows.
+        height: usize,
+    },
+    /// `records` rows of a table.
+    Table {
+        /// Number of records.
+        records: usize,
+    },
+}
+
+/// One layer: an image or a table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer {
+    /// Layer name (empty for the single layer of a plain image, so viewers
+    /// show its R, G, B directly).
+    pub name: String,
+    /// Image or table.
+    pub kind: LayerKind,
+    /// The channels, each with `width * height` or `records` samples.
+    pub channels: Vec<Channel>,
+}
+
+/// Per-layer description written into the header.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LayerMeta {
+    /// Layer name.
+    pub name: String,
+    /// Image size or record count.
+    pub kind: LayerKind,
+    /// `(channel, meaning)` pairs.
+    pub channels: Vec<(String, String)>,
+}
+
+/// The content of the `pipeline` header attribute.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ExrMeta {
+    /// Format tag, schema, version, provenance.
+    pub header: Header,
+    /// What each layer and channel holds.
+    pub layers: Vec<LayerMeta>,
+}
+
+impl Layer {
+    /// A table layer of `records` records.
+    pub fn table(name: &str, records: usize, channels: Vec<Channel>) -> Self {
+        Layer { name: name.into(), kind: LayerKind::Table { records }, channels }
+    }
+
+    /// The layer's channel `name`, as `f32` samples; `path` names the file in
+    /// the error.
+    pub fn f32s(&self, path: &Path, name: &str) -> Result<&[f32]> {
+        match &self.channel(path, name)?.samples {
+            Samples::F32(v) => Ok(v),
+            Samples::U32(_) => Err(self.wrong_type(path, name, "f32")),
+        }
+    }
+
+    /// The layer's channel `name`, as `u32` samples.
+    pub fn u32s(&self, path: &Path, name: &str) -> Result<&[u32]> {
+        match &self.channel(path, name)?.samples {
+            Samples::U32(v) => Ok(v),
+            Samples::F32(_) => Err(self.wrong_type(path, name, "u32")),
+        }
+    }
+
+    /// Number of records (tables) or pixels (images).
+    pub fn len(&self) -> usize {
+        match self.kind {
+            LayerKind::Image { width, height } => width * height,
+            LayerKind::Table { records } => records,
+        }
+    }
+
+    /// Whether the layer holds no record.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn channel(&self, path: &Path, name: &str) -> Result<&Channel> {
+        self.channels
+            .iter()
+            .find(|c| c.name == name)
+            .ok_or_else(|| Error::invalid(path, None, format!("layer '{}' has no channel '{name}'", self.name)))
+    }
+
+    fn wrong_type(&self, path: &Path, name: &str, wanted: &str) -> Error {
+        Error::invalid(path, None, format!("channel '{name}' of layer '{}' is not {wanted}", self.name))
+    }
+
+    /// Pixel dimensions of the layer in the file.
+    fn stored_size(&self) -> (usize, usize) {
+        match self.kind {
+            LayerKind::Image { width, height } => (width, height),
+            LayerKind::Table { records } => {
+                let width = records.clamp(1, TABLE_WIDTH);
+                (width, records.div_ceil(width).max(1))
+            }
+        }
+    }
+}
+
+/// An EXR artifact in memory: header plus layers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrArtifact {
+    /// Format tag, schema, version, provenance.
+    pub header: Header,
+    /// Image and table layers.
+    pub layers: Vec<Layer>,
+}
+
+impl ExrArtifact {
+    /// The layer called `name`; `path` names the file in the error.
+    pub fn layer(&self, path: &Path, name: &str) -> Result<&Layer> {
+        self.layers
+            .iter()
+            .find(|l| l.name == name)
+            .ok_or_else(|| Error::invalid(path, None, format!("no layer '{name}' in this {}", self.header.schema)))
+    }
+}
+
+/// Writes `artifact` to `path` atomically, ZIP-compressed, chunks in
+/// increasing order, so identical content gives identical bytes.
+pub fn write_exr(path: &Path, artifact: &ExrArtifact) -> Result<()> {
+    let meta = ExrMeta {
+        header: artifact.header.clone(),
+        layers: artifact
+            .layers
+            .iter()
+            .map(|l| LayerMeta {
+                name: l.name.clone(),
+                kind: l.kind,
+                channels: l.channels.iter().map(|c| (c.name.clone(), c.meaning.clone())).collect(),
+            })
+            .collect(),
+    };
+    let encoding = Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+    let mut exr_layers = Vec::with_capacity(artifact.layers.len());
+    let mut bounds = (1, 1);
+    for layer in &artifact.layers {
+        let (width, height) = layer.stored_size();
+        bounds = (bounds.0.max(width), bounds.1.max(height));
+        let stored = width * height;
+        let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = layer
+            .channels
+            .iter()
+            .map(|c| {
+                if c.samples.len() != layer.len() {
+                    return Err(Error::invalid(
+                        path,
+                        None,
+                        format!("internal: channel '{}' has {} samples for {} records", c.name, c.samples.len(), layer.len()),
+                    ));
+                }
+                let samples = match &c.samples {
+                    Samples::F32(v) => FlatSamples::F32(padded(v, stored)),
+                    Samples::U32(v) => FlatSamples::U32(padded(v, stored)),
+                };
+                Ok(AnyChannel::new(c.name.as_str(), samples))
+            })
+            .collect::<Result<_>>()?;
+        let attributes = if layer.name.is_empty() { LayerAttributes::default() } else { LayerAttributes::named(layer.name.as_str()) };
+        exr_layers.push(exr::image::Layer::new((width, height), attributes, encoding, AnyChannels::sort(channels)));
+    }
+    let mut image = Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions(bounds)), exr_layers);
+    let text = to_ron_text(&meta);
+    image
+        .attributes
+        .other
+        .insert(Text::from(META_ATTRIBUTE), AttributeValue::Text(Text::from_slice_unchecked(text.as_bytes())));
+    write_atomically(path, |writer| {
+        image
+            .write()
+            .non_parallel()
+            .to_buffered(writer)
+            .map_err(|e| Error::invalid(path, None, format!("cannot encode EXR: {e}")))
+    })
+}
+
+fn padded<T: Copy + Default>(values: &[T], len: usize) -> Vec<T> {
+    let mut out = values.to_vec();
+    out.resize(len, T::default());
+    out
+}
+
+/// Reads the EXR artifact at `path` and checks that it is of schema `S`.
+/// Returns it with the input record (hash, carried provenance).
+pub fn read_exr<S: Schema>(path: &Path) -> Result<(ExrArtifact, Input)> {
+    let bytes = read_bytes(path)?;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(&bytes))
+        .map_err(|e| Error::parse(path, None, format!("not a readable EXR file: {e}")))?;
+    // `exr` may file an attribute written as shared under any layer on read.
+    let key = Text::from(META_ATTRIBUTE);
+    let found = std::iter::once(&image.attributes.other)
+        .chain(image.layer_data.iter().map(|l| &l.attributes.other))
+        .find_map(|attributes| attributes.get(&key));
+    let text = match found {
+        Some(AttributeValue::Text(t)) => String::from_utf8_lossy(t.bytes()).into_owned(),
+        _ => {
+            return Err(Error::schema(
+                path,
+                format!("EXR without a '{META_ATTRIBUTE}' header; expected a '{}' artifact of this pipeline", S::NAME),
+            ))
+        }
+    };
+    let untyped: ron::Value = parse_ron(path, &text)?;
+    let tag: Option<HeaderTag> = match &untyped {
+        ron::Value::Map(m) => m.get(&ron::Value::String("header".into())).and_then(|h| h.clone().into_rust().ok()),
+        _ => None,
+    };
+    tag.ok_or_else(|| Error::schema(path, "EXR header attribute holds no artifact header"))?.check::<S>(path)?;
+    let meta: ExrMeta = parse_ron(path, &text)?;
+    let mut layers = Vec::with_capacity(meta.layers.len());
+    for described in &meta.layers {
+        let stored = image
+            .layer_data
+            .iter()
+            .find(|l| l.attributes.layer_name.as_ref().map(|n| n.to_string()).unwrap_or_default() == described.name)
+            .ok_or_else(|| Error::invalid(path, None, format!("layer '{}' described but absent", described.name)))?;
+        let layer_len = match described.kind {
+            LayerKind::Image { width, height } => width * height,
+            LayerKind::Table { records } => records,
+        };
+        let mut channels = Vec::with_capacity(described.channels.len());
+        for (name, meaning) in &described.channels {
+            let data = stored
+                .channel_data
+                .list
+                .iter()
+                .find(|c| c.name.to_string() == *name)
+                .ok_or_else(|| Error::invalid(path, None, format!("channel '{name}' described but absent")))?;
+            if data.sample_data.len() < layer_len {
+                return Err(Error::invalid(path, None, format!("channel '{name}' holds fewer samples than its layer's size")));
+            }
+            let samples = match &data.sample_data {
+                FlatSamples::F32(v) => Samples::F32(v[..layer_len].to_vec()),
+                FlatSamples::U32(v) => Samples::U32(v[..layer_len].to_vec()),
+                FlatSamples::F16(v) => Samples::F32(v[..layer_len].iter().map(|h| h.to_f32()).collect()),
+            };
+            channels.push(Channel { name: name.clone(), meaning: meaning.clone(), samples });
+        }
+        layers.push(Layer { name: described.name.clone(), kind: described.kind, channels });
+    }
+    let input = Input::new(path, &bytes, Some(meta.header.provenance.clone()));
+    Ok((ExrArtifact { header: meta.header, layers }, input))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::header::Provenance;
+
+    struct Demo;
+    impl Schema for Demo {
+        const NAME: &'static str = "demo";
+        const VERSION: u32 = 1;
+    }
+
+    fn provenance() -> Provenance {
+        Provenance {
+            stage: "test".into(),
+            stage_version: "0".into(),
+            command_line: vec!["test".into()],
+            parameters: ron::Value::Unit,
+            inputs: vec![],
+        }
+    }
+
+    #[test]
+    fn tables_round_trip_with_padding_and_identical_bytes() {
+        let records = TABLE_WIDTH + 3;
+        let artifact = ExrArtifact {
+            header: Demo::header(provenance()),
+            layers: vec![
+                Layer::table(
+                    "rows",
+                    records,
+                    vec![
+                        Channel::f32("x", "a value", (0..records).map(|i| i as f32 * 0.5).collect()),
+                        Channel::u32("i", "an index", (0..records as u32).rev().collect()),
+                    ],
+                ),
+                Layer::table("empty", 0, vec![Channel::u32("i", "nothing", vec![])]),
+            ],
+        };
+        let dir = std::env::temp_dir().join(format!("exr-io-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+        write_exr(&a, &artifact).unwrap();
+        write_exr(&b, &artifact).unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+        let (back, input) = read_exr::<Demo>(&a).unwrap();
+        assert_eq!(back, artifact);
+        assert_eq!(input.sha256.len(), 64);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn wrong_version_is_refused_with_both_versions_named() {
+        struct DemoV2;
+        impl Schema for DemoV2 {
+            const NAME: &'static str = "demo";
+            const VERSION: u32 = 2;
+        }
+        let artifact = ExrArtifact {
+            header: Demo::header(provenance()),
+            layers: vec![Layer::table("rows", 1, vec![Channel::u32("i", "an index", vec![7])])],
+        };
+        let path = std::env::temp_dir().join(format!("exr-io-v-{}.exr", std::process::id()));
+        write_exr(&path, &artifact).unwrap();
+        let message = read_exr::<DemoV2>(&path).unwrap_err().to_string();
+        assert!(message.contains("version 1") && message.contains("version 2"), "{message}");
+        std::fs::remove_file(&path).unwrap();
+    }
+}

@@ -1,0 +1,34 @@
+//! # schemas: the file contracts between the pipeline's stages
+//!
+//! Every file that passes between two stages is defined here, and nowhere
+//! else: the serde types of the RON artifacts (manifest, reports,
+//! parameters), the layers and channels of the EXR artifacts (mesh,
+//! solution, images), their schema names and versions, and the provenance
+//! every artifact carries. Readers check the format tag and the version
+//! before anything else; writers are atomic and deterministic.
+//!
+//! | artifact | file | schema | written by |
+//! |---|---|---|---|
+//! | [`mesh::Mesh`] | `mesh.exr` | `mesh` 1 | mesh-prep |
+//! | [`mesh::Manifest`] | `manifest.ron` | `manifest` 1 | mesh-prep |
+//! | [`solution::Solution`] | `solution.exr` | `solution` 1 | hierarchical-solve |
+//! | [`image::HdrImage`] | `*.exr` | `image` 1 | grid-gather |
+//! | [`report::Report`] | `*.report.ron` | `report` 1 | every stage |
+//!
+//! ```
+//! use schemas::header::Schema;
+//! assert_eq!(schemas::solution::Solution::NAME, "solution");
+//! ```
+
+pub mod atomic;
+pub mod error;
+pub mod exr_io;
+pub mod header;
+pub mod image;
+pub mod mesh;
+pub mod report;
+pub mod ron_io;
+pub mod solution;
+pub mod stage;
+
+pub use error::{Error, Result};

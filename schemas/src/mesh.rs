@@ -1,0 +1,261 @@
+//! The mesh artifact (`mesh.exr`) and its manifest (`manifest.ron`), both
+//! written by `mesh-prep` and read by every later stage.
+//!
+//! Frames and units: positions are in the *mesh frame*, metres, which is the
+//! world frame translated by `-world_from_mesh_translation` so that the scene
+//! is centred on the origin: f32 positions then keep their precision even
+//! when the scene file places the model a thousand kilometres away.
+
+use crate::error::{Error, Result};
+use crate::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer};
+use crate::header::{Header, Input, Provenance, Schema};
+use crate::ron_io::RonArtifact;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// One triangle of the prepared mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Indices into the vertex table, counter-clockwise seen from the front.
+    pub vertices: [u32; 3],
+    /// Index into [`Manifest::materials`].
+    pub material: u32,
+    /// Index into [`Manifest::objects`].
+    pub object: u32,
+    /// Area in m².
+    pub area: f32,
+    /// Unit normal of the front face, mesh frame.
+    pub normal: [f32; 3],
+}
+
+/// The mesh: welded vertices and non-degenerate triangles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Header with provenance.
+    pub header: Header,
+    /// Vertex positions, mesh frame, metres.
+    pub positions: Vec<[f32; 3]>,
+    /// Triangles.
+    pub triangles: Vec<Triangle>,
+}
+
+impl Schema for Mesh {
+    const NAME: &'static str = "mesh";
+    const VERSION: u32 = 1;
+}
+
+impl Mesh {
+    /// Writes `mesh.exr`: layers `vertex` and `triangle`.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let p = &self.positions;
+        let t = &self.triangles;
+        let vertex = Layer::table(
+            "vertex",
+            p.len(),
+            vec![
+                Channel::f32("P.X", "position x, mesh frame, m", p.iter().map(|v| v[0]).collect()),
+                Channel::f32("P.Y", "position y, mesh frame, m", p.iter().map(|v| v[1]).collect()),
+                Channel::f32("P.Z", "position z, mesh frame, m", p.iter().map(|v| v[2]).collect()),
+            ],
+        );
+        let triangle = Layer::table(
+            "triangle",
+            t.len(),
+            vec![
+                Channel::u32("v0", "first vertex index", t.iter().map(|t| t.vertices[0]).collect()),
+                Channel::u32("v1", "second vertex index", t.iter().map(|t| t.vertices[1]).collect()),
+                Channel::u32("v2", "third vertex index", t.iter().map(|t| t.vertices[2]).collect()),
+                Channel::u32("material", "index into manifest materials", t.iter().map(|t| t.material).collect()),
+                Channel::u32("object", "index into manifest objects", t.iter().map(|t| t.object).collect()),
+                Channel::f32("area", "area, m^2", t.iter().map(|t| t.area).collect()),
+                Channel::f32("N.X", "front-face unit normal x", t.iter().map(|t| t.normal[0]).collect()),
+                Channel::f32("N.Y", "front-face unit normal y", t.iter().map(|t| t.normal[1]).collect()),
+                Channel::f32("N.Z", "front-face unit normal z", t.iter().map(|t| t.normal[2]).collect()),
+            ],
+        );
+        write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![vertex, triangle] })
+    }
+
+    /// Reads and validates `mesh.exr`: indices in range, positions finite.
+    pub fn read(path: &Path) -> Result<(Mesh, Input)> {
+        let (artifact, input) = read_exr::<Mesh>(path)?;
+        let vertex = artifact.layer(path, "vertex")?;
+        let (x, y, z) = (vertex.f32s(path, "P.X")?, vertex.f32s(path, "P.Y")?, vertex.f32s(path, "P.Z")?);
+        let positions: Vec<[f32; 3]> = (0..vertex.len()).map(|i| [x[i], y[i], z[i]]).collect();
+        if let Some(i) = positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return Err(Error::invalid(path, None, format!("vertex {i} has a non-finite coordinate")));
+        }
+        let tri = artifact.layer(path, "triangle")?;
+        let v = [tri.u32s(path, "v0")?, tri.u32s(path, "v1")?, tri.u32s(path, "v2")?];
+        let (material, object, area) = (tri.u32s(path, "material")?, tri.u32s(path, "object")?, tri.f32s(path, "area")?);
+        let n = [tri.f32s(path, "N.X")?, tri.f32s(path, "N.Y")?, tri.f32s(path, "N.Z")?];
+        let mut triangles = Vec::with_capacity(tri.len());
+        for i in 0..tri.len() {
+            let vertices = [v[0][i], v[1][i], v[2][i]];
+            if vertices.iter().any(|&k| k as usize >= positions.len()) {
+                return Err(Error::invalid(path, None, format!("triangle {i} indexes a vertex out of range")));
+            }
+            triangles.push(Triangle { vertices, material: material[i], object: object[i], area: area[i], normal: [n[0][i], n[1][i], n[2][i]] });
+        }
+        Ok((Mesh { header: artifact.header, positions, triangles }, input))
+    }
+}
+
+/// A pinhole camera, mesh frame.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    /// Eye position, m.
+    pub eye: [f64; 3],
+    /// A point the camera looks at.
+    pub target: [f64; 3],
+    /// Up direction (need not be orthogonal to the view direction).
+    pub up: [f64; 3],
+    /// Full vertical field of view, degrees.
+    pub vertical_fov_deg: f64,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+}
+
+/// A surface material. Colours are linear RGB.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Name from the MTL file or the scene.
+    pub name: String,
+    /// Diffuse reflectance rho, in [0, 1).
+    pub diffuse: [f64; 3],
+    /// Emitted radiosity (radiant exitance), W/m², front face only.
+    pub emission: [f64; 3],
+    /// Ideal specular reflectance.
+    pub specular_reflectance: [f64; 3],
+    /// Ideal specular transmittance.
+    pub specular_transmittance: [f64; 3],
+    /// Diffuse transmittance.
+    pub diffuse_transmittance: [f64; 3],
+    /// Diffuse texture file, if any.
+    pub diffuse_map: Option<String>,
+    /// Alpha (cut-out) mask file, if any.
+    pub alpha_map: Option<String>,
+    /// Normal map file, if any.
+    pub normal_map: Option<String>,
+}
+
+/// A goniometric point light: an EULUMDAT or IES file placed in the scene.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GoniometricLight {
+    /// Photometric file (.ldt or .ies), as given in the scene.
+    pub file: String,
+    /// Position, mesh frame, m.
+    pub position: [f64; 3],
+    /// Direction of the luminaire's nadir (C-plane axis), unit.
+    pub nadir: [f64; 3],
+    /// Multiplier on the file's intensities.
+    pub scale: f64,
+}
+
+/// Which phenomena the scene contains. Every stage reads this and runs only
+/// the code paths a scene needs; its report says what it skipped and why.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Effects {
+    /// Some surface emits and some surface reflects diffusely.
+    pub diffuse_interreflection: bool,
+    /// Some material transmits diffusely.
+    pub diffuse_transmission: bool,
+    /// Some material reflects specularly (mirrors).
+    pub specular_reflection: bool,
+    /// Some material transmits specularly (glass, water).
+    pub specular_transmission: bool,
+    /// The scene has goniometric point lights.
+    pub goniometric_lights: bool,
+    /// Some material has an alpha mask.
+    pub alpha_masks: bool,
+    /// Some material has a normal map.
+    pub normal_maps: bool,
+    /// Some material has a diffuse texture.
+    pub textures: bool,
+    /// The mesh is fine enough that clustering pays (many small triangles).
+    pub fine_clustered_geometry: bool,
+}
+
+/// What `mesh-prep` did to the input geometry.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct MeshStatistics {
+    /// Triangles after triangulating the input faces.
+    pub input_triangles: usize,
+    /// Triangles dropped because their area is (numerically) zero.
+    pub degenerate_dropped: usize,
+    /// Triangles dropped because they repeat another (same three vertices).
+    pub duplicates_dropped: usize,
+    /// Vertices merged into another at the same position.
+    pub vertices_welded: usize,
+    /// Triangles kept.
+    pub triangles: usize,
+    /// Vertices kept.
+    pub vertices: usize,
+    /// Total surface area, m².
+    pub total_area: f64,
+    /// Area of emitting surfaces, m².
+    pub emitting_area: f64,
+    /// Total emitted power, W per channel.
+    pub emitted_power: [f64; 3],
+    /// Mesh-frame bounding box: min corner.
+    pub bounds_min: [f64; 3],
+    /// Mesh-frame bounding box: max corner.
+    pub bounds_max: [f64; 3],
+}
+
+/// `manifest.ron`: what the scene is made of besides its triangles.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// Header with provenance.
+    pub header: Header,
+    /// World position of the mesh frame's origin, m (f64: it may be large).
+    pub world_from_mesh_translation: [f64; 3],
+    /// The camera, mesh frame.
+    pub camera: Camera,
+    /// Materials, indexed by the triangles' `material`.
+    pub materials: Vec<Material>,
+    /// Object names, indexed by the triangles' `object`.
+    pub objects: Vec<String>,
+    /// Goniometric point lights.
+    pub goniometric_lights: Vec<GoniometricLight>,
+    /// Which phenomena the scene contains.
+    pub effects: Effects,
+    /// What preparation did.
+    pub statistics: MeshStatistics,
+}
+
+impl Schema for Manifest {
+    const NAME: &'static str = "manifest";
+    const VERSION: u32 = 1;
+}
+
+impl RonArtifact for Manifest {
+    fn provenance(&self) -> &Provenance {
+        &self.header.provenance
+    }
+}
+
+impl Manifest {
+    /// Checks that `mesh` belongs to this manifest: every material and
+    /// object index in range.
+    pub fn check_mesh(&self, mesh_path: &Path, mesh: &Mesh) -> Result<()> {
+        for (i, t) in mesh.triangles.iter().enumerate() {
+            if t.material as usize >= self.materials.len() || t.object as usize >= self.objects.len() {
+                return Err(Error::invalid(
+                    mesh_path,
+                    None,
+                    format!("triangle {i} names material {} / object {}, which the manifest does not have", t.material, t.object),
+                ));
+            }
+        }
+        Ok(())
+    }
+}

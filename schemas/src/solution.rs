@@ -1,0 +1,173 @@
+//! The radiosity solution artifact (`solution.exr`), written by
+//! `hierarchical-solve`: the element hierarchy with radiosity per element,
+//! and every link of every level (the final gather reads them).
+
+use crate::error::{Error, Result};
+use crate::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer};
+use crate::header::{Header, Input, Schema};
+use std::path::Path;
+
+/// Marks "no element" in `parent` and `first_child`.
+pub const NONE: u32 = u32::MAX;
+
+/// One element: an input triangle, or a sub-triangle of it from regular
+/// 1:4 subdivision (children: three corner triangles, then the middle one).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Element {
+    /// The input triangle this element lies on.
+    pub triangle: u32,
+    /// Parent element, or [`NONE`] for an input triangle.
+    pub parent: u32,
+    /// First of four consecutive children, or [`NONE`] for a leaf.
+    pub first_child: u32,
+    /// Subdivision depth, 0 for input triangles.
+    pub level: u32,
+    /// Barycentric `(u, v)` of each corner in the input triangle: the point
+    /// is `(1-u-v) P0 + u P1 + v P2`. Dyadic fractions, exact in f32.
+    pub corners: [[f32; 2]; 3],
+    /// Area, m².
+    pub area: f32,
+    /// Radiosity B (exitance: emitted plus reflected), W/m², RGB; for inner
+    /// elements the area-weighted mean of their children.
+    pub radiosity: [f32; 3],
+}
+
+impl Element {
+    /// Whether the element has no children.
+    pub fn is_leaf(&self) -> bool {
+        self.first_child == NONE
+    }
+}
+
+/// One link: light gathered by `receiver` from `sender`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Link {
+    /// Receiving element.
+    pub receiver: u32,
+    /// Sending element.
+    pub sender: u32,
+    /// Unoccluded form factor F_rs (fraction of the energy leaving the
+    /// receiver that would reach the sender; by reciprocity the receiver's
+    /// irradiance is F_rs B_s).
+    pub form_factor: f32,
+    /// Fraction of receiver-sender rays not blocked, in [0, 1].
+    pub visibility: f32,
+    /// Unoccluded irradiance F_rs B_s at the receiver, W/m², RGB.
+    pub unoccluded_irradiance: [f32; 3],
+    /// Distance from the receiver to the nearest occluder found by the
+    /// visibility rays, m; +inf when no ray was blocked.
+    pub occluder_distance: f32,
+}
+
+/// The solution: element hierarchy and links.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solution {
+    /// Header with provenance.
+    pub header: Header,
+    /// Elements; input triangle `t` is element `t`, children follow.
+    pub elements: Vec<Element>,
+    /// Links, sorted by receiver then sender.
+    pub links: Vec<Link>,
+}
+
+impl Schema for Solution {
+    const NAME: &'static str = "solution";
+    const VERSION: u32 = 1;
+}
+
+fn column<T: Copy, U>(rows: &[T], f: impl Fn(&T) -> U) -> Vec<U> {
+    rows.iter().map(f).collect()
+}
+
+impl Solution {
+    /// Writes `solution.exr`: layers `element` and `link`.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let e = &self.elements;
+        let corner = |k: usize, axis: usize| column(e, move |x: &Element| x.corners[k][axis]);
+        let element = Layer::table(
+            "element",
+            e.len(),
+            vec![
+                Channel::u32("triangle", "input triangle index", column(e, |x| x.triangle)),
+                Channel::u32("parent", "parent element, 4294967295 = none", column(e, |x| x.parent)),
+                Channel::u32("first_child", "first of 4 children, 4294967295 = leaf", column(e, |x| x.first_child)),
+                Channel::u32("level", "subdivision depth", column(e, |x| x.level)),
+                Channel::f32("c0.u", "corner 0 barycentric u", corner(0, 0)),
+                Channel::f32("c0.v", "corner 0 barycentric v", corner(0, 1)),
+                Channel::f32("c1.u", "corner 1 barycentric u", corner(1, 0)),
+                Channel::f32("c1.v", "corner 1 barycentric v", corner(1, 1)),
+                Channel::f32("c2.u", "corner 2 barycentric u", corner(2, 0)),
+                Channel::f32("c2.v", "corner 2 barycentric v", corner(2, 1)),
+                Channel::f32("area", "area, m^2", column(e, |x| x.area)),
+                Channel::f32("B.R", "radiosity, W/m^2", column(e, |x| x.radiosity[0])),
+                Channel::f32("B.G", "radiosity, W/m^2", column(e, |x| x.radiosity[1])),
+                Channel::f32("B.B", "radiosity, W/m^2", column(e, |x| x.radiosity[2])),
+            ],
+        );
+        let l = &self.links;
+        let link = Layer::table(
+            "link",
+            l.len(),
+            vec![
+                Channel::u32("receiver", "receiving element", column(l, |x| x.receiver)),
+                Channel::u32("sender", "sending element", column(l, |x| x.sender)),
+                Channel::f32("F", "unoccluded form factor receiver->sender", column(l, |x| x.form_factor)),
+                Channel::f32("V", "visible fraction of rays", column(l, |x| x.visibility)),
+                Channel::f32("Eu.R", "unoccluded irradiance F*B_sender, W/m^2", column(l, |x| x.unoccluded_irradiance[0])),
+                Channel::f32("Eu.G", "unoccluded irradiance F*B_sender, W/m^2", column(l, |x| x.unoccluded_irradiance[1])),
+                Channel::f32("Eu.B", "unoccluded irradiance F*B_sender, W/m^2", column(l, |x| x.unoccluded_irradiance[2])),
+                Channel::f32("occluder_distance", "receiver to nearest occluder, m (inf = none)", column(l, |x| x.occluder_distance)),
+            ],
+        );
+        write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![element, link] })
+    }
+
+    /// Reads `solution.exr` and checks the hierarchy's indices.
+    pub fn read(path: &Path) -> Result<(Solution, Input)> {
+        let (artifact, input) = read_exr::<Solution>(path)?;
+        let el = artifact.layer(path, "element")?;
+        let u = |name: &str| el.u32s(path, name);
+        let f = |name: &str| el.f32s(path, name);
+        let (triangle, parent, first_child, level) = (u("triangle")?, u("parent")?, u("first_child")?, u("level")?);
+        let c = [f("c0.u")?, f("c0.v")?, f("c1.u")?, f("c1.v")?, f("c2.u")?, f("c2.v")?];
+        let (area, b) = (f("area")?, [f("B.R")?, f("B.G")?, f("B.B")?]);
+        let n = el.len();
+        let elements: Vec<Element> = (0..n)
+            .map(|i| Element {
+                triangle: triangle[i],
+                parent: parent[i],
+                first_child: first_child[i],
+                level: level[i],
+                corners: [[c[0][i], c[1][i]], [c[2][i], c[3][i]], [c[4][i], c[5][i]]],
+                area: area[i],
+                radiosity: [b[0][i], b[1][i], b[2][i]],
+            })
+            .collect();
+        for (i, e) in elements.iter().enumerate() {
+            let bad_parent = e.parent != NONE && e.parent as usize >= n;
+            let bad_child = e.first_child != NONE && e.first_child as usize + 4 > n;
+            if bad_parent || bad_child {
+                return Err(Error::invalid(path, None, format!("element {i} links outside the element table")));
+            }
+        }
+        let li = artifact.layer(path, "link")?;
+        let (receiver, sender) = (li.u32s(path, "receiver")?, li.u32s(path, "sender")?);
+        let (ff, vis, dist) = (li.f32s(path, "F")?, li.f32s(path, "V")?, li.f32s(path, "occluder_distance")?);
+        let eu = [li.f32s(path, "Eu.R")?, li.f32s(path, "Eu.G")?, li.f32s(path, "Eu.B")?];
+        let mut links = Vec::with_capacity(li.len());
+        for i in 0..li.len() {
+            if receiver[i] as usize >= n || sender[i] as usize >= n {
+                return Err(Error::invalid(path, None, format!("link {i} names an element out of range")));
+            }
+            links.push(Link {
+                receiver: receiver[i],
+                sender: sender[i],
+                form_factor: ff[i],
+                visibility: vis[i],
+                unoccluded_irradiance: [eu[0][i], eu[1][i], eu[2][i]],
+                occluder_distance: dist[i],
+            });
+        }
+        Ok((Solution { header: artifact.header, elements, links }, input))
+    }
+}

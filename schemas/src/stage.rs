@@ -1,0 +1,120 @@
+//! The grammar every stage binary shares: provenance capture, `--params`
+//! files, `--print-params`, reports, progress bars and exit codes
+//! (0 ok, 1 a negative answer, 2 error).
+
+use crate::error::{Error, Result};
+use crate::header::{Input, Provenance};
+use crate::report::Report;
+use crate::ron_io::{parse_ron, read_bytes, to_ron_text, write_ron};
+use crate::header::Schema;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Exit code of a run that failed.
+pub const EXIT_ERROR: u8 = 2;
+
+/// One run of a stage: collects its inputs, then stamps its outputs.
+pub struct Run {
+    stage: &'static str,
+    version: &'static str,
+    started: Instant,
+    inputs: Vec<Input>,
+}
+
+impl Run {
+    /// Starts the clock for `stage` at crate `version`.
+    pub fn start(stage: &'static str, version: &'static str) -> Self {
+        Run { stage, version, started: Instant::now(), inputs: Vec::new() }
+    }
+
+    /// Records an input file.
+    pub fn input(&mut self, input: Input) {
+        self.inputs.push(input);
+    }
+
+    /// The provenance of this run's outputs, with `params` as effective
+    /// parameters.
+    pub fn provenance<P: Serialize>(&self, params: &P) -> Provenance {
+        Provenance {
+            stage: self.stage.into(),
+            stage_version: self.version.into(),
+            command_line: std::env::args().collect(),
+            // Our parameter types always serialize to valid RON.
+            parameters: ron::from_str(&to_ron_text(params)).unwrap_or(ron::Value::Unit),
+            inputs: self.inputs.clone(),
+        }
+    }
+
+    /// Writes this run's report to `path`.
+    pub fn write_report<P: Serialize>(
+        &self,
+        path: &Path,
+        params: &P,
+        counters: BTreeMap<String, f64>,
+        skipped: Vec<String>,
+        notes: Vec<String>,
+    ) -> Result<()> {
+        let report = Report {
+            header: Report::header(self.provenance(params)),
+            wall_time_s: self.started.elapsed().as_secs_f64(),
+            counters,
+            skipped,
+            notes,
+        };
+        write_ron(path, &report)
+    }
+}
+
+/// The stage's parameters: defaults, or the `--params` file (strict: an
+/// unknown field is an error naming the file and line).
+pub fn load_params<P: DeserializeOwned + Default>(path: Option<&Path>) -> Result<P> {
+    match path {
+        None => Ok(P::default()),
+        Some(path) => {
+            let bytes = read_bytes(path)?;
+            let text = std::str::from_utf8(&bytes).map_err(|e| Error::parse(path, None, format!("not UTF-8 text: {e}")))?;
+            parse_ron(path, text)
+        }
+    }
+}
+
+/// Prints the effective parameters as RON on stdout, in a form `--params`
+/// reads back.
+pub fn print_params<P: Serialize>(params: &P) {
+    println!("{}", to_ron_text(params));
+}
+
+/// Runs a stage's body and turns its outcome into the process exit code;
+/// an error is printed as one line `stage: error: ...` on stderr.
+pub fn exit_code(stage: &str, outcome: Result<ExitCode>) -> ExitCode {
+    match outcome {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("{stage}: error: {e}");
+            ExitCode::from(EXIT_ERROR)
+        }
+    }
+}
+
+/// A progress bar on stderr for `len` steps of `what` (hidden when stderr is
+/// not a terminal, as in `make` logs and tests).
+pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({eta})")
+            .expect("valid progress template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+/// A usage error (bad parameter value) as a contract error naming the
+/// parameter source.
+pub fn bad_parameter(message: impl Into<String>) -> Error {
+    Error::invalid(Path::new("parameters"), None, message)
+}

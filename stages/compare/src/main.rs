@@ -1,0 +1,2 @@
+//! compare binary (skeleton).
+fn main() {}

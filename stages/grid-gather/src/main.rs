@@ -1,0 +1,2 @@
+//! grid-gather binary (skeleton).
+fn main() {}

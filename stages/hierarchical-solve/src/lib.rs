@@ -1,0 +1,1 @@
+//! hierarchical-solve (skeleton).

@@ -1,0 +1,2 @@
+//! hierarchical-solve binary (skeleton).
+fn main() {}

@@ -1,0 +1,2 @@
+//! mesh-prep binary (skeleton).
+fn main() {}

@@ -1,0 +1,1 @@
+//! radiometry (skeleton).

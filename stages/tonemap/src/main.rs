@@ -1,0 +1,2 @@
+//! tonemap binary (skeleton).
+fn main() {}
