@@ -1,1 +1,21 @@
-//! radiometry (skeleton).
+//! # radiometry: the math several stages share
+//!
+//! - [`form_factor`]: Lambert's point-to-polygon factor (paper 002 Eq. 3)
+//!   and area-averaged element factors by Dunavant quadrature.
+//! - [`sampling`]: deterministic per-work-item random streams, stratified
+//!   points on triangles.
+//! - [`subdivision`]: the 1:4 element subdivision rule and point location.
+//! - [`geometry`]: triangle corners, normals and areas in f64.
+//! - [`rays`]: ray casting over obvhs's CWBVH.
+//! - [`camera`]: pinhole camera rays.
+//! - [`color`]: luminance.
+//!
+//! Everything here takes data, not paths, and never prints.
+
+pub mod camera;
+pub mod color;
+pub mod form_factor;
+pub mod geometry;
+pub mod rays;
+pub mod sampling;
+pub mod subdivision;

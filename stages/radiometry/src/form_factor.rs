@@ -1,0 +1,193 @@
+//! Form-factor kernels.
+//!
+//! The workhorse is Lambert's closed-form factor from a differential area to
+//! a polygon (paper 002, Section 2.1.1, Eq. 3):
+//!
+//! ```text
+//! F_{dA->P} = 1/(2 pi) * sum_i gamma_i cos(delta_i)
+//! ```
+//!
+//! `gamma_i` is the angle the edge `(v_i, v_{i+1})` subtends at the point,
+//! `delta_i` the angle between the receiver normal and the normal of the
+//! plane through the point and that edge. It is exact for any planar polygon
+//! without holes in the receiver's upper hemisphere, so the polygon is first
+//! clipped to that hemisphere. Being exact in the sender, it stays finite and
+//! accurate where sender and receiver touch (a wall meeting the floor): the
+//! only singularity left is at the shared edge itself, which the receiver's
+//! quadrature points never reach (they are strictly inside the receiver).
+
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// Most vertices a clipped polygon can have: the input polygons are
+/// triangles and quads, and one plane adds at most one vertex.
+const MAX_CLIPPED: usize = 8;
+
+/// Lambert's point-to-polygon form factor (002 Eq. 3): the fraction of the
+/// energy leaving a differential area at `point` with unit normal `normal`
+/// that arrives at the polygon `polygon` (any winding, planar, convex or not,
+/// at most 7 vertices). Dimensionless, in [0, 1].
+///
+/// Degenerate edges (zero length, or collinear with `point`) contribute
+/// nothing, which is their limit; a point lying exactly on the polygon's
+/// boundary has an undefined factor and gets the value of the remaining
+/// edges, still finite.
+pub fn point_to_polygon(point: DVec3, normal: DVec3, polygon: &[DVec3]) -> f64 {
+    let mut clipped = [DVec3::ZERO; MAX_CLIPPED];
+    let count = clip_to_upper_hemisphere(point, normal, polygon, &mut clipped);
+    if count < 3 {
+        return 0.0;
+    }
+    let mut sum = 0.0;
+    for i in 0..count {
+        let a = clipped[i] - point;
+        let b = clipped[(i + 1) % count] - point;
+        let c = a.cross(b);
+        let c_len = c.length();
+        if c_len <= f64::MIN_POSITIVE {
+            continue;
+        }
+        // gamma via atan2 keeps full precision at small and near-pi angles,
+        // where acos of a dot product would not.
+        let gamma = c_len.atan2(a.dot(b));
+        sum += gamma * normal.dot(c) / c_len;
+    }
+    (sum.abs() / (2.0 * PI)).min(1.0)
+}
+
+/// Clips `polygon` to the half-space `(x - point) . normal >= 0`
+/// (Sutherland-Hodgman against one plane); writes the result into `out` and
+/// returns its vertex count.
+fn clip_to_upper_hemisphere(point: DVec3, normal: DVec3, polygon: &[DVec3], out: &mut [DVec3; MAX_CLIPPED]) -> usize {
+    let mut count = 0;
+    let n = polygon.len();
+    for i in 0..n {
+        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+        let (da, db) = ((a - point).dot(normal), (b - point).dot(normal));
+        if da >= 0.0 && count < MAX_CLIPPED {
+            out[count] = a;
+            count += 1;
+        }
+        if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
+            let t = da / (da - db);
+            if count < MAX_CLIPPED {
+                out[count] = a + (b - a) * t;
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+/// A symmetric quadrature rule on the triangle: barycentric points and
+/// weights summing to 1. Dunavant's degree-5 rule (D. A. Dunavant, "High
+/// degree efficient symmetrical Gaussian quadrature rules for the triangle",
+/// IJNME 21, 1985): 7 points, all strictly inside the triangle, so a
+/// receiver point never lies on a touching sender's edge.
+pub const DUNAVANT_5: [([f64; 3], f64); 7] = {
+    const A1: f64 = 0.059_715_871_789_770;
+    const B1: f64 = 0.470_142_064_105_115;
+    const W1: f64 = 0.132_394_152_788_506;
+    const A2: f64 = 0.797_426_985_353_087;
+    const B2: f64 = 0.101_286_507_323_456;
+    const W2: f64 = 0.125_939_180_544_827;
+    [
+        ([1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0], 0.225),
+        ([A1, B1, B1], W1),
+        ([B1, A1, B1], W1),
+        ([B1, B1, A1], W1),
+        ([A2, B2, B2], W2),
+        ([B2, A2, B2], W2),
+        ([B2, B2, A2], W2),
+    ]
+};
+
+/// Area-averaged form factor from a receiver triangle to a sender polygon:
+///
+/// ```text
+/// F_rs = 1/A_r * integral over A_r of F_{dA->s} dA
+/// ```
+///
+/// with the inner factor exact (002 Eq. 3) and the outer integral by
+/// [`DUNAVANT_5`]. Returns the factor and the largest point value, which the
+/// refinement oracle uses as a bound.
+pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3]) -> (f64, f64) {
+    let mut mean = 0.0;
+    let mut max = 0.0f64;
+    for (b, w) in DUNAVANT_5 {
+        let p = receiver[0] * b[0] + receiver[1] * b[1] + receiver[2] * b[2];
+        let f = point_to_polygon(p, receiver_normal, sender);
+        mean += w * f;
+        max = max.max(f);
+    }
+    (mean, max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::dvec3;
+
+    /// Differential area at the corner of, and parallel to, an a x b
+    /// rectangle at distance c (Howell catalogue B-3).
+    fn corner_parallel_rectangle(a: f64, b: f64, c: f64) -> f64 {
+        let (x, y) = (a / c, b / c);
+        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
+    }
+
+    #[test]
+    fn matches_the_corner_factor_of_a_parallel_rectangle() {
+        for (a, b, c) in [(1.0, 1.0, 1.0), (2.0, 0.5, 0.3), (0.1, 5.0, 2.0)] {
+            let rect = [dvec3(0.0, 0.0, c), dvec3(a, 0.0, c), dvec3(a, b, c), dvec3(0.0, b, c)];
+            let f = point_to_polygon(DVec3::ZERO, DVec3::Z, &rect);
+            let exact = corner_parallel_rectangle(a, b, c);
+            assert!((f - exact).abs() < 1e-12 * exact.max(1.0), "{a} {b} {c}: {f} vs {exact}");
+        }
+    }
+
+    #[test]
+    fn a_polygon_covering_the_hemisphere_gives_one_and_winding_does_not_matter() {
+        let big = 1e6;
+        let quad = [dvec3(-big, -big, 1.0), dvec3(big, -big, 1.0), dvec3(big, big, 1.0), dvec3(-big, big, 1.0)];
+        let f = point_to_polygon(DVec3::ZERO, DVec3::Z, &quad);
+        assert!((f - 1.0).abs() < 1e-5, "{f}");
+        let reversed: Vec<_> = quad.iter().rev().copied().collect();
+        assert_eq!(f, point_to_polygon(DVec3::ZERO, DVec3::Z, &reversed));
+    }
+
+    #[test]
+    fn polygon_below_the_tangent_plane_is_clipped_away() {
+        let below = [dvec3(0.0, 0.0, -1.0), dvec3(1.0, 0.0, -1.0), dvec3(0.0, 1.0, -1.0)];
+        assert_eq!(point_to_polygon(DVec3::ZERO, DVec3::Z, &below), 0.0);
+        // A wall straddling the tangent plane: only its upper half counts.
+        let wall = [dvec3(-1.0, 1.0, -1.0), dvec3(1.0, 1.0, -1.0), dvec3(1.0, 1.0, 1.0), dvec3(-1.0, 1.0, 1.0)];
+        let upper = [dvec3(-1.0, 1.0, 0.0), dvec3(1.0, 1.0, 0.0), dvec3(1.0, 1.0, 1.0), dvec3(-1.0, 1.0, 1.0)];
+        let f = point_to_polygon(DVec3::ZERO, DVec3::Z, &wall);
+        assert!(f > 0.0);
+        assert!((f - point_to_polygon(DVec3::ZERO, DVec3::Z, &upper)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn grazing_and_touching_configurations_stay_finite() {
+        // Receiver point a hair away from a perpendicular wall it touches.
+        for eps in [1e-3, 1e-9, 1e-15] {
+            let wall = [dvec3(0.0, eps, 0.0), dvec3(1.0, eps, 0.0), dvec3(1.0, eps, 1.0), dvec3(0.0, eps, 1.0)];
+            let f = point_to_polygon(dvec3(0.5, 0.0, 0.0), DVec3::Z, &wall);
+            assert!(f.is_finite() && f > 0.0 && f <= 0.5, "{eps}: {f}");
+        }
+        // Coplanar polygon: no exchange.
+        let coplanar = [dvec3(1.0, 0.0, 0.0), dvec3(2.0, 0.0, 0.0), dvec3(1.0, 1.0, 0.0)];
+        assert_eq!(point_to_polygon(DVec3::ZERO, DVec3::Z, &coplanar), 0.0);
+    }
+
+    #[test]
+    fn dunavant_rule_integrates_quintics_exactly() {
+        let weights: f64 = DUNAVANT_5.iter().map(|(_, w)| w).sum();
+        assert!((weights - 1.0).abs() < 1e-12);
+        // Mean of l0^a l1^b over a triangle is 2 a! b! / (a + b + 2)!.
+        let integral: f64 = DUNAVANT_5.iter().map(|(b, w)| w * b[0].powi(2) * b[1].powi(3)).sum();
+        let exact = 2.0 * 2.0 * 6.0 / 5040.0;
+        assert!((integral - exact).abs() < 1e-12, "{integral} vs {exact}");
+    }
+}
