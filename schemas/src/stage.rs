@@ -118,3 +118,54 @@ pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
 pub fn bad_parameter(message: impl Into<String>) -> Error {
     Error::invalid(Path::new("parameters"), None, message)
 }
+
+/// Checks, before any work, that `path` can be written: its directory
+/// exists and accepts a new file. A stage that would fail only after
+/// minutes of computing fails at once instead.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let probe = dir.join(format!(".{}.probe", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| Error::io(path, e))?;
+    std::fs::remove_file(&probe).map_err(|e| Error::io(path, e))
+}
+
+/// The outputs of one run, all or none: every file written through it is
+/// removed again unless [`Outputs::keep`] is called, so a run that fails
+/// half-way through its writes leaves no partial output for `make`.
+#[derive(Default)]
+pub struct Outputs {
+    written: Vec<std::path::PathBuf>,
+    kept: bool,
+}
+
+impl Outputs {
+    /// No output written yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Writes one output (atomically, through `write`) and remembers it.
+    pub fn write(&mut self, path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+        write(path)?;
+        self.written.push(path.to_path_buf());
+        Ok(())
+    }
+
+    /// The run succeeded: keep everything written.
+    pub fn keep(mut self) {
+        self.kept = true;
+    }
+}
+
+impl Drop for Outputs {
+    fn drop(&mut self) {
+        if !self.kept {
+            for path in &self.written {
+                let _ = std::fs::remove_file(path);
+            }
+        }
+    }
+}

@@ -1,1 +1,55 @@
-//! mesh-prep (skeleton).
+//! # mesh-prep: from a scene file to the prepared mesh
+//!
+//! Reads `scene.ron` ([`scene::Scene`]: OBJ/MTL files, camera, lights,
+//! material overrides) or a built-in scene ([`builtin::Builtin`]),
+//! triangulates, places and recentres the geometry, welds duplicate
+//! vertices, drops degenerate and duplicate triangles, and lists the effects
+//! the scene calls for. The binary writes the result as `mesh.exr` and
+//! `manifest.ron` (see the `schemas` crate).
+
+pub mod builtin;
+pub mod material;
+pub mod obj;
+pub mod prepare;
+pub mod scene;
+
+pub use prepare::{prepare, Params, Prepared};
+
+use obj::TextSource;
+use schemas::header::Input;
+use schemas::Error;
+use std::cell::RefCell;
+use std::path::Path;
+
+/// Reads and parses the scene file at `path` through `source`.
+pub fn read_scene(source: &dyn TextSource, path: &Path) -> Result<scene::Scene, Error> {
+    let text = source.read(path)?;
+    schemas::ron_io::parse_ron(path, &text)
+}
+
+/// A [`TextSource`] that records every file read through it (path and
+/// content hash), for the outputs' provenance.
+pub struct Recording<'a> {
+    inner: &'a dyn TextSource,
+    inputs: RefCell<Vec<Input>>,
+}
+
+impl<'a> Recording<'a> {
+    /// Records reads from `inner`.
+    pub fn new(inner: &'a dyn TextSource) -> Self {
+        Recording { inner, inputs: RefCell::new(Vec::new()) }
+    }
+
+    /// The files read so far, in order.
+    pub fn into_inputs(self) -> Vec<Input> {
+        self.inputs.into_inner()
+    }
+}
+
+impl TextSource for Recording<'_> {
+    fn read(&self, path: &Path) -> Result<String, Error> {
+        let text = self.inner.read(path)?;
+        self.inputs.borrow_mut().push(Input::new(path, text.as_bytes(), None));
+        Ok(text)
+    }
+}

@@ -1,2 +1,121 @@
-//! mesh-prep binary (skeleton).
-fn main() {}
+//! `mesh-prep`: see the library's documentation and `mesh-prep --help`.
+
+use clap::Parser;
+use mesh_prep::builtin::Builtin;
+use mesh_prep::obj::Files;
+use mesh_prep::{prepare, read_scene, Params, Recording};
+use schemas::header::Schema;
+use schemas::mesh::{Manifest, Mesh};
+use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Prepare a scene for the radiosity pipeline: read scene.ron (OBJ/MTL
+/// files, camera, lights, material overrides), or a built-in scene; weld,
+/// clean and recentre the mesh; write mesh.exr and manifest.ron (materials,
+/// camera, and the effects the scene calls for).
+#[derive(Parser, Debug)]
+#[command(name = "mesh-prep", version)]
+struct Args {
+    /// Scene file (scene.ron); omit it and give --builtin for a built-in scene.
+    #[arg(required_unless_present_any = ["builtin", "print_params"])]
+    scene: Option<PathBuf>,
+    /// Use a built-in scene instead of a file.
+    #[arg(long, value_enum, conflicts_with = "scene")]
+    builtin: Option<Builtin>,
+    /// Output: the mesh (EXR tables of vertices and triangles).
+    #[arg(long, required_unless_present = "print_params")]
+    mesh: Option<PathBuf>,
+    /// Output: the manifest (RON: camera, materials, effects, statistics).
+    #[arg(long, required_unless_present = "print_params")]
+    manifest: Option<PathBuf>,
+    /// Output: a report of the run (RON, with wall time).
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Read parameters from this RON file; flags below override it.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Print the effective parameters as RON and exit.
+    #[arg(long)]
+    print_params: bool,
+    /// Weld vertices closer than this times the scene's diagonal.
+    #[arg(long)]
+    weld_tolerance: Option<f64>,
+    /// Drop triangles smaller than this times the squared diagonal.
+    #[arg(long)]
+    degenerate_area: Option<f64>,
+    /// Flag the geometry as fine (for clustering) above this many triangles.
+    #[arg(long)]
+    fine_geometry_triangles: Option<usize>,
+}
+
+fn run(args: Args) -> schemas::Result<ExitCode> {
+    let mut params: Params = load_params(args.params.as_deref())?;
+    params.weld_tolerance = args.weld_tolerance.unwrap_or(params.weld_tolerance);
+    params.degenerate_area = args.degenerate_area.unwrap_or(params.degenerate_area);
+    params.fine_geometry_triangles = args.fine_geometry_triangles.unwrap_or(params.fine_geometry_triangles);
+    if args.print_params {
+        print_params(&params);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let (Some(mesh_path), Some(manifest_path)) = (args.mesh, args.manifest) else {
+        unreachable!("clap requires --mesh and --manifest without --print-params")
+    };
+    for path in [Some(&mesh_path), Some(&manifest_path), args.report.as_ref()].into_iter().flatten() {
+        check_writable(path)?;
+    }
+    let mut run = Run::start("mesh-prep", env!("CARGO_PKG_VERSION"));
+    let builtin;
+    let (source, scene_path): (&dyn mesh_prep::obj::TextSource, PathBuf) = match (args.builtin, &args.scene) {
+        (Some(b), _) => {
+            builtin = b;
+            (&builtin, b.scene_path())
+        }
+        (None, Some(path)) => (&Files, path.clone()),
+        (None, None) => unreachable!("clap requires a scene or --builtin"),
+    };
+    let recording = Recording::new(source);
+    let scene = read_scene(&recording, &scene_path)?;
+    let prepared = prepare(&scene, &scene_path, &recording, &params)?;
+    for input in recording.into_inputs() {
+        run.input(input);
+    }
+    let provenance = run.provenance(&params);
+    let mesh = Mesh { header: Mesh::header(provenance.clone()), positions: prepared.positions, triangles: prepared.triangles };
+    let statistics = prepared.statistics;
+    let manifest = Manifest {
+        header: Manifest::header(provenance),
+        world_from_mesh_translation: prepared.world_from_mesh_translation,
+        camera: prepared.camera,
+        materials: prepared.materials,
+        objects: prepared.objects,
+        goniometric_lights: prepared.goniometric_lights,
+        effects: prepared.effects,
+        statistics: statistics.clone(),
+    };
+    eprintln!(
+        "mesh-prep: {} triangles, {} vertices ({} degenerate and {} duplicate triangles dropped, {} vertices welded)",
+        statistics.triangles, statistics.vertices, statistics.degenerate_dropped, statistics.duplicates_dropped, statistics.vertices_welded
+    );
+    let mut outputs = Outputs::new();
+    outputs.write(&mesh_path, |p| mesh.write(p))?;
+    outputs.write(&manifest_path, |p| schemas::ron_io::write_ron(p, &manifest))?;
+    if let Some(report) = &args.report {
+        let counters = BTreeMap::from([
+            ("input_triangles".to_string(), statistics.input_triangles as f64),
+            ("triangles".to_string(), statistics.triangles as f64),
+            ("vertices".to_string(), statistics.vertices as f64),
+            ("degenerate_dropped".to_string(), statistics.degenerate_dropped as f64),
+            ("duplicates_dropped".to_string(), statistics.duplicates_dropped as f64),
+            ("vertices_welded".to_string(), statistics.vertices_welded as f64),
+        ]);
+        outputs.write(report, |p| run.write_report(p, &params, counters, vec![], vec![]))?;
+    }
+    outputs.keep();
+    Ok(ExitCode::SUCCESS)
+}
+
+fn main() -> ExitCode {
+    exit_code("mesh-prep", run(Args::parse()))
+}

@@ -1,0 +1,140 @@
+//! Materials: MTL values, read the way path tracers read them, plus the
+//! scene's overrides, checked for physical plausibility.
+
+use crate::scene::MaterialOverride;
+use schemas::mesh::Material;
+use std::f64::consts::PI;
+
+/// The material of an OBJ object without `usemtl`: grey, diffuse.
+pub fn default_material() -> Material {
+    Material {
+        name: "default".into(),
+        diffuse: [0.5; 3],
+        emission: [0.0; 3],
+        specular_reflectance: [0.0; 3],
+        specular_transmittance: [0.0; 3],
+        diffuse_transmittance: [0.0; 3],
+        diffuse_map: None,
+        alpha_map: None,
+        normal_map: None,
+    }
+}
+
+/// The pipeline's material for an MTL entry.
+///
+/// - `Kd` is the diffuse reflectance (0.5 grey when absent).
+/// - `Ke` is read as emitted *radiance* L, as path tracers that read these
+///   files do; radiosity needs exitance, `M = pi L` for a Lambertian
+///   emitter.
+/// - `Ks` is an ideal specular reflectance only for the illumination models
+///   that ask for ray-traced reflection (`illum` 3 to 7); under `illum` 2 it
+///   is a Phong highlight, which a diffuse radiosity solution ignores.
+/// - `Tf` is a specular transmittance for the refracting models (`illum`
+///   4, 6, 7, 9); without `Tf` those models transmit `1 - d`.
+/// - `map_Kd`, `map_d` and `norm`/`bump` name the diffuse texture, alpha mask
+///   and normal map.
+pub fn from_mtl(m: &tobj::Material) -> Material {
+    let illum = m.illumination_model.unwrap_or(2);
+    let rgb = |v: Option<[f64; 3]>| v.unwrap_or([0.0; 3]);
+    let transmitted = match m.unknown_param.get("Tf").and_then(|t| parse_rgb(t)) {
+        Some(tf) => tf,
+        None => [1.0 - m.dissolve.unwrap_or(1.0); 3],
+    };
+    Material {
+        name: m.name.clone(),
+        diffuse: m.diffuse.unwrap_or([0.5; 3]),
+        emission: rgb(m.emissive).map(|l| PI * l),
+        specular_reflectance: if (3..=7).contains(&illum) { rgb(m.specular) } else { [0.0; 3] },
+        specular_transmittance: if matches!(illum, 4 | 6 | 7 | 9) { transmitted } else { [0.0; 3] },
+        diffuse_transmittance: [0.0; 3],
+        diffuse_map: m.diffuse_texture.clone(),
+        alpha_map: m.dissolve_texture.clone(),
+        normal_map: m.normal_texture.clone(),
+    }
+}
+
+fn parse_rgb(text: &str) -> Option<[f64; 3]> {
+    let v: Vec<f64> = text.split_whitespace().map(str::parse).collect::<Result<_, _>>().ok()?;
+    match v.as_slice() {
+        [g] => Some([*g; 3]),
+        [r, g, b] => Some([*r, *g, *b]),
+        _ => None,
+    }
+}
+
+/// Applies the fields an override sets.
+pub fn apply(material: &mut Material, o: &MaterialOverride) {
+    let set = |target: &mut [f64; 3], value: Option<[f64; 3]>| {
+        if let Some(v) = value {
+            *target = v;
+        }
+    };
+    set(&mut material.diffuse, o.diffuse);
+    set(&mut material.emission, o.emission);
+    set(&mut material.specular_reflectance, o.specular_reflectance);
+    set(&mut material.specular_transmittance, o.specular_transmittance);
+    set(&mut material.diffuse_transmittance, o.diffuse_transmittance);
+    for (target, value) in [
+        (&mut material.alpha_map, &o.alpha_map),
+        (&mut material.normal_map, &o.normal_map),
+        (&mut material.diffuse_map, &o.diffuse_map),
+    ] {
+        if value.is_some() {
+            target.clone_from(value);
+        }
+    }
+}
+
+/// Why a material is not physical, if it is not: every coefficient finite
+/// and in [0, 1], the scattered total (diffuse + specular, reflected and
+/// transmitted) at most 1 per channel, emission finite and non-negative.
+/// A diffuse reflectance of exactly 1 is allowed here; the solver's
+/// convergence in closed scenes is its own concern.
+pub fn check(m: &Material) -> Option<String> {
+    let coefficients = [
+        ("diffuse", m.diffuse),
+        ("specular_reflectance", m.specular_reflectance),
+        ("specular_transmittance", m.specular_transmittance),
+        ("diffuse_transmittance", m.diffuse_transmittance),
+    ];
+    for (name, v) in coefficients {
+        if let Some(x) = v.iter().find(|x| !(0.0..=1.0).contains(*x)) {
+            return Some(format!("material '{}': {name} {x} is outside [0, 1]", m.name));
+        }
+    }
+    for channel in 0..3 {
+        let total: f64 = coefficients.iter().map(|(_, v)| v[channel]).sum();
+        if total > 1.0 + 1e-9 {
+            return Some(format!("material '{}': scatters {total} of the light in channel {channel}, more than it receives", m.name));
+        }
+    }
+    if let Some(x) = m.emission.iter().find(|x| !x.is_finite() || **x < 0.0) {
+        return Some(format!("material '{}': emission {x} is not a finite non-negative number", m.name));
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mtl_emission_is_radiance_and_exitance_is_pi_times_it() {
+        let mtl = tobj::Material { name: "light".into(), emissive: Some([17.0, 12.0, 4.0]), ..Default::default() };
+        let m = from_mtl(&mtl);
+        assert_eq!(m.emission, [17.0 * PI, 12.0 * PI, 4.0 * PI]);
+        assert_eq!(m.specular_reflectance, [0.0; 3], "illum 2 highlight is not a mirror");
+    }
+
+    #[test]
+    fn implausible_materials_are_refused() {
+        let mut m = default_material();
+        assert_eq!(check(&m), None);
+        m.diffuse = [0.7, 0.7, 0.7];
+        m.specular_reflectance = [0.5, 0.0, 0.0];
+        assert!(check(&m).unwrap().contains("channel 0"));
+        m.specular_reflectance = [0.0; 3];
+        m.diffuse[1] = f64::NAN;
+        assert!(check(&m).unwrap().contains("outside [0, 1]"));
+    }
+}
