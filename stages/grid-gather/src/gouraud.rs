@@ -1,0 +1,295 @@
+//! Preview shading: the solution's piecewise-constant element radiosity
+//! made continuous by Gouraud interpolation over the leaf elements' corners.
+//!
+//! # Vertex radiosity
+//!
+//! Every leaf corner `c` of leaf `i` gets the value
+//!
+//! ```text
+//! B_c = sum_{j in S(c)} A_j B_j / sum_{j in S(c)} A_j
+//! ```
+//!
+//! where `S(c)` holds the leaves `j` that have a corner at the same world
+//! point as `c` and whose normal lies within the crease angle of leaf `i`'s
+//! normal (`n_i . n_j >= cos(crease)`; `i` itself always belongs). `A_j` is
+//! the leaf's area in m² (its triangle's area over `4^level`, exact for the
+//! 1:4 rule), `B_j` its radiosity in W/m². A crease (wall against floor)
+//! therefore stays sharp, while the two triangles of a flat wall or the
+//! facets of a tessellated sphere blend. Inside a leaf, radiosity is
+//! `B(p) = sum_k l_k B_{c_k}` with `l` the point's barycentric coordinates
+//! in the leaf (linear interpolation, Gouraud 1971).
+//!
+//! # Coincident corners
+//!
+//! Corners are compared in f64 world (mesh-frame) coordinates: two corners
+//! are the same point when every coordinate differs by at most
+//! `h = weld_tolerance x` the scene's bounding-box diagonal. Each corner is
+//! hashed into the cube of side `h` that contains it (`round(p / h)`), and a
+//! lookup scans that cube and its 26 neighbours, then checks the distance.
+//! So one point computed twice with different rounding (from two triangles'
+//! barycentrics) is never split across a cell border. Sums run over the
+//! matched leaves sorted by leaf index, so every corner of one point gets
+//! bit-identical values whatever the thread count.
+//!
+//! # Remaining discontinuities
+//!
+//! T-vertices are not resolved: where a fine leaf's corner lies on the edge
+//! of a coarser neighbouring leaf (the solver refined one side of an edge
+//! more than the other), the coarse leaf interpolates between its own two
+//! corners along that edge and ignores the fine corner's value, so the image
+//! can step slightly along such edges. This is a preview: the full final
+//! gather (perspective grid, sender classification; paper 000 Sec. 4, a
+//! later issue) replaces it and does not interpolate element radiosity.
+
+use glam::DVec3;
+use radiometry::geometry::TriangleGeometry;
+use radiometry::subdivision::{children, locate_child, Corners, ROOT};
+use rayon::prelude::*;
+use schemas::solution::{Solution, NONE};
+use schemas::{Error, Result};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// How leaf corners are merged into shading vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Smoothing {
+    /// Leaves whose normals differ by more than this angle, degrees, do not
+    /// blend at a shared corner.
+    pub crease_angle_deg: f64,
+    /// Corners closer than this fraction of the scene's bounding-box
+    /// diagonal (per coordinate) are one point.
+    pub weld_tolerance: f64,
+}
+
+/// One leaf element with what shading needs of it.
+struct Leaf {
+    /// Element index in the solution.
+    element: u32,
+    /// Mesh triangle.
+    triangle: u32,
+    /// Subdivision depth.
+    level: u32,
+    /// Barycentric corners in the triangle, from the 1:4 rule.
+    corners: Corners,
+}
+
+/// Gouraud-interpolated radiosity over the solution's leaf elements.
+#[derive(Clone, Debug)]
+pub struct Gouraud {
+    /// `first_child` of every element.
+    first_child: Vec<u32>,
+    /// Leaf number of every element, [`NONE`] for inner elements.
+    leaf_of_element: Vec<u32>,
+    /// Radiosity at the three corners of every leaf, W/m², RGB.
+    corner_radiosity: Vec<[[f64; 3]; 3]>,
+    /// Number of distinct corner points (welded positions).
+    vertices: usize,
+}
+
+impl Gouraud {
+    /// Checks that `solution` belongs to the mesh of `triangles` and
+    /// computes the vertex radiosity. `solution_path` only names the file in
+    /// errors.
+    pub fn new(triangles: &[TriangleGeometry], solution: &Solution, solution_path: &Path, smoothing: Smoothing) -> Result<Self> {
+        let leaves = leaves(triangles.len(), solution).map_err(|why| {
+            Error::invalid(solution_path, None, format!("solution does not belong to this mesh: {why}"))
+        })?;
+        let elements = &solution.elements;
+        if let Some(leaf) = leaves.iter().find(|l| !elements[l.element as usize].radiosity.iter().all(|b| b.is_finite())) {
+            return Err(Error::invalid(solution_path, None, format!("element {} has a non-finite radiosity", leaf.element)));
+        }
+        let mut leaf_of_element = vec![NONE; elements.len()];
+        for (k, leaf) in leaves.iter().enumerate() {
+            leaf_of_element[leaf.element as usize] = k as u32;
+        }
+
+        // Per leaf: world corners, normal, area, radiosity.
+        let positions: Vec<DVec3> =
+            leaves.iter().flat_map(|l| triangles[l.triangle as usize].element(&l.corners)).collect();
+        let normal: Vec<DVec3> = leaves.iter().map(|l| triangles[l.triangle as usize].normal).collect();
+        let area: Vec<f64> =
+            leaves.iter().map(|l| triangles[l.triangle as usize].area * 0.25f64.powi(l.level as i32)).collect();
+        let radiosity: Vec<[f64; 3]> =
+            leaves.iter().map(|l| elements[l.element as usize].radiosity.map(f64::from)).collect();
+
+        let cell = weld_cell(triangles, smoothing.weld_tolerance);
+        let key = |p: DVec3| -> [i64; 3] { (p / cell).round().to_array().map(|x| x as i64) };
+        // Built sequentially in corner order: each cell's list is sorted.
+        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (c, &p) in positions.iter().enumerate() {
+            grid.entry(key(p)).or_default().push(c as u32);
+        }
+        let cos_crease = smoothing.crease_angle_deg.to_radians().cos();
+
+        // (value, whether this corner is the lowest-numbered one at its point)
+        let per_corner: Vec<([f64; 3], bool)> = (0..positions.len())
+            .into_par_iter()
+            .map(|c| {
+                let p = positions[c];
+                let home = key(p);
+                let mut same_point = Vec::new();
+                for dx in -1..=1 {
+                    for dy in -1..=1 {
+                        for dz in -1..=1 {
+                            let Some(ids) = grid.get(&[home[0] + dx, home[1] + dy, home[2] + dz]) else { continue };
+                            same_point.extend(ids.iter().map(|&d| d as usize).filter(|&d| {
+                                let q = positions[d];
+                                (q - p).abs().max_element() <= cell
+                            }));
+                        }
+                    }
+                }
+                let representative = same_point.iter().all(|&d| d >= c);
+                let me = c / 3;
+                let mut blend: Vec<usize> = same_point
+                    .into_iter()
+                    .map(|d| d / 3)
+                    .filter(|&j| j == me || normal[me].dot(normal[j]) >= cos_crease)
+                    .collect();
+                blend.sort_unstable();
+                blend.dedup();
+                let (mut weighted, mut total) = ([0.0; 3], 0.0);
+                for &j in &blend {
+                    for (w, b) in weighted.iter_mut().zip(radiosity[j]) {
+                        *w += area[j] * b;
+                    }
+                    total += area[j];
+                }
+                let value = if total > 0.0 { weighted.map(|w| w / total) } else { radiosity[me] };
+                (value, representative)
+            })
+            .collect();
+
+        let vertices = per_corner.iter().filter(|(_, first)| *first).count();
+        let corner_radiosity =
+            per_corner.chunks_exact(3).map(|c| [c[0].0, c[1].0, c[2].0]).collect();
+        let first_child = elements.iter().map(|e| e.first_child).collect();
+        Ok(Gouraud { first_child, leaf_of_element, corner_radiosity, vertices })
+    }
+
+    /// Number of leaf elements.
+    pub fn leaves(&self) -> usize {
+        self.corner_radiosity.len()
+    }
+
+    /// Number of distinct corner points of the leaves (shared corners
+    /// counted once, whatever their normals).
+    pub fn vertices(&self) -> usize {
+        self.vertices
+    }
+
+    /// Radiosity B, W/m² RGB, at the point with barycentric `uv` in mesh
+    /// triangle `triangle`: descend from the triangle's root element to the
+    /// leaf containing the point, then interpolate the leaf's corner values.
+    /// Coordinates slightly outside the triangle (ray-hit round-off) are
+    /// clamped onto it.
+    pub fn radiosity(&self, triangle: u32, uv: [f64; 2]) -> [f64; 3] {
+        let mut local = [1.0 - uv[0] - uv[1], uv[0], uv[1]].map(|l| l.max(0.0));
+        let sum: f64 = local.iter().sum();
+        local = if sum > 0.0 { local.map(|l| l / sum) } else { [1.0 / 3.0; 3] };
+        let mut element = triangle as usize;
+        while self.first_child[element] != NONE {
+            let (k, child_local) = locate_child(local);
+            local = child_local;
+            element = self.first_child[element] as usize + k;
+        }
+        let corners = &self.corner_radiosity[self.leaf_of_element[element] as usize];
+        std::array::from_fn(|channel| (0..3).map(|k| local[k] * corners[k][channel]).sum())
+    }
+}
+
+/// Side of the weld cell: `tolerance x` the bounding-box diagonal of the
+/// triangles (`tolerance` itself, in metres, for a scene of zero extent).
+fn weld_cell(triangles: &[TriangleGeometry], tolerance: f64) -> f64 {
+    let corners = triangles.iter().flat_map(|t| t.corners);
+    let (lo, hi) = corners.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let diagonal = (hi - lo).length();
+    if diagonal.is_finite() && diagonal > 0.0 {
+        tolerance * diagonal
+    } else {
+        tolerance
+    }
+}
+
+/// The leaves of the hierarchy below every input triangle, triangle by
+/// triangle in depth-first order, with their corners from the 1:4 rule;
+/// checks on the way that the hierarchy is the one the rule and the mesh
+/// with `triangle_count` triangles give. The error says what does not fit.
+fn leaves(triangle_count: usize, solution: &Solution) -> std::result::Result<Vec<Leaf>, String> {
+    let elements = &solution.elements;
+    let n = elements.len();
+    if n < triangle_count {
+        return Err(format!("it has {n} elements, fewer than the mesh's {triangle_count} triangles"));
+    }
+    for (i, e) in elements.iter().enumerate() {
+        if e.triangle as usize >= triangle_count {
+            return Err(format!("element {i} lies on triangle {}, but the mesh has {triangle_count} triangles", e.triangle));
+        }
+        let root = i < triangle_count;
+        if root && (e.triangle as usize != i || e.parent != NONE || e.level != 0) {
+            return Err(format!(
+                "element {i} should be input triangle {i} (level 0, no parent), found triangle {} level {}",
+                e.triangle, e.level
+            ));
+        }
+        if !root && e.parent == NONE {
+            return Err(format!("element {i} has no parent but is not one of the mesh's {triangle_count} triangles"));
+        }
+    }
+    let per_root: Vec<std::result::Result<(Vec<Leaf>, usize), String>> =
+        (0..triangle_count).into_par_iter().map(|t| leaves_below(solution, t as u32)).collect();
+    let mut all = Vec::new();
+    let mut reached = 0;
+    for result in per_root {
+        let (leaves, visited) = result?;
+        all.extend(leaves);
+        reached += visited;
+    }
+    if reached != n {
+        return Err(format!("{} of its {n} elements lie below no input triangle", n - reached));
+    }
+    Ok(all)
+}
+
+/// Largest difference allowed between a stored corner and the 1:4 rule's.
+const CORNER_TOLERANCE: f64 = 1e-6;
+
+/// Leaves below root element `t` and the number of elements visited.
+fn leaves_below(solution: &Solution, t: u32) -> std::result::Result<(Vec<Leaf>, usize), String> {
+    let elements = &solution.elements;
+    let mut stack = vec![(t, ROOT)];
+    let (mut leaves, mut visited) = (Vec::new(), 0);
+    while let Some((i, corners)) = stack.pop() {
+        visited += 1;
+        let e = &elements[i as usize];
+        let stored_fits = e.corners.iter().zip(&corners).all(|(s, c)| {
+            (f64::from(s[0]) - c[0]).abs() <= CORNER_TOLERANCE && (f64::from(s[1]) - c[1]).abs() <= CORNER_TOLERANCE
+        });
+        if !stored_fits {
+            return Err(format!("element {i} has corners {:?}, but the 1:4 rule gives {corners:?}", e.corners));
+        }
+        if e.is_leaf() {
+            leaves.push(Leaf { element: i, triangle: t, level: e.level, corners });
+            continue;
+        }
+        let first = e.first_child as usize;
+        if first + 4 > elements.len() {
+            return Err(format!("element {i} has children beyond the element table"));
+        }
+        // Pushed in reverse so that children are visited in order.
+        for (k, child_corners) in children(&corners).into_iter().enumerate().rev() {
+            let c = &elements[first + k];
+            if c.parent != i || c.triangle != t || c.level != e.level + 1 {
+                return Err(format!(
+                    "element {} is listed as child {k} of element {i} but names parent {}, triangle {}, level {}",
+                    first + k,
+                    c.parent,
+                    c.triangle,
+                    c.level
+                ));
+            }
+            stack.push(((first + k) as u32, child_corners));
+        }
+    }
+    Ok((leaves, visited))
+}

@@ -1,0 +1,122 @@
+//! Camera rays through the pixels, closest hits, and the per-pixel mean.
+
+use crate::gouraud::Gouraud;
+use radiometry::camera::Pinhole;
+use radiometry::geometry::TriangleGeometry;
+use radiometry::rays::SceneRays;
+use radiometry::sampling::Stream;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// What the camera sees: the scene's triangles, their BVH, their shading.
+pub struct View<'a> {
+    /// The camera.
+    pub camera: &'a Pinhole,
+    /// Triangle geometry, mesh frame.
+    pub triangles: &'a [TriangleGeometry],
+    /// BVH over `triangles`; `None` for an empty scene.
+    pub rays: Option<&'a SceneRays>,
+    /// Radiosity over the surfaces.
+    pub shading: &'a Gouraud,
+}
+
+/// How pixels are sampled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampling {
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Samples per pixel, at least 1.
+    pub spp: u32,
+    /// Seed of the per-pixel random streams.
+    pub seed: u64,
+}
+
+/// A rendered image before it gets its header.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    /// Radiance per pixel, W/(m² sr), linear RGB, row-major, top row first.
+    pub rgb: Vec<[f32; 3]>,
+    /// Fraction of each pixel's samples that hit a surface.
+    pub coverage: Vec<f32>,
+    /// Camera rays that hit a surface.
+    pub hits: u64,
+    /// Of those, hits on the back of a triangle (shaded black).
+    pub back_face_hits: u64,
+}
+
+/// The `k`-th of `n` sample positions in the unit pixel: the first `m²`
+/// samples (`m = floor(sqrt n)`) are jittered in an `m x m` grid of
+/// strata, row by row; the remaining `n - m²` are uniform over the pixel.
+/// Every sample is uniform over its stratum, so the equal-weight mean is an
+/// unbiased estimate of the pixel's mean radiance.
+pub fn pixel_offset(k: u32, n: u32, stream: &mut Stream) -> (f64, f64) {
+    let m = (f64::from(n).sqrt().floor() as u32).max(1);
+    let (jx, jy) = (stream.next_f64(), stream.next_f64());
+    if k < m * m {
+        ((f64::from(k % m) + jx) / f64::from(m), (f64::from(k / m) + jy) / f64::from(m))
+    } else {
+        (jx, jy)
+    }
+}
+
+/// Renders the image: rows in parallel, each pixel from its own random
+/// stream keyed by `(seed, pixel index)`, so the result does not depend on
+/// the thread count. Radiance of a front-face hit is `L = B / pi`
+/// (Lambertian exitance to radiance, W/(m² sr)); a back-face hit
+/// (`direction . normal > 0`) is black, since radiosity is one-sided; a miss
+/// is black with no coverage. `rows_done` is called with 1 after each row.
+pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync)) -> Film {
+    let Sampling { width, height, spp, seed } = sampling;
+    let rows: Vec<(Vec<([f32; 3], f32)>, u64, u64)> = (0..height)
+        .into_par_iter()
+        .map(|y| {
+            let (mut hits, mut back) = (0, 0);
+            let row = (0..width)
+                .map(|x| {
+                    let pixel = u64::from(y) * u64::from(width) + u64::from(x);
+                    let mut stream = Stream::new(seed, pixel, 0);
+                    let (mut sum, mut covered) = ([0.0f64; 3], 0u32);
+                    for k in 0..spp {
+                        let (jx, jy) = pixel_offset(k, spp, &mut stream);
+                        let Some(sample) = trace(view, f64::from(x) + jx, f64::from(y) + jy) else { continue };
+                        covered += 1;
+                        hits += 1;
+                        match sample {
+                            Some(radiance) => sum.iter_mut().zip(radiance).for_each(|(s, r)| *s += r),
+                            None => back += 1,
+                        }
+                    }
+                    let n = f64::from(spp);
+                    (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32)
+                })
+                .collect();
+            rows_done(1);
+            (row, hits, back)
+        })
+        .collect();
+    let mut film = Film { rgb: Vec::new(), coverage: Vec::new(), hits: 0, back_face_hits: 0 };
+    for (row, hits, back) in rows {
+        film.rgb.extend(row.iter().map(|p| p.0));
+        film.coverage.extend(row.iter().map(|p| p.1));
+        film.hits += hits;
+        film.back_face_hits += back;
+    }
+    film
+}
+
+/// One camera ray through image point `(x, y)`: `None` for a miss,
+/// `Some(None)` for a back-face hit, `Some(Some(L))` for the radiance of a
+/// front-face hit.
+fn trace(view: &View, x: f64, y: f64) -> Option<Option<[f64; 3]>> {
+    let direction = view.camera.direction(x, y);
+    let hit = view.rays?.closest_hit(view.camera.eye, direction, 0.0, f32::INFINITY, [u32::MAX; 2])?;
+    let triangle = &view.triangles[hit.triangle as usize];
+    if direction.dot(triangle.normal) > 0.0 {
+        return Some(None);
+    }
+    let point = view.camera.eye + direction * f64::from(hit.t);
+    let radiosity = view.shading.radiosity(hit.triangle, triangle.uv_of(point));
+    Some(Some(radiosity.map(|b| b / PI)))
+}
