@@ -111,7 +111,9 @@ impl Params {
         for (name, setting) in [("key", self.key), ("exposure", self.exposure)] {
             if let Setting::Fixed(v) = setting {
                 if !(v.is_finite() && v > 0.0) {
-                    return Err(schemas::stage::bad_parameter(format!("{name} must be a positive number or 'auto', got {v}")));
+                    return Err(schemas::stage::bad_parameter(format!(
+                        "{name} must be a positive number or 'auto', got {v}"
+                    )));
                 }
             }
         }
@@ -392,7 +394,11 @@ mod tests {
     #[test]
     fn exposure_operator_exact_value() {
         // k = ln 2, x = 1: y = 1/2, sRGB 0.735357 -> 187.52 -> 188.
-        let params = Params { operator: Operator::Exposure, exposure: Setting::Fixed(std::f64::consts::LN_2), ..Params::default() };
+        let params = Params {
+            operator: Operator::Exposure,
+            exposure: Setting::Fixed(std::f64::consts::LN_2),
+            ..Params::default()
+        };
         let out = tonemap(&grey(&[1.0, 0.0]), &params).unwrap();
         assert_eq!(out.pixels, vec![[188, 188, 188], [0, 0, 0]]);
         // Auto: k = 1 / L_avg; a uniform image at 2 maps to 1 - 1/e = 0.632 -> sRGB 0.81647 -> 208.2 -> 208.

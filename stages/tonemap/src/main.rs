@@ -66,7 +66,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (image, record) = HdrImage::read(input)?;
     run.input(record);
     let mapped = tonemap::tonemap(&image, &params).map_err(|e| Error::invalid(input, None, e.to_string()))?;
-    let png = tonemap::encode_png(mapped.width, mapped.height, &mapped.pixels).map_err(|e| Error::invalid(output, None, e))?;
+    let png = tonemap::encode_png(mapped.width, mapped.height, &mapped.pixels)
+        .map_err(|e| Error::invalid(output, None, e))?;
     schemas::atomic::write_bytes_atomically(output, &png)?;
     if let Some(report) = args.report.as_deref() {
         write_report(&run, report, &params, &mapped.stats)?;
