@@ -202,3 +202,6 @@ pub fn skipped_in_preview(manifest: &Manifest) -> Vec<String> {
     skipped.extend(present.iter().filter(|(on, _)| *on).map(|(_, why)| why.to_string()));
     skipped
 }
+
+#[cfg(test)]
+mod tests;

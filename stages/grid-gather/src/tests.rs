@@ -1,0 +1,341 @@
+//! Tests over small in-memory scenes with known answers.
+
+use crate::gouraud::{Gouraud, Smoothing};
+use crate::render::pixel_offset;
+use crate::{gather, Mode, Params, Rendered, Scene};
+use glam::{dvec3, DVec3};
+use radiometry::geometry::{mesh_triangles, TriangleGeometry};
+use radiometry::sampling::Stream;
+use radiometry::subdivision::{children, Corners, ROOT};
+use schemas::header::{Provenance, Schema};
+use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
+use schemas::solution::{Element, Solution, NONE};
+use std::f64::consts::PI;
+use std::path::Path;
+
+fn provenance() -> Provenance {
+    Provenance {
+        stage: "test".into(),
+        stage_version: "0".into(),
+        command_line: vec![],
+        parameters: ron::Value::Unit,
+        inputs: vec![],
+    }
+}
+
+/// A mesh of the given triangles (corners counter-clockwise from the front).
+fn mesh(triangles: &[[DVec3; 3]]) -> Mesh {
+    let mut positions = Vec::new();
+    let mut tris = Vec::new();
+    for t in triangles {
+        let base = positions.len() as u32;
+        positions.extend(t.iter().map(|p| p.as_vec3().to_array()));
+        let g = TriangleGeometry::new(*t);
+        tris.push(Triangle {
+            vertices: [base, base + 1, base + 2],
+            material: 0,
+            object: 0,
+            area: g.area as f32,
+            normal: g.normal.as_vec3().to_array(),
+        });
+    }
+    Mesh { header: Mesh::header(provenance()), positions, triangles: tris }
+}
+
+fn manifest(eye: DVec3, target: DVec3, size: u32) -> Manifest {
+    let black = [0.0; 3];
+    Manifest {
+        header: Manifest::header(provenance()),
+        world_from_mesh_translation: [0.0; 3],
+        camera: Camera { eye: eye.to_array(), target: target.to_array(), up: [0.0, 1.0, 0.0], vertical_fov_deg: 60.0, width: size, height: size },
+        materials: vec![Material {
+            name: "grey".into(),
+            diffuse: [0.5; 3],
+            emission: black,
+            specular_reflectance: black,
+            specular_transmittance: black,
+            diffuse_transmittance: black,
+            diffuse_map: None,
+            alpha_map: None,
+            normal_map: None,
+        }],
+        objects: vec!["square".into()],
+        goniometric_lights: vec![],
+        effects: Effects::default(),
+        statistics: MeshStatistics::default(),
+    }
+}
+
+/// Every triangle subdivided `depth` levels by the 1:4 rule; every element
+/// gets the radiosity `b(triangle, its corners)`.
+fn solution(triangle_count: usize, depth: u32, b: impl Fn(u32, &Corners) -> f32) -> Solution {
+    let element = |triangle: u32, parent: u32, level: u32, c: &Corners| Element {
+        triangle,
+        parent,
+        first_child: NONE,
+        level,
+        corners: c.map(|uv| uv.map(|x| x as f32)),
+        area: 0.5f32.powi(2 * level as i32),
+        radiosity: [b(triangle, c); 3],
+    };
+    let mut elements: Vec<Element> = (0..triangle_count as u32).map(|t| element(t, NONE, 0, &ROOT)).collect();
+    let mut frontier: Vec<(u32, Corners)> = (0..triangle_count as u32).map(|t| (t, ROOT)).collect();
+    for level in 1..=depth {
+        let mut next = Vec::new();
+        for (i, c) in frontier {
+            let first = elements.len() as u32;
+            elements[i as usize].first_child = first;
+            let triangle = elements[i as usize].triangle;
+            for (k, child) in children(&c).iter().enumerate() {
+                elements.push(element(triangle, i, level, child));
+                next.push((first + k as u32, *child));
+            }
+        }
+        frontier = next;
+    }
+    Solution { header: Solution::header(provenance()), elements, links: vec![] }
+}
+
+/// The unit square in z = 0 facing +z, split along its diagonal (0,0)-(1,1):
+/// triangle 0 below the diagonal (x > y), triangle 1 above.
+fn square() -> [[DVec3; 3]; 2] {
+    let (a, b, c, d) = (dvec3(0.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(1.0, 1.0, 0.0), dvec3(0.0, 1.0, 0.0));
+    [[a, b, c], [a, c, d]]
+}
+
+/// Camera 2 m in front of the square's centre: the square spans about 28
+/// of the 64 rows, the image border sees nothing.
+fn front_camera() -> Manifest {
+    manifest(dvec3(0.5, 0.5, 2.0), dvec3(0.5, 0.5, 0.0), 64)
+}
+
+fn render(params: &Params, mesh: &Mesh, manifest: &Manifest, solution: &Solution) -> Rendered {
+    let scene = Scene { mesh, manifest, manifest_path: Path::new("manifest.ron"), solution, solution_path: Path::new("solution.exr") };
+    gather(params, &scene, &|_| {}).expect("render")
+}
+
+const SMOOTH: Smoothing = Smoothing { crease_angle_deg: 30.0, weld_tolerance: 1e-7 };
+
+#[test]
+fn uniform_radiosity_gives_b_over_pi_times_coverage() {
+    let mesh = mesh(&square());
+    let image = render(&Params::default(), &mesh, &front_camera(), &solution(2, 2, |_, _| 2.0));
+    let expected = 2.0 / PI;
+    for (rgb, &a) in image.rgb.iter().zip(&image.coverage) {
+        for channel in rgb {
+            assert!((f64::from(*channel) - expected * f64::from(a)).abs() < 1e-6, "{rgb:?} at coverage {a}");
+        }
+    }
+    let full = image.coverage.iter().filter(|&&a| a == 1.0).count();
+    assert!(full > 500, "the square covers the image centre: {full} pixels");
+    assert_eq!(image.coverage[0], 0.0, "the corner pixel misses");
+    assert_eq!(image.rgb[0], [0.0; 3]);
+    assert!(image.coverage.iter().any(|&a| a > 0.0 && a < 1.0), "the square's outline is partly covered");
+    assert_eq!(image.counters["rays_cast"], 64.0 * 64.0 * 4.0);
+    assert_eq!(image.counters["leaf_elements"], 32.0);
+    // 4 corners of the square, 15 corner points per 16-leaf triangle:
+    // 25 distinct points on the 4 x 4 grid of the square.
+    assert_eq!(image.counters["vertices"], 25.0);
+}
+
+/// Luminance-free helper: the red channel as radiosity B = pi L.
+fn b_of(image: &Rendered, x: usize, y: usize) -> f64 {
+    f64::from(image.rgb[y * image.width + x][0]) * PI
+}
+
+#[test]
+fn different_triangles_blend_continuously_across_the_flat_diagonal() {
+    let mesh = mesh(&square());
+    let two_values = solution(2, 2, |t, _| if t == 0 { 1.0 } else { 3.0 });
+    let image = render(&Params { spp: 16, ..Params::default() }, &mesh, &front_camera(), &two_values);
+    let full = |x: usize, y: usize| image.coverage[y * image.width + x] == 1.0;
+    let mut largest_step: f64 = 0.0;
+    let mut on_diagonal = Vec::new();
+    for y in 0..image.height {
+        for x in 1..image.width {
+            if full(x - 1, y) && full(x, y) {
+                largest_step = largest_step.max((b_of(&image, x, y) - b_of(&image, x - 1, y)).abs());
+            }
+        }
+        // World y grows upwards, image y downwards: the diagonal x = y of the
+        // square is the image's anti-diagonal x + y = 63 around the centre.
+        let x = 63 - y;
+        if full(x, y) && (x as i64 - 32).abs() < 10 {
+            on_diagonal.push(b_of(&image, x, y));
+        }
+    }
+    // Flat shading would jump by 2 across the diagonal; the steepest
+    // Gouraud slope is 1 per 0.177 m leaf height, 0.036 m per pixel.
+    assert!(largest_step < 0.35, "adjacent pixels differ by {largest_step}");
+    assert!(on_diagonal.len() > 10);
+    for b in on_diagonal {
+        assert!((b - 2.0).abs() < 0.25, "the diagonal is the area-weighted mean 2, got {b}");
+    }
+    // Far from the diagonal each triangle keeps its own radiosity: near
+    // corner (1, 0) (image right, bottom) B = 1; near (0, 1) B = 3.
+    let (lo, hi) = (b_of(&image, 44, 44), b_of(&image, 19, 19));
+    assert!((lo - 1.0).abs() < 1e-5 && (hi - 3.0).abs() < 1e-5, "{lo} {hi}");
+}
+
+#[test]
+fn vertex_values_are_area_weighted_means_and_a_crease_stays_sharp() {
+    let two_values = |t: u32, _: &Corners| if t == 0 { 1.0 } else { 3.0 };
+    // uv of the point (s, s) in each triangle: (u + v, v) in 0, (u, u + v) in 1.
+    let on_diagonal = |t: u32, s: f64| if t == 0 { [0.0, s] } else { [s, 0.0] };
+    let flat = mesh_triangles(&mesh(&square()));
+    let g = Gouraud::new(&flat, &solution(2, 2, two_values), Path::new("s.exr"), SMOOTH).unwrap();
+    for s in [0.0, 0.1, 0.25, 0.4, 0.5, 0.8, 1.0] {
+        for t in 0..2 {
+            let b = g.radiosity(t, on_diagonal(t, s));
+            assert!((b[0] - 2.0).abs() < 1e-12, "flat, triangle {t} at {s}: {b:?}");
+        }
+    }
+    // Fold triangle 1 up by 90 degrees about the diagonal: a floor and a wall.
+    let [floor, wall] = square();
+    let folded = [floor, [wall[0], wall[1], dvec3(0.5, 0.5, 0.5f64.sqrt())]];
+    let folded = mesh_triangles(&mesh(&folded));
+    assert!(folded[0].normal.dot(folded[1].normal).abs() < 1e-12);
+    let g = Gouraud::new(&folded, &solution(2, 2, two_values), Path::new("s.exr"), SMOOTH).unwrap();
+    for s in [0.0, 0.25, 0.4, 1.0] {
+        assert!((g.radiosity(0, on_diagonal(0, s))[0] - 1.0).abs() < 1e-12);
+        assert!((g.radiosity(1, on_diagonal(1, s))[0] - 3.0).abs() < 1e-12);
+    }
+    // A crease angle over 90 degrees blends them again.
+    let wide = Smoothing { crease_angle_deg: 95.0, ..SMOOTH };
+    let g = Gouraud::new(&folded, &solution(2, 2, two_values), Path::new("s.exr"), wide).unwrap();
+    let blended = g.radiosity(0, on_diagonal(0, 0.4))[0];
+    assert!((blended - 2.0).abs() < 1e-6, "areas differ by the f32 rounding of the fold: {blended}");
+}
+
+#[test]
+fn interpolation_inside_a_subdivided_triangle_matches_the_hand_computation() {
+    // One triangle, one level: children (corner 0, corner 1, corner 2,
+    // middle) with B = a, b, c, d and equal areas.
+    let (a, b, c, d) = (1.0, 2.0, 4.0, 8.0);
+    let values = [a, b, c, d];
+    let one = [square()[0]];
+    let mut sol = solution(1, 1, |_, _| 0.0);
+    for k in 0..4 {
+        sol.elements[1 + k].radiosity = [values[k] as f32; 3];
+    }
+    let g = Gouraud::new(&mesh_triangles(&mesh(&one)), &sol, Path::new("s.exr"), SMOOTH).unwrap();
+    let (m01, m12, m20) = ((a + b + d) / 3.0, (b + c + d) / 3.0, (a + c + d) / 3.0);
+    let cases = [
+        ([0.0, 0.0], a),
+        ([1.0, 0.0], b),
+        ([0.0, 1.0], c),
+        ([0.5, 0.0], m01),
+        ([0.5, 0.5], m12),
+        ([0.0, 0.5], m20),
+        ([0.25, 0.0], 0.5 * (a + m01)),
+        ([0.5, 0.25], 0.5 * (m01 + m12)),
+        ([1.0 / 3.0, 1.0 / 3.0], (m01 + m12 + m20) / 3.0),
+        // Inside corner child 1 at local (0.25, 0.5, 0.25) of [m01, c1, m12].
+        ([0.25 * 0.5 + 0.5 + 0.25 * 0.5, 0.25 * 0.5], 0.25 * m01 + 0.5 * b + 0.25 * m12),
+    ];
+    for (uv, want) in cases {
+        let got = g.radiosity(0, uv)[0];
+        assert!((got - want).abs() < 1e-12, "at {uv:?}: {got} != {want}");
+    }
+    // Continuous across the border of the middle and corner-1 children.
+    for e in [1e-9, -1e-9] {
+        let got = g.radiosity(0, [0.5 + e, 0.1])[0];
+        let want = 0.8 * m01 + 0.2 * m12; // on the segment m01 -> m12 at 1/5
+        assert!((got - want).abs() < 1e-7, "{got} vs {want}");
+    }
+}
+
+#[test]
+fn back_faces_shade_black_and_misses_have_no_coverage() {
+    let mesh = mesh(&square());
+    let behind = manifest(dvec3(0.5, 0.5, -2.0), dvec3(0.5, 0.5, 0.0), 32);
+    let image = render(&Params::default(), &mesh, &behind, &solution(2, 1, |_, _| 5.0));
+    assert!(image.rgb.iter().all(|p| *p == [0.0; 3]), "back faces are black");
+    assert_eq!(image.coverage[16 * 32 + 16], 1.0, "but they are covered");
+    assert_eq!(image.coverage[0], 0.0);
+    assert_eq!(image.counters["back_face_hits"], image.counters["ray_hits"]);
+    assert!(image.counters["ray_hits"] > 0.0);
+
+    let away = manifest(dvec3(0.5, 0.5, 2.0), dvec3(0.5, 0.5, 4.0), 16);
+    let image = render(&Params::default(), &mesh, &away, &solution(2, 1, |_, _| 5.0));
+    assert!(image.coverage.iter().all(|&a| a == 0.0) && image.rgb.iter().all(|p| *p == [0.0; 3]));
+}
+
+#[test]
+fn renders_are_bit_identical_across_runs_and_thread_counts() {
+    let mesh = mesh(&square());
+    let sol = solution(2, 3, |t, c| (1 + t) as f32 * (1.0 + c[0][0] as f32 + 2.0 * c[1][1] as f32));
+    let params = Params { spp: 5, seed: 7, ..Params::default() };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| render(&params, &mesh, &front_camera(), &sol))
+    };
+    let (one, four, again) = (run(1), run(4), run(4));
+    assert_eq!(one.rgb, four.rgb);
+    assert_eq!(one.coverage, four.coverage);
+    assert_eq!(four, again);
+    let other_seed = render(&Params { seed: 8, ..params.clone() }, &mesh, &front_camera(), &sol);
+    assert_ne!(other_seed.rgb, one.rgb, "the seed drives the jitter");
+}
+
+#[test]
+fn pixel_samples_are_stratified_and_inside_the_pixel() {
+    let mut stream = Stream::new(0, 0, 0);
+    let strata: Vec<(u32, u32)> = (0..4)
+        .map(|k| {
+            let (x, y) = pixel_offset(k, 4, &mut stream);
+            assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+            ((x * 2.0) as u32, (y * 2.0) as u32)
+        })
+        .collect();
+    assert_eq!(strata, [(0, 0), (1, 0), (0, 1), (1, 1)]);
+    for n in [1, 2, 3, 5, 10] {
+        for k in 0..n {
+            let (x, y) = pixel_offset(k, n, &mut stream);
+            assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+        }
+    }
+}
+
+#[test]
+fn a_solution_of_another_mesh_is_refused_naming_the_file() {
+    let three = mesh(&[square()[0], square()[1], square()[0].map(|p| p + DVec3::Z)]);
+    let m = front_camera();
+    let check = |sol: &Solution| {
+        let scene = Scene { mesh: &three, manifest: &m, manifest_path: Path::new("m.ron"), solution: sol, solution_path: Path::new("sol.exr") };
+        gather(&Params::default(), &scene, &|_| {}).unwrap_err().to_string()
+    };
+    let too_few = check(&solution(2, 1, |_, _| 1.0));
+    assert!(too_few.starts_with("sol.exr") && too_few.contains("solution does not belong to this mesh"), "{too_few}");
+    let mut foreign = solution(3, 1, |_, _| 1.0);
+    foreign.elements[5].triangle = 3;
+    assert!(check(&foreign).contains("triangle 3, but the mesh has 3 triangles"), "{}", check(&foreign));
+    let mut swapped = solution(3, 0, |_, _| 1.0);
+    swapped.elements[0].triangle = 1;
+    assert!(check(&swapped).contains("solution does not belong to this mesh"));
+    let mut bent = solution(3, 1, |_, _| 1.0);
+    bent.elements[4].corners[0] = [0.25, 0.0];
+    assert!(check(&bent).contains("1:4 rule"), "{}", check(&bent));
+    let ok = solution(3, 1, |_, _| 1.0);
+    let scene = Scene { mesh: &three, manifest: &m, manifest_path: Path::new("m.ron"), solution: &ok, solution_path: Path::new("sol.exr") };
+    assert!(gather(&Params::default(), &scene, &|_| {}).is_ok());
+}
+
+#[test]
+fn full_mode_is_refused_until_it_exists() {
+    let mesh = mesh(&square());
+    let m = front_camera();
+    let sol = solution(2, 0, |_, _| 1.0);
+    let scene = Scene { mesh: &mesh, manifest: &m, manifest_path: Path::new("m.ron"), solution: &sol, solution_path: Path::new("s.exr") };
+    let err = gather(&Params { mode: Mode::Full, ..Params::default() }, &scene, &|_| {}).unwrap_err();
+    assert!(err.to_string().contains("full gather not implemented yet (preview only)"));
+}
+
+#[test]
+fn params_round_trip_through_ron_and_refuse_typos() {
+    let p = Params { width: Some(320), spp: 16, ..Params::default() };
+    let text = schemas::ron_io::to_ron_text(&p);
+    assert_eq!(ron::from_str::<Params>(&text).unwrap(), p);
+    assert!(ron::from_str::<Params>("(spp: 2, sp: 3)").is_err());
+    assert_eq!(ron::from_str::<Params>("(spp: 2)").unwrap().crease_angle_deg, 30.0);
+}
