@@ -1,2 +1,155 @@
-//! hierarchical-solve binary (skeleton).
-fn main() {}
+//! `hierarchical-solve`: see the library's documentation and `--help`.
+
+use clap::Parser;
+use hierarchical_solve::{solve, Params};
+use schemas::header::Schema;
+use schemas::mesh::{Effects, Manifest, Mesh};
+use schemas::ron_io::read_ron;
+use schemas::solution::Solution;
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, Outputs, Run};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Hierarchical radiosity (Hanrahan, Salzman, Aupperle 1991) on a prepared
+/// mesh: BF refinement against a threshold and a minimum element area,
+/// Lambert's closed-form form factors, ray-cast visibility per link, Jacobi
+/// gather with push-pull. Writes solution.exr: the element hierarchy with
+/// radiosity, and every link (form factor, visibility, unoccluded
+/// irradiance, nearest occluder distance).
+#[derive(Parser, Debug)]
+#[command(name = "hierarchical-solve", version)]
+struct Args {
+    /// Input: mesh.exr from mesh-prep.
+    #[arg(long, required_unless_present = "print_params")]
+    mesh: Option<PathBuf>,
+    /// Input: manifest.ron from mesh-prep.
+    #[arg(long, required_unless_present = "print_params")]
+    manifest: Option<PathBuf>,
+    /// Output: the solution (EXR tables of elements and links).
+    #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
+    output: Option<PathBuf>,
+    /// Output: a report of the run (RON: work done, wall time).
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Read parameters from this RON file; flags below override it.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Print the effective parameters as RON and exit.
+    #[arg(long)]
+    print_params: bool,
+    /// BF refinement threshold, as a fraction of the largest emitted radiosity.
+    #[arg(long)]
+    eps: Option<f64>,
+    /// Smallest element area, as a fraction of the scene's total area.
+    #[arg(long)]
+    min_area: Option<f64>,
+    /// Visibility rays per link.
+    #[arg(long)]
+    visibility_rays: Option<usize>,
+    /// Stop gathering when no leaf changes by more than this fraction of the largest radiosity.
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// Jacobi iterations per solve, at most.
+    #[arg(long)]
+    max_iterations: Option<usize>,
+    /// Refine-and-solve passes, at most.
+    #[arg(long)]
+    max_passes: Option<usize>,
+    /// Seed of the visibility rays.
+    #[arg(long)]
+    seed: Option<u64>,
+}
+
+fn params_of(args: &Args) -> schemas::Result<Params> {
+    let mut p: Params = load_params(args.params.as_deref())?;
+    p.eps = args.eps.unwrap_or(p.eps);
+    p.min_area = args.min_area.unwrap_or(p.min_area);
+    p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
+    p.tolerance = args.tolerance.unwrap_or(p.tolerance);
+    p.max_iterations = args.max_iterations.unwrap_or(p.max_iterations);
+    p.max_passes = args.max_passes.unwrap_or(p.max_passes);
+    p.seed = args.seed.unwrap_or(p.seed);
+    match p.problem() {
+        Some(problem) => Err(bad_parameter(problem)),
+        None => Ok(p),
+    }
+}
+
+/// What this stage does not simulate, for the effects the scene has.
+fn skipped(effects: &Effects) -> Vec<String> {
+    let mut skipped = Vec::new();
+    let mut note = |present: bool, what: &str| {
+        if present {
+            skipped.push(what.to_string());
+        }
+    };
+    note(!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only");
+    note(effects.specular_reflection, "specular reflection: not simulated by hierarchical-solve; mirrors keep their diffuse part only");
+    note(effects.specular_transmission, "specular transmission: not simulated by hierarchical-solve");
+    note(effects.diffuse_transmission, "diffuse transmission: not simulated by hierarchical-solve");
+    note(effects.goniometric_lights, "goniometric lights: not simulated by hierarchical-solve; only emitting surfaces light the scene");
+    note(effects.textures, "textures: radiosity uses each material's mean diffuse reflectance");
+    note(effects.alpha_masks, "alpha masks: surfaces are treated as opaque");
+    note(effects.normal_maps, "normal maps: radiosity uses geometric normals");
+    note(effects.fine_clustered_geometry, "clustering: not available yet; every pair of input triangles starts linked");
+    skipped
+}
+
+fn run(args: Args) -> schemas::Result<ExitCode> {
+    let params = params_of(&args)?;
+    if args.print_params {
+        print_params(&params);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
+        unreachable!("clap requires the inputs and output without --print-params")
+    };
+    for path in [Some(output), args.report.as_ref()].into_iter().flatten() {
+        check_writable(path)?;
+    }
+    let mut run = Run::start("hierarchical-solve", env!("CARGO_PKG_VERSION"));
+    let (mesh, mesh_input) = Mesh::read(mesh_path)?;
+    let manifest = read_ron::<Manifest>(manifest_path)?;
+    manifest.value.check_mesh(mesh_path, &mesh)?;
+    run.input(mesh_input);
+    run.input(manifest.input);
+    let bar = progress(params.max_passes as u64, "passes");
+    let solved = solve(&mesh, &manifest.value, &params, &|p| {
+        bar.set_position(p.pass as u64);
+        bar.set_message(format!("{} links", p.links));
+    })
+    .map_err(|message| schemas::Error::invalid(mesh_path, None, message))?;
+    bar.finish_and_clear();
+    let w = &solved.work;
+    eprintln!(
+        "hierarchical-solve: {} passes, {} links, {} elements ({} leaves), {} rays, {} iterations",
+        w.passes, w.links, w.elements, w.leaves, w.rays, w.iterations
+    );
+    let solution = Solution { header: Solution::header(run.provenance(&params)), elements: solved.elements, links: solved.links };
+    let mut outputs = Outputs::new();
+    outputs.write(output, |p| solution.write(p))?;
+    if let Some(report) = &args.report {
+        let counters = BTreeMap::from([
+            ("passes".to_string(), w.passes as f64),
+            ("links".to_string(), w.links as f64),
+            ("elements".to_string(), w.elements as f64),
+            ("leaves".to_string(), w.leaves as f64),
+            ("form_factors".to_string(), w.form_factors as f64),
+            ("rays".to_string(), w.rays as f64),
+            ("iterations".to_string(), w.iterations as f64),
+            ("relative_change".to_string(), w.relative_change),
+            ("refine_seconds".to_string(), w.refine_seconds),
+            ("visibility_seconds".to_string(), w.visibility_seconds),
+            ("gather_seconds".to_string(), w.gather_seconds),
+            ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
+        ]);
+        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.value.effects), vec![]))?;
+    }
+    outputs.keep();
+    Ok(ExitCode::SUCCESS)
+}
+
+fn main() -> ExitCode {
+    exit_code("hierarchical-solve", run(Args::parse()))
+}

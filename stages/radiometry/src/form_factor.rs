@@ -102,6 +102,26 @@ pub const DUNAVANT_5: [([f64; 3], f64); 7] = {
     ]
 };
 
+/// The [`DUNAVANT_5`] estimate of the receiver-area mean of the point
+/// factor over `receiver`, and the largest point value.
+fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3]) -> (f64, f64) {
+    let mut mean = 0.0;
+    let mut max = 0.0f64;
+    for (b, w) in DUNAVANT_5 {
+        let p = receiver[0] * b[0] + receiver[1] * b[1] + receiver[2] * b[2];
+        let f = point_to_polygon(p, normal, sender);
+        mean += w * f;
+        max = max.max(f);
+    }
+    (mean, max)
+}
+
+/// Relative accuracy the adaptive receiver quadrature aims for.
+pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
+
+/// Deepest 1:4 split of the receiver the adaptive quadrature makes.
+pub const QUADRATURE_DEPTH: u32 = 7;
+
 /// Area-averaged form factor from a receiver triangle to a sender polygon:
 ///
 /// ```text
@@ -111,14 +131,47 @@ pub const DUNAVANT_5: [([f64; 3], f64); 7] = {
 /// with the inner factor exact (002 Eq. 3) and the outer integral by
 /// [`DUNAVANT_5`]. Returns the factor and the largest point value, which the
 /// refinement oracle uses as a bound.
+///
+/// Where the two are close (nearer than three times their sizes) the
+/// integrand varies fast, and near a shared edge it has a logarithmic
+/// singularity, so the rule is applied adaptively: a triangle whose estimate
+/// differs from the sum over its four midpoint children by more than
+/// [`QUADRATURE_TOLERANCE`] is split, down to [`QUADRATURE_DEPTH`] levels.
+/// This matters for energy balance: in a closed room with reflectance rho,
+/// a relative error d in the sum of a receiver's form factors becomes an
+/// error of about rho d / (1 - rho) in the mean radiosity.
 pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3]) -> (f64, f64) {
+    let centroid = |p: &[DVec3]| p.iter().copied().sum::<DVec3>() / p.len() as f64;
+    let size = |p: &[DVec3], c: DVec3| p.iter().map(|v| v.distance(c)).fold(0.0, f64::max);
+    let (cr, cs) = (centroid(receiver), centroid(sender));
+    let far = cr.distance(cs) > 3.0 * (size(receiver, cr) + size(sender, cs));
+    let coarse = rule(receiver, receiver_normal, sender);
+    if far {
+        coarse
+    } else {
+        adaptive(receiver, receiver_normal, sender, coarse, QUADRATURE_DEPTH)
+    }
+}
+
+fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3], coarse: (f64, f64), depth: u32) -> (f64, f64) {
+    if depth == 0 {
+        return coarse;
+    }
+    let [a, b, c] = *receiver;
+    let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
+    let children = [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]];
+    let estimates = children.map(|child| rule(&child, normal, sender));
+    let fine: f64 = estimates.iter().map(|e| e.0).sum::<f64>() * 0.25;
+    let max = estimates.iter().map(|e| e.1).fold(coarse.1, f64::max);
+    if (fine - coarse.0).abs() <= QUADRATURE_TOLERANCE * fine.abs().max(1e-12) {
+        return (fine, max);
+    }
     let mut mean = 0.0;
-    let mut max = 0.0f64;
-    for (b, w) in DUNAVANT_5 {
-        let p = receiver[0] * b[0] + receiver[1] * b[1] + receiver[2] * b[2];
-        let f = point_to_polygon(p, receiver_normal, sender);
-        mean += w * f;
-        max = max.max(f);
+    let mut max = max;
+    for (child, estimate) in children.iter().zip(estimates) {
+        let (m, x) = adaptive(child, normal, sender, estimate, depth - 1);
+        mean += 0.25 * m;
+        max = max.max(x);
     }
     (mean, max)
 }
@@ -179,6 +232,33 @@ mod tests {
         // Coplanar polygon: no exchange.
         let coplanar = [dvec3(1.0, 0.0, 0.0), dvec3(2.0, 0.0, 0.0), dvec3(1.0, 1.0, 0.0)];
         assert_eq!(point_to_polygon(DVec3::ZERO, DVec3::Z, &coplanar), 0.0);
+    }
+
+    /// Howell C-14: from a w x l rectangle to an h x l rectangle sharing
+    /// the edge of length l at right angles.
+    fn perpendicular_shared_edge(w: f64, h: f64, l: f64) -> f64 {
+        let (w, h) = (w / l, h / l);
+        let (w2, h2) = (w * w, h * h);
+        let s = (h2 + w2).sqrt();
+        let log = ((1.0 + w2) * (1.0 + h2) / (1.0 + w2 + h2)).ln()
+            + w2 * (w2 * (1.0 + w2 + h2) / ((1.0 + w2) * (w2 + h2))).ln()
+            + h2 * (h2 * (1.0 + h2 + w2) / ((1.0 + h2) * (h2 + w2))).ln();
+        (w * (1.0 / w).atan() + h * (1.0 / h).atan() - s * (1.0 / s).atan() + 0.25 * log) / (PI * w)
+    }
+
+    #[test]
+    fn adaptive_quadrature_resolves_the_shared_edge_singularity() {
+        // Receiver: the floor rectangle [0, w] x [0, l] at z = 0, split into
+        // two triangles; sender: the wall x = 0, z in [0, h], touching it.
+        let (w, h, l) = (1.0, 0.5, 2.0);
+        let floor = [dvec3(0.0, 0.0, 0.0), dvec3(w, 0.0, 0.0), dvec3(w, l, 0.0), dvec3(0.0, l, 0.0)];
+        let wall = [dvec3(0.0, 0.0, 0.0), dvec3(0.0, l, 0.0), dvec3(0.0, l, h), dvec3(0.0, 0.0, h)];
+        let halves = [[floor[0], floor[1], floor[2]], [floor[0], floor[2], floor[3]]];
+        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall).0).sum();
+        let exact = perpendicular_shared_edge(w, h, l);
+        assert!(((f - exact) / exact).abs() < 1e-4, "{f} vs {exact}");
+        let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &wall).0).sum();
+        assert!(((plain - exact) / exact).abs() > 1e-3, "the fixed rule alone would not do: {plain}");
     }
 
     #[test]

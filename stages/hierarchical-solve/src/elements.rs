@@ -1,0 +1,108 @@
+//! The element hierarchy: input triangles (elements `0..n`, element `t` is
+//! triangle `t`) and their 1:4 subdivisions, in one arena. Children are
+//! created in a deterministic order, four at a time, so element indices do
+//! not depend on threads.
+
+use glam::DVec3;
+use radiometry::geometry::TriangleGeometry;
+use radiometry::subdivision::{children, Corners, ROOT};
+use schemas::mesh::{Manifest, Mesh};
+use schemas::solution::NONE;
+
+/// One element.
+#[derive(Clone, Debug)]
+pub struct Element {
+    /// Input triangle.
+    pub triangle: u32,
+    /// Parent element or [`NONE`].
+    pub parent: u32,
+    /// First of four children or [`NONE`].
+    pub first_child: u32,
+    /// Depth below the input triangle.
+    pub level: u32,
+    /// Barycentric corners in the input triangle.
+    pub corners: Corners,
+    /// World corners, mesh frame.
+    pub points: [DVec3; 3],
+    /// Area, m².
+    pub area: f64,
+}
+
+impl Element {
+    /// Whether the element has no children.
+    pub fn is_leaf(&self) -> bool {
+        self.first_child == NONE
+    }
+}
+
+/// The arena plus the per-triangle data every element inherits.
+pub struct Hierarchy {
+    /// All elements; children of `e` are `first_child .. first_child + 4`.
+    pub elements: Vec<Element>,
+    /// Geometry of each input triangle.
+    pub triangles: Vec<TriangleGeometry>,
+    /// Diffuse reflectance of each input triangle.
+    pub reflectance: Vec<[f64; 3]>,
+    /// Emitted radiosity of each input triangle, W/m².
+    pub emission: Vec<[f64; 3]>,
+}
+
+impl Hierarchy {
+    /// One root element per input triangle.
+    pub fn new(mesh: &Mesh, manifest: &Manifest) -> Self {
+        let triangles = radiometry::geometry::mesh_triangles(mesh);
+        let elements = triangles
+            .iter()
+            .enumerate()
+            .map(|(t, g)| Element {
+                triangle: t as u32,
+                parent: NONE,
+                first_child: NONE,
+                level: 0,
+                corners: ROOT,
+                points: g.corners,
+                area: g.area,
+            })
+            .collect();
+        let material = |t: &schemas::mesh::Triangle| &manifest.materials[t.material as usize];
+        Hierarchy {
+            elements,
+            reflectance: mesh.triangles.iter().map(|t| material(t).diffuse).collect(),
+            emission: mesh.triangles.iter().map(|t| material(t).emission).collect(),
+            triangles,
+        }
+    }
+
+    /// Unit front normal of element `e` (its triangle's).
+    pub fn normal(&self, e: u32) -> DVec3 {
+        self.triangles[self.elements[e as usize].triangle as usize].normal
+    }
+
+    /// Diffuse reflectance of element `e`.
+    pub fn reflectance_of(&self, e: u32) -> [f64; 3] {
+        self.reflectance[self.elements[e as usize].triangle as usize]
+    }
+
+    /// Creates the four children of `e` if it has none; returns the first.
+    pub fn subdivide(&mut self, e: u32) -> u32 {
+        let parent = self.elements[e as usize].clone();
+        if !parent.is_leaf() {
+            return parent.first_child;
+        }
+        let first = self.elements.len() as u32;
+        let geometry = self.triangles[parent.triangle as usize];
+        for corners in children(&parent.corners) {
+            self.elements.push(Element {
+                triangle: parent.triangle,
+                parent: e,
+                first_child: NONE,
+                level: parent.level + 1,
+                corners,
+                points: geometry.element(&corners),
+                area: parent.area / 4.0,
+            });
+        }
+        self.elements[e as usize].first_child = first;
+        first
+    }
+}
