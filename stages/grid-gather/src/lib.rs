@@ -17,7 +17,7 @@
 //!
 //! | name | type | meaning | default |
 //! |---|---|---|---|
-//! | `mode` | `Preview` / `Full` | gather mode | `Preview` |
+//! | `mode` | `"preview"` / `"full"` | gather mode | `"preview"` |
 //! | `width`, `height` | pixels | image size | the manifest camera's |
 //! | `spp` | count | camera rays per pixel (stratified, jittered) | 4 |
 //! | `seed` | u64 | seed of the per-pixel random streams | 0 |
@@ -46,14 +46,38 @@ use std::path::Path;
 /// The message for `--mode full` until the full gather exists.
 pub const FULL_NOT_IMPLEMENTED: &str = "full gather not implemented yet (preview only)";
 
-/// Which gather to run.
+/// Which gather to run. Written as the strings `"preview"` / `"full"` (the
+/// CLI's values), so that the parameters recorded in provenance, which go
+/// through `ron::Value` and would drop a unit variant's name, keep it.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[serde(into = "String", try_from = "String")]
 pub enum Mode {
     /// Interpolate the solution's radiosity (Gouraud over element corners).
     #[default]
     Preview,
     /// Final gather with sender classification (not implemented yet).
     Full,
+}
+
+impl From<Mode> for String {
+    fn from(mode: Mode) -> String {
+        match mode {
+            Mode::Preview => "preview".into(),
+            Mode::Full => "full".into(),
+        }
+    }
+}
+
+impl TryFrom<String> for Mode {
+    type Error = String;
+
+    fn try_from(name: String) -> std::result::Result<Self, String> {
+        match name.as_str() {
+            "preview" => Ok(Mode::Preview),
+            "full" => Ok(Mode::Full),
+            _ => Err(format!("unknown mode {name:?}, expected \"preview\" or \"full\"")),
+        }
+    }
 }
 
 /// The stage's parameters (`--params file.ron`, overridden by flags).

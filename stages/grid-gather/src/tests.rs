@@ -138,7 +138,7 @@ fn uniform_radiosity_gives_b_over_pi_times_coverage() {
     assert_eq!(image.counters["vertices"], 25.0);
 }
 
-/// Luminance-free helper: the red channel as radiosity B = pi L.
+/// The red channel as radiosity: B = pi L.
 fn b_of(image: &Rendered, x: usize, y: usize) -> f64 {
     f64::from(image.rgb[y * image.width + x][0]) * PI
 }
@@ -338,4 +338,9 @@ fn params_round_trip_through_ron_and_refuse_typos() {
     assert_eq!(ron::from_str::<Params>(&text).unwrap(), p);
     assert!(ron::from_str::<Params>("(spp: 2, sp: 3)").is_err());
     assert_eq!(ron::from_str::<Params>("(spp: 2)").unwrap().crease_angle_deg, 30.0);
+    assert_eq!(ron::from_str::<Params>("(mode: \"full\")").unwrap().mode, Mode::Full);
+    assert!(ron::from_str::<Params>("(mode: \"ful\")").is_err());
+    // Provenance stores parameters as ron::Value: the mode must survive it.
+    let value: ron::Value = ron::from_str(&text).unwrap();
+    assert_eq!(value.into_rust::<Params>().unwrap(), p);
 }

@@ -87,6 +87,7 @@ fn renders_the_scene_with_provenance_and_report_and_reruns_byte_identical() {
     assert!(image.coverage[8 * 24 + 12] == 1.0 && centre > 0.5 && centre < 0.8, "about 2/pi on the diagonal: {centre}");
     let p = &image.header.provenance;
     assert_eq!(p.stage, "grid-gather");
+    assert_eq!(p.parameters.clone().into_rust::<grid_gather::Params>().unwrap(), grid_gather::Params::default());
     assert_eq!(p.inputs.iter().map(|i| i.path.as_str()).collect::<Vec<_>>(), ["mesh.exr", "manifest.ron", "solution.exr"]);
     let report = read_ron::<Report>(&dir.join("report.ron")).unwrap().value;
     assert_eq!(report.counters["rays_cast"], 24.0 * 16.0 * 4.0);
