@@ -11,11 +11,17 @@
 //!
 //! where `S(c)` holds the leaves `j` that have a corner at the same world
 //! point as `c` and whose normal lies within the crease angle of leaf `i`'s
-//! normal (`n_i . n_j >= cos(crease)`; `i` itself always belongs). `A_j` is
+//! normal (`n_i . n_j >= cos(crease)`; `i` itself always belongs), and,
+//! with material seams on (the default), the same material as leaf `i`.
+//! `A_j` is
 //! the leaf's area in m² (its triangle's area over `4^level`, exact for the
 //! 1:4 rule), `B_j` its radiosity in W/m². A crease (wall against floor)
 //! therefore stays sharp, while the two triangles of a flat wall or the
-//! facets of a tessellated sphere blend. Inside a leaf, radiosity is
+//! facets of a tessellated sphere blend. Material seams keep a flat
+//! boundary between materials sharp too: there the irradiance H is
+//! continuous but `B = E + rho H` jumps with the emission E and the
+//! reflectance rho (a ceiling light set into a ceiling, a rug on a floor);
+//! blending would smear the light into the ceiling. Inside a leaf, radiosity is
 //! `B(p) = sum_k l_k B_{c_k}` with `l` the point's barycentric coordinates
 //! in the leaf (linear interpolation, Gouraud 1971).
 //!
@@ -59,6 +65,8 @@ pub struct Smoothing {
     /// Corners closer than this fraction of the scene's bounding-box
     /// diagonal (per coordinate) are one point.
     pub weld_tolerance: f64,
+    /// Leaves of different materials do not blend at a shared corner.
+    pub material_seams: bool,
 }
 
 /// One leaf element with what shading needs of it.
@@ -87,10 +95,16 @@ pub struct Gouraud {
 }
 
 impl Gouraud {
-    /// Checks that `solution` belongs to the mesh of `triangles` and
-    /// computes the vertex radiosity. `solution_path` only names the file in
-    /// errors.
-    pub fn new(triangles: &[TriangleGeometry], solution: &Solution, solution_path: &Path, smoothing: Smoothing) -> Result<Self> {
+    /// Checks that `solution` belongs to the mesh of `triangles` (whose
+    /// material indices are `materials`) and computes the vertex radiosity.
+    /// `solution_path` only names the file in errors.
+    pub fn new(
+        triangles: &[TriangleGeometry],
+        materials: &[u32],
+        solution: &Solution,
+        solution_path: &Path,
+        smoothing: Smoothing,
+    ) -> Result<Self> {
         let leaves = leaves(triangles.len(), solution).map_err(|why| {
             Error::invalid(solution_path, None, format!("solution does not belong to this mesh: {why}"))
         })?;
@@ -107,6 +121,7 @@ impl Gouraud {
         let positions: Vec<DVec3> =
             leaves.iter().flat_map(|l| triangles[l.triangle as usize].element(&l.corners)).collect();
         let normal: Vec<DVec3> = leaves.iter().map(|l| triangles[l.triangle as usize].normal).collect();
+        let material: Vec<u32> = leaves.iter().map(|l| materials[l.triangle as usize]).collect();
         let area: Vec<f64> =
             leaves.iter().map(|l| triangles[l.triangle as usize].area * 0.25f64.powi(l.level as i32)).collect();
         let radiosity: Vec<[f64; 3]> =
@@ -144,7 +159,10 @@ impl Gouraud {
                 let mut blend: Vec<usize> = same_point
                     .into_iter()
                     .map(|d| d / 3)
-                    .filter(|&j| j == me || normal[me].dot(normal[j]) >= cos_crease)
+                    .filter(|&j| {
+                        let same_material = !smoothing.material_seams || material[j] == material[me];
+                        j == me || (same_material && normal[me].dot(normal[j]) >= cos_crease)
+                    })
                     .collect();
                 blend.sort_unstable();
                 blend.dedup();

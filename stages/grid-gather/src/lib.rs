@@ -23,6 +23,7 @@
 //! | `seed` | u64 | seed of the per-pixel random streams | 0 |
 //! | `crease_angle_deg` | degrees | leaves whose normals differ more do not blend at a shared corner | 30 |
 //! | `weld_tolerance` | fraction of the bounding-box diagonal | corners closer than this are one point | 1e-7 |
+//! | `material_seams` | bool | leaves of different materials do not blend at a shared corner | true |
 //!
 //! Same inputs and parameters give bit-identical images, whatever the
 //! number of threads.
@@ -100,11 +101,14 @@ pub struct Params {
     /// Corner weld tolerance, as a fraction of the scene's bounding-box
     /// diagonal, in (0, 1e-3].
     pub weld_tolerance: f64,
+    /// Leaves of different materials do not blend at a shared corner (B
+    /// jumps where emission or reflectance does, even on a flat surface).
+    pub material_seams: bool,
 }
 
 impl Default for Params {
     fn default() -> Self {
-        Params { mode: Mode::Preview, width: None, height: None, spp: 4, seed: 0, crease_angle_deg: 30.0, weld_tolerance: 1e-7 }
+        Params { mode: Mode::Preview, width: None, height: None, spp: 4, seed: 0, crease_angle_deg: 30.0, weld_tolerance: 1e-7, material_seams: true }
     }
 }
 
@@ -181,8 +185,13 @@ pub fn gather(params: &Params, scene: &Scene, rows_done: &(dyn Fn(u64) + Sync)) 
         )
     })?;
     let triangles = mesh_triangles(scene.mesh);
-    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance };
-    let shading = Gouraud::new(&triangles, scene.solution, scene.solution_path, smoothing)?;
+    let smoothing = Smoothing {
+        crease_angle_deg: params.crease_angle_deg,
+        weld_tolerance: params.weld_tolerance,
+        material_seams: params.material_seams,
+    };
+    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
+    let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
     let rays = (!triangles.is_empty()).then(|| SceneRays::new(&triangles.iter().map(|t| t.corners).collect::<Vec<_>>()));
     let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading };
     let film = render::render(&view, Sampling { width, height, spp: params.spp, seed: params.seed }, rows_done);
@@ -213,7 +222,7 @@ pub fn gather(params: &Params, scene: &Scene, rows_done: &(dyn Fn(u64) + Sync)) 
 pub fn skipped_in_preview(manifest: &Manifest) -> Vec<String> {
     let e = &manifest.effects;
     let mut skipped = vec![
-        "full gather (perspective grid, sender classification, resampling): preview mode interpolates the solution's radiosity".to_string(),
+        "full gather (perspective grid, sender classification, resampling): preview mode interpolates the radiosity of the solution".to_string(),
     ];
     let present = [
         (e.textures, "diffuse textures: present but not applied; preview shows element radiosity only"),
@@ -221,7 +230,7 @@ pub fn skipped_in_preview(manifest: &Manifest) -> Vec<String> {
         (e.alpha_masks, "alpha masks: present but not applied; camera rays hit the whole triangles"),
         (e.specular_reflection, "specular reflection: present but not traced; mirrors show their diffuse radiosity"),
         (e.specular_transmission, "specular transmission: present but not traced; glass shows its diffuse radiosity"),
-        (e.diffuse_transmission, "diffuse transmission: back faces shade black, the solution's radiosity is one-sided"),
+        (e.diffuse_transmission, "diffuse transmission: back faces shade black, radiosity in the solution is one-sided"),
     ];
     skipped.extend(present.iter().filter(|(on, _)| *on).map(|(_, why)| why.to_string()));
     skipped

@@ -59,6 +59,14 @@ struct Args {
     /// point [default: 1e-7].
     #[arg(long, value_name = "FRACTION")]
     weld_tolerance: Option<f64>,
+    /// Leaves of different materials do not blend at a shared corner
+    /// [default: on].
+    #[arg(long, overrides_with = "no_material_seams")]
+    material_seams: bool,
+    /// Let leaves of different materials blend (only the crease angle
+    /// separates them).
+    #[arg(long)]
+    no_material_seams: bool,
     /// Parameters file (RON); flags override its values.
     #[arg(long, value_name = "PARAMS.ron")]
     params: Option<PathBuf>,
@@ -94,6 +102,12 @@ impl Args {
         }
         if let Some(tolerance) = self.weld_tolerance {
             p.weld_tolerance = tolerance;
+        }
+        if self.material_seams {
+            p.material_seams = true;
+        }
+        if self.no_material_seams {
+            p.material_seams = false;
         }
         p.validate()?;
         Ok(p)

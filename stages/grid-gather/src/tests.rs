@@ -114,7 +114,12 @@ fn render(params: &Params, mesh: &Mesh, manifest: &Manifest, solution: &Solution
     gather(params, &scene, &|_| {}).expect("render")
 }
 
-const SMOOTH: Smoothing = Smoothing { crease_angle_deg: 30.0, weld_tolerance: 1e-7 };
+const SMOOTH: Smoothing = Smoothing { crease_angle_deg: 30.0, weld_tolerance: 1e-7, material_seams: true };
+
+/// Vertex radiosity over `triangles`, all of material 0.
+fn gouraud(triangles: &[TriangleGeometry], solution: &Solution, smoothing: Smoothing) -> Gouraud {
+    Gouraud::new(triangles, &vec![0; triangles.len()], solution, Path::new("s.exr"), smoothing).unwrap()
+}
 
 #[test]
 fn uniform_radiosity_gives_b_over_pi_times_coverage() {
@@ -183,7 +188,7 @@ fn vertex_values_are_area_weighted_means_and_a_crease_stays_sharp() {
     // uv of the point (s, s) in each triangle: (u + v, v) in 0, (u, u + v) in 1.
     let on_diagonal = |t: u32, s: f64| if t == 0 { [0.0, s] } else { [s, 0.0] };
     let flat = mesh_triangles(&mesh(&square()));
-    let g = Gouraud::new(&flat, &solution(2, 2, two_values), Path::new("s.exr"), SMOOTH).unwrap();
+    let g = gouraud(&flat, &solution(2, 2, two_values), SMOOTH);
     for s in [0.0, 0.1, 0.25, 0.4, 0.5, 0.8, 1.0] {
         for t in 0..2 {
             let b = g.radiosity(t, on_diagonal(t, s));
@@ -195,16 +200,29 @@ fn vertex_values_are_area_weighted_means_and_a_crease_stays_sharp() {
     let folded = [floor, [wall[0], wall[1], dvec3(0.5, 0.5, 0.5f64.sqrt())]];
     let folded = mesh_triangles(&mesh(&folded));
     assert!(folded[0].normal.dot(folded[1].normal).abs() < 1e-12);
-    let g = Gouraud::new(&folded, &solution(2, 2, two_values), Path::new("s.exr"), SMOOTH).unwrap();
+    let g = gouraud(&folded, &solution(2, 2, two_values), SMOOTH);
     for s in [0.0, 0.25, 0.4, 1.0] {
         assert!((g.radiosity(0, on_diagonal(0, s))[0] - 1.0).abs() < 1e-12);
         assert!((g.radiosity(1, on_diagonal(1, s))[0] - 3.0).abs() < 1e-12);
     }
     // A crease angle over 90 degrees blends them again.
     let wide = Smoothing { crease_angle_deg: 95.0, ..SMOOTH };
-    let g = Gouraud::new(&folded, &solution(2, 2, two_values), Path::new("s.exr"), wide).unwrap();
+    let g = gouraud(&folded, &solution(2, 2, two_values), wide);
     let blended = g.radiosity(0, on_diagonal(0, 0.4))[0];
     assert!((blended - 2.0).abs() < 1e-6, "areas differ by the f32 rounding of the fold: {blended}");
+}
+
+#[test]
+fn a_material_boundary_on_a_flat_surface_stays_sharp_unless_seams_are_off() {
+    // A light set flush into a ceiling: flat, but B jumps with emission.
+    let flat = mesh_triangles(&mesh(&square()));
+    let sol = solution(2, 2, |t, _| if t == 0 { 1.0 } else { 3.0 });
+    let seams = Gouraud::new(&flat, &[0, 1], &sol, Path::new("s.exr"), SMOOTH).unwrap();
+    assert!((seams.radiosity(0, [0.0, 0.4])[0] - 1.0).abs() < 1e-12);
+    assert!((seams.radiosity(1, [0.4, 0.0])[0] - 3.0).abs() < 1e-12);
+    let blended = Smoothing { material_seams: false, ..SMOOTH };
+    let g = Gouraud::new(&flat, &[0, 1], &sol, Path::new("s.exr"), blended).unwrap();
+    assert!((g.radiosity(0, [0.0, 0.4])[0] - 2.0).abs() < 1e-12);
 }
 
 #[test]
@@ -218,7 +236,7 @@ fn interpolation_inside_a_subdivided_triangle_matches_the_hand_computation() {
     for k in 0..4 {
         sol.elements[1 + k].radiosity = [values[k] as f32; 3];
     }
-    let g = Gouraud::new(&mesh_triangles(&mesh(&one)), &sol, Path::new("s.exr"), SMOOTH).unwrap();
+    let g = gouraud(&mesh_triangles(&mesh(&one)), &sol, SMOOTH);
     let (m01, m12, m20) = ((a + b + d) / 3.0, (b + c + d) / 3.0, (a + c + d) / 3.0);
     let cases = [
         ([0.0, 0.0], a),

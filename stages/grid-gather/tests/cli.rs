@@ -131,13 +131,13 @@ fn errors_are_one_line_naming_the_file_and_leave_no_output() {
 fn print_params_reads_back_through_params() {
     let dir = workdir("params");
     let run = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_grid-gather")).current_dir(&dir).args(args).output().unwrap();
-    let out = run(&["--print-params", "--spp", "9", "--width", "100"]);
+    let out = run(&["--print-params", "--spp", "9", "--width", "100", "--no-material-seams"]);
     assert!(out.status.success());
     std::fs::write(dir.join("p.ron"), &out.stdout).unwrap();
     let again = run(&["--params", "p.ron", "--print-params"]);
     assert_eq!(out.stdout, again.stdout);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("spp: 9") && text.contains("width: Some(100)"), "{text}");
+    assert!(text.contains("spp: 9") && text.contains("width: Some(100)") && text.contains("material_seams: false"), "{text}");
     std::fs::write(dir.join("typo.ron"), "(spp: 2, sp: 3)").unwrap();
     let out = run(&["--params", "typo.ron", "--print-params"]);
     assert_eq!(out.status.code(), Some(2));
