@@ -65,7 +65,7 @@ struct Args {
     material_seams: bool,
     /// Let leaves of different materials blend (only the crease angle
     /// separates them).
-    #[arg(long)]
+    #[arg(long, overrides_with = "material_seams")]
     no_material_seams: bool,
     /// Parameters file (RON); flags override its values.
     #[arg(long, value_name = "PARAMS.ron")]
