@@ -1,1 +1,58 @@
-//! Helpers for the end-to-end tests (skeleton).
+//! Helpers for the end-to-end tests: where the stage binaries are, scratch
+//! directories, scene files written from code, and the closed-form answers
+//! the tests compare with (written here independently of the stages).
+//!
+//! The binaries are those of `cargo build --release`, which `make test`
+//! runs before the tests.
+
+pub mod closed_form;
+pub mod scenes;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Path of the stage binary `name` next to this test executable.
+pub fn bin(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    let dir = exe.parent().and_then(Path::parent).expect("target profile directory");
+    let path = dir.join(name);
+    assert!(path.exists(), "{} is missing: run `make test` (it builds the stages first)", path.display());
+    path
+}
+
+/// A fresh, empty scratch directory for one test.
+pub fn scratch(test: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    let dir = exe.parent().and_then(Path::parent).expect("target profile directory").join("e2e").join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    dir
+}
+
+/// Runs stage `name` with `args`.
+pub fn run(name: &str, args: &[&str]) -> Output {
+    Command::new(bin(name)).args(args).output().expect("stage binary runs")
+}
+
+/// Runs stage `name` and panics with its stderr if it fails.
+pub fn run_ok(name: &str, args: &[&str]) -> Output {
+    let out = run(name, args);
+    assert!(out.status.success(), "{name} {args:?} failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+/// Path as `&str` (test paths are UTF-8).
+pub fn s(path: &Path) -> &str {
+    path.to_str().expect("UTF-8 path")
+}
+
+/// mesh-prep then hierarchical-solve on `scene` in `dir`, with extra
+/// solver arguments; returns the paths of mesh, manifest and solution.
+pub fn prepare_and_solve(dir: &Path, scene: &Path, solve_args: &[&str]) -> (PathBuf, PathBuf, PathBuf) {
+    let (mesh, manifest, solution) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("solution.exr"));
+    run_ok("mesh-prep", &[s(scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let mut args = vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution)];
+    args.extend_from_slice(solve_args);
+    run_ok("hierarchical-solve", &args);
+    (mesh, manifest, solution)
+}

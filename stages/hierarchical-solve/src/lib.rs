@@ -177,7 +177,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &dyn F
             refined_any = true;
             for (l, d) in all_links.iter().zip(&decisions) {
                 let split = match d {
-                    Split::Keep => continue,
+                    Split::Keep | Split::Larger => continue,
                     Split::Sender => l.sender,
                     Split::Receiver => l.receiver,
                 };

@@ -2,7 +2,7 @@
 //! Salzman, Aupperle, "A rapid hierarchical radiosity algorithm", SIGGRAPH
 //! 1991): a link carries light from a sender to a receiver element; a link
 //! whose transport is too coarse is replaced by links from or to the
-//! children of the larger element.
+//! children of one of the two.
 
 use crate::elements::Hierarchy;
 use radiometry::form_factor::triangle_to_polygon;
@@ -17,9 +17,9 @@ pub struct Link {
     /// Unoccluded form factor F_rs: receiver-area mean of Lambert's
     /// point-to-polygon factor to the sender (002 Eq. 3).
     pub form_factor: f64,
-    /// Largest point factor over the receiver's quadrature points: the
-    /// oracle's bound on the transport's variation.
-    pub bound: f64,
+    /// Largest minus smallest point factor over the receiver's quadrature
+    /// points: how much the transport varies over the receiver.
+    pub spread: f64,
     /// Visible fraction, `None` until rays were cast.
     pub visibility: Option<f32>,
     /// Distance from the receiver to the nearest occluder, +inf if none.
@@ -35,6 +35,9 @@ pub enum Split {
     Sender,
     /// Replace by links to the receiver's children.
     Receiver,
+    /// Split whichever of the two is larger (oracle's wish only; resolved
+    /// to `Sender` or `Receiver` before any link is split).
+    Larger,
 }
 
 /// The link from `sender` to `receiver`, or `None` where no light can pass:
@@ -54,28 +57,70 @@ pub fn link(h: &Hierarchy, receiver: u32, sender: u32) -> Option<Link> {
     if receiver == sender || !in_front(&s.points, r.points[0], nr) || !in_front(&r.points, s.points[0], ns) {
         return None;
     }
-    let (form_factor, bound) = triangle_to_polygon(&r.points, nr, &s.points);
-    (form_factor > 0.0).then_some(Link { receiver, sender, form_factor, bound, visibility: None, occluder_distance: f32::INFINITY })
+    let f = triangle_to_polygon(&r.points, nr, &s.points);
+    (f.mean > 0.0).then_some(Link {
+        receiver,
+        sender,
+        form_factor: f.mean,
+        spread: f.max - f.min,
+        visibility: None,
+        occluder_distance: f32::INFINITY,
+    })
 }
 
-/// BF refinement oracle: the radiosity a link may misplace on its receiver
-/// is bounded by `rho_r B_s F_max` (reflectance of the receiver, radiosity
-/// of the sender, largest point form factor). Above `threshold` (W/m²) the
-/// larger of the two elements is split, unless a child would be smaller than
-/// `min_area`; then the other one, if it can be.
+/// The refinement oracle: HSA's BF criterion, with the "F" replaced by an
+/// estimate of the link's error rather than its size. A link makes the
+/// receiver's radiosity `rho_r V F_rs B_s` constant over the receiver; it
+/// misplaces at most (W/m²)
+///
+/// - `rho_r B_s (F_max - F_min)` where the kernel varies over the receiver
+///   (the spread of the point factors): only splitting the **receiver**
+///   reduces it;
+/// - `rho_r (B_s_max - B_s_min) F_rs` where the sender's radiosity varies
+///   (known from its children, if it has any): splitting the **sender**
+///   reduces it;
+/// - `2 min(V, 1 - V) rho_r B_s F_rs` where the link is partly occluded (a
+///   shadow edge crosses it): splitting the **larger** of the two reduces it.
+///
+/// Plain BF (`rho_r B_s F_rs`, split the larger) would also split senders
+/// whose every part sends the same light: our form factor is exact over
+/// the sender, so that buys nothing, and it multiplies links whose small
+/// same-signed errors then add up on the receiver. The largest term above
+/// `threshold` decides which element is split, unless its children would be
+/// smaller than `min_area`: then a shadow edge splits the other element,
+/// and the other errors keep the link (splitting the other element would
+/// not reduce them).
 pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64, min_area: f64) -> Split {
     let rho = h.reflectance_of(link.receiver);
     let b = radiosity[link.sender as usize];
-    let transported = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max) * link.bound;
-    if transported <= threshold {
+    let reflected = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);
+    let sender = &h.elements[link.sender as usize];
+    let sender_variation = if sender.is_leaf() {
+        0.0
+    } else {
+        (sender.first_child..sender.first_child + 4)
+            .flat_map(|child| (0..3).map(move |c| (child, c)))
+            .map(|(child, c)| rho[c] * (radiosity[child as usize][c] - b[c]).abs())
+            .fold(0.0, f64::max)
+    };
+    let v = f64::from(link.visibility.unwrap_or(1.0));
+    let errors = [
+        (reflected * link.spread, Split::Receiver),
+        (sender_variation * link.form_factor, Split::Sender),
+        (2.0 * v.min(1.0 - v) * reflected * link.form_factor, Split::Larger),
+    ];
+    let (error, wanted) = errors.into_iter().fold((0.0, Split::Keep), |best, e| if e.0 > best.0 { e } else { best });
+    if error <= threshold {
         return Split::Keep;
     }
-    let (ar, as_) = (h.elements[link.receiver as usize].area, h.elements[link.sender as usize].area);
+    let (ar, as_) = (h.elements[link.receiver as usize].area, sender.area);
     let (can_r, can_s) = (ar / 4.0 >= min_area, as_ / 4.0 >= min_area);
-    match (as_ >= ar, can_s, can_r) {
-        (true, true, _) => Split::Sender,
-        (_, _, true) => Split::Receiver,
-        (_, true, false) => Split::Sender,
+    let larger = if as_ > ar { Split::Sender } else { Split::Receiver };
+    match (wanted, can_r, can_s) {
+        (Split::Receiver, true, _) | (Split::Sender, _, true) => wanted,
+        (Split::Larger, true, true) => larger,
+        (Split::Larger, true, false) => Split::Receiver,
+        (Split::Larger, false, true) => Split::Sender,
         _ => Split::Keep,
     }
 }
@@ -83,7 +128,7 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64
 /// The links replacing `link` after `split` (children already exist).
 pub fn children_links(h: &Hierarchy, link: &Link, split: Split) -> Vec<Link> {
     match split {
-        Split::Keep => vec![*link],
+        Split::Keep | Split::Larger => vec![*link],
         Split::Sender => {
             let first = h.elements[link.sender as usize].first_child;
             (first..first + 4).filter_map(|s| self::link(h, link.receiver, s)).collect()

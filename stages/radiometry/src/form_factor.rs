@@ -102,18 +102,30 @@ pub const DUNAVANT_5: [([f64; 3], f64); 7] = {
     ]
 };
 
-/// The [`DUNAVANT_5`] estimate of the receiver-area mean of the point
-/// factor over `receiver`, and the largest point value.
-fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3]) -> (f64, f64) {
-    let mut mean = 0.0;
-    let mut max = 0.0f64;
+/// A receiver-area mean of the point factor, with the smallest and largest
+/// point values seen: their spread is how much the transport varies over
+/// the receiver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaFactor {
+    /// `F_rs`, the receiver-area mean.
+    pub mean: f64,
+    /// Smallest point factor at the quadrature points.
+    pub min: f64,
+    /// Largest point factor at the quadrature points.
+    pub max: f64,
+}
+
+/// The [`DUNAVANT_5`] estimate over `receiver`.
+fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3]) -> AreaFactor {
+    let mut estimate = AreaFactor { mean: 0.0, min: f64::INFINITY, max: 0.0 };
     for (b, w) in DUNAVANT_5 {
         let p = receiver[0] * b[0] + receiver[1] * b[1] + receiver[2] * b[2];
         let f = point_to_polygon(p, normal, sender);
-        mean += w * f;
-        max = max.max(f);
+        estimate.mean += w * f;
+        estimate.min = estimate.min.min(f);
+        estimate.max = estimate.max.max(f);
     }
-    (mean, max)
+    estimate
 }
 
 /// Relative accuracy the adaptive receiver quadrature aims for.
@@ -129,8 +141,8 @@ pub const QUADRATURE_DEPTH: u32 = 7;
 /// ```
 ///
 /// with the inner factor exact (002 Eq. 3) and the outer integral by
-/// [`DUNAVANT_5`]. Returns the factor and the largest point value, which the
-/// refinement oracle uses as a bound.
+/// [`DUNAVANT_5`], with the spread of the point values (the refinement
+/// oracle's measure of how much the transport varies over the receiver).
 ///
 /// Where the two are close (nearer than three times their sizes) the
 /// integrand varies fast, and near a shared edge it has a logarithmic
@@ -140,7 +152,7 @@ pub const QUADRATURE_DEPTH: u32 = 7;
 /// This matters for energy balance: in a closed room with reflectance rho,
 /// a relative error d in the sum of a receiver's form factors becomes an
 /// error of about rho d / (1 - rho) in the mean radiosity.
-pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3]) -> (f64, f64) {
+pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3]) -> AreaFactor {
     let centroid = |p: &[DVec3]| p.iter().copied().sum::<DVec3>() / p.len() as f64;
     let size = |p: &[DVec3], c: DVec3| p.iter().map(|v| v.distance(c)).fold(0.0, f64::max);
     let (cr, cs) = (centroid(receiver), centroid(sender));
@@ -153,7 +165,7 @@ pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender
     }
 }
 
-fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3], coarse: (f64, f64), depth: u32) -> (f64, f64) {
+fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3], coarse: AreaFactor, depth: u32) -> AreaFactor {
     if depth == 0 {
         return coarse;
     }
@@ -161,19 +173,16 @@ fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3], coarse: (f64
     let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
     let children = [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]];
     let estimates = children.map(|child| rule(&child, normal, sender));
-    let fine: f64 = estimates.iter().map(|e| e.0).sum::<f64>() * 0.25;
-    let max = estimates.iter().map(|e| e.1).fold(coarse.1, f64::max);
-    if (fine - coarse.0).abs() <= QUADRATURE_TOLERANCE * fine.abs().max(1e-12) {
-        return (fine, max);
-    }
-    let mut mean = 0.0;
-    let mut max = max;
+    let fine: f64 = estimates.iter().map(|e| e.mean).sum::<f64>() * 0.25;
+    let converged = (fine - coarse.mean).abs() <= QUADRATURE_TOLERANCE * fine.abs().max(1e-12);
+    let mut result = AreaFactor { mean: 0.0, min: coarse.min, max: coarse.max };
     for (child, estimate) in children.iter().zip(estimates) {
-        let (m, x) = adaptive(child, normal, sender, estimate, depth - 1);
-        mean += 0.25 * m;
-        max = max.max(x);
+        let part = if converged { estimate } else { adaptive(child, normal, sender, estimate, depth - 1) };
+        result.mean += 0.25 * part.mean;
+        result.min = result.min.min(part.min);
+        result.max = result.max.max(part.max);
     }
-    (mean, max)
+    result
 }
 
 #[cfg(test)]
@@ -254,10 +263,10 @@ mod tests {
         let floor = [dvec3(0.0, 0.0, 0.0), dvec3(w, 0.0, 0.0), dvec3(w, l, 0.0), dvec3(0.0, l, 0.0)];
         let wall = [dvec3(0.0, 0.0, 0.0), dvec3(0.0, l, 0.0), dvec3(0.0, l, h), dvec3(0.0, 0.0, h)];
         let halves = [[floor[0], floor[1], floor[2]], [floor[0], floor[2], floor[3]]];
-        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall).0).sum();
+        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall).mean).sum();
         let exact = perpendicular_shared_edge(w, h, l);
         assert!(((f - exact) / exact).abs() < 1e-4, "{f} vs {exact}");
-        let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &wall).0).sum();
+        let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &wall).mean).sum();
         assert!(((plain - exact) / exact).abs() > 1e-3, "the fixed rule alone would not do: {plain}");
     }
 

@@ -1,0 +1,124 @@
+//! Test scenes written from code: quads with materials, as OBJ + MTL +
+//! scene.ron in a directory.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// A material: diffuse reflectance and emitted radiosity (exitance, W/m²).
+#[derive(Clone, Debug)]
+pub struct TestMaterial {
+    /// MTL name.
+    pub name: String,
+    /// Diffuse reflectance, grey.
+    pub reflectance: f64,
+    /// Emitted radiosity, W/m², grey.
+    pub emission: f64,
+}
+
+/// A scene of planar quads.
+#[derive(Clone, Debug, Default)]
+pub struct QuadScene {
+    /// `(object, material, corners)`; corners are reordered to face `normal`.
+    pub quads: Vec<(String, String, [[f64; 3]; 4])>,
+    /// Materials by name.
+    pub materials: Vec<TestMaterial>,
+    /// Camera eye and target.
+    pub camera: ([f64; 3], [f64; 3]),
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+impl QuadScene {
+    /// Adds a quad (corners in order around it) whose front faces `normal`.
+    pub fn quad(&mut self, object: &str, material: &str, corners: [[f64; 3]; 4], normal: [f64; 3]) -> &mut Self {
+        let n = cross(sub(corners[1], corners[0]), sub(corners[2], corners[0]));
+        let facing = n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] > 0.0;
+        let mut c = corners;
+        if !facing {
+            c.reverse();
+        }
+        self.quads.push((object.into(), material.into(), c));
+        self
+    }
+
+    /// Adds a material.
+    pub fn material(&mut self, name: &str, reflectance: f64, emission: f64) -> &mut Self {
+        self.materials.push(TestMaterial { name: name.into(), reflectance, emission });
+        self
+    }
+
+    /// Writes `scene.obj`, `scene.mtl` and `scene.ron` into `dir`; returns
+    /// the scene file's path. Emission is set in scene.ron as exitance.
+    pub fn write(&self, dir: &Path) -> PathBuf {
+        let mut obj = String::from("mtllib scene.mtl\n");
+        for (object, material, corners) in &self.quads {
+            writeln!(obj, "o {object}\nusemtl {material}").unwrap();
+            for v in corners {
+                writeln!(obj, "v {:.17} {:.17} {:.17}", v[0], v[1], v[2]).unwrap();
+            }
+            obj.push_str("f -4 -3 -2 -1\n");
+        }
+        let mut mtl = String::new();
+        let mut overrides = String::new();
+        for m in &self.materials {
+            writeln!(mtl, "newmtl {}\nKd {r} {r} {r}", m.name, r = m.reflectance).unwrap();
+            writeln!(overrides, "    \"{}\": (emission: Some(({e:?}, {e:?}, {e:?}))),", m.name, e = m.emission).unwrap();
+        }
+        let (eye, target) = self.camera;
+        let scene = format!(
+            "Scene(\n  meshes: [Obj(file: \"scene.obj\")],\n  camera: Camera(eye: {eye:?}, target: {target:?}, up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 64, height: 64),\n  materials: {{\n{overrides}  }},\n)\n",
+            eye = (eye[0], eye[1], eye[2]),
+            target = (target[0], target[1], target[2]),
+        );
+        std::fs::write(dir.join("scene.obj"), obj).unwrap();
+        std::fs::write(dir.join("scene.mtl"), mtl).unwrap();
+        let path = dir.join("scene.ron");
+        std::fs::write(&path, scene).unwrap();
+        path
+    }
+}
+
+/// An axis-aligned rectangle in the plane `axis = at`, spanning `lo..hi` in
+/// the two other axes (in cyclic order after `axis`).
+pub fn rectangle(axis: usize, at: f64, lo: [f64; 2], hi: [f64; 2]) -> [[f64; 3]; 4] {
+    let point = |u: f64, v: f64| {
+        let mut p = [0.0; 3];
+        p[axis] = at;
+        p[(axis + 1) % 3] = u;
+        p[(axis + 2) % 3] = v;
+        p
+    };
+    [point(lo[0], lo[1]), point(hi[0], lo[1]), point(hi[0], hi[1]), point(lo[0], hi[1])]
+}
+
+/// A closed `size`-sided cube room, walls facing in, uniform reflectance
+/// `rho`; the ceiling (z = size) is split 3 x 3 and its centre square emits
+/// `emission`. Returns the scene.
+pub fn closed_box(size: f64, rho: f64, emission: f64) -> QuadScene {
+    let mut scene = QuadScene { camera: ([0.5 * size, 0.1 * size, 0.5 * size], [0.5 * size, size, 0.5 * size]), ..Default::default() };
+    scene.material("wall", rho, 0.0).material("lamp", rho, emission);
+    for axis in 0..3 {
+        for (at, sign) in [(0.0, 1.0), (size, -1.0)] {
+            let mut normal = [0.0; 3];
+            normal[axis] = sign;
+            if axis == 2 && at > 0.0 {
+                let cuts = [0.0, size / 3.0, 2.0 * size / 3.0, size];
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let (object, material) = if (i, j) == (1, 1) { ("lamp", "lamp") } else { ("ceiling", "wall") };
+                        scene.quad(object, material, rectangle(2, at, [cuts[i], cuts[j]], [cuts[i + 1], cuts[j + 1]]), normal);
+                    }
+                }
+            } else {
+                scene.quad(&format!("wall{axis}{}", at > 0.0), "wall", rectangle(axis, at, [0.0, 0.0], [size, size]), normal);
+            }
+        }
+    }
+    scene
+}

@@ -1,0 +1,163 @@
+//! hierarchical-solve against closed forms: configuration factors of
+//! rectangles (Howell C-11, C-14), irradiance under a square emitter
+//! (Lambert), and energy balance of closed rooms.
+
+use end_to_end::closed_form::{parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
+use end_to_end::scenes::{closed_box, rectangle, QuadScene};
+use end_to_end::{prepare_and_solve, scratch};
+use schemas::mesh::{Manifest, Mesh};
+use schemas::ron_io::read_ron;
+use schemas::solution::Solution;
+use std::path::Path;
+
+/// The solved scene, with each element's object name.
+struct Solved {
+    solution: Solution,
+    object_of_element: Vec<String>,
+}
+
+fn solve(test: &str, scene: &QuadScene, args: &[&str]) -> Solved {
+    let dir = scratch(test);
+    let scene_path = scene.write(&dir);
+    let (mesh, manifest, solution) = prepare_and_solve(&dir, &scene_path, args);
+    load(&mesh, &manifest, &solution)
+}
+
+fn load(mesh: &Path, manifest: &Path, solution: &Path) -> Solved {
+    let (mesh, _) = Mesh::read(mesh).unwrap();
+    let manifest = read_ron::<Manifest>(manifest).unwrap().value;
+    let (solution, _) = Solution::read(solution).unwrap();
+    let object_of_element = solution
+        .elements
+        .iter()
+        .map(|e| manifest.objects[mesh.triangles[e.triangle as usize].object as usize].clone())
+        .collect();
+    Solved { solution, object_of_element }
+}
+
+impl Solved {
+    /// The solver's factor from object `r` to object `s`: the area-weighted
+    /// sum of the form factors of all links between their elements, at any
+    /// level.
+    fn form_factor(&self, r: &str, s: &str) -> f64 {
+        let e = &self.solution.elements;
+        let area_of = |name: &str| -> f64 {
+            e.iter().zip(&self.object_of_element).filter(|(x, o)| x.parent == u32::MAX && *o == name).map(|(x, _)| f64::from(x.area)).sum()
+        };
+        let flux: f64 = self
+            .solution
+            .links
+            .iter()
+            .filter(|l| self.object_of_element[l.receiver as usize] == r && self.object_of_element[l.sender as usize] == s)
+            .map(|l| f64::from(e[l.receiver as usize].area) * f64::from(l.form_factor))
+            .sum();
+        flux / area_of(r)
+    }
+
+    /// Leaves with their object, area and radiosity (grey: channel 0).
+    fn leaves(&self) -> impl Iterator<Item = (&str, f64, f64, usize)> {
+        self.solution
+            .elements
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.first_child == u32::MAX)
+            .map(|(i, e)| (self.object_of_element[i].as_str(), f64::from(e.area), f64::from(e.radiosity[0]), i))
+    }
+}
+
+const FINE: [&str; 4] = ["--eps", "1e-4", "--min-area", "1e-4"];
+
+fn assert_close(what: &str, got: f64, want: f64, relative: f64) {
+    let error = (got - want).abs() / want.abs();
+    eprintln!("{what}: relative error {error:.2e}");
+    assert!(error <= relative, "{what}: {got} vs closed form {want} (relative error {error:.2e} > {relative:.0e})");
+}
+
+#[test]
+fn parallel_rectangles_match_howell_c11() {
+    for (k, (a, b, c)) in [(1.0, 1.0, 1.0), (2.0, 1.0, 0.5), (1.0, 3.0, 2.0)].into_iter().enumerate() {
+        let mut scene = QuadScene { camera: ([-2.0, 0.5 * b, 0.5 * c], [0.5 * a, 0.5 * b, 0.5 * c]), ..Default::default() };
+        scene.material("receiving", 0.5, 0.0).material("emitting", 0.0, 1.0);
+        scene.quad("R", "receiving", rectangle(2, 0.0, [0.0, 0.0], [a, b]), [0.0, 0.0, 1.0]);
+        scene.quad("S", "emitting", rectangle(2, c, [0.0, 0.0], [a, b]), [0.0, 0.0, -1.0]);
+        let solved = solve(&format!("c11_{k}"), &scene, &FINE);
+        assert_close(&format!("F_RS for {a} x {b} at {c}"), solved.form_factor("R", "S"), parallel_rectangles(a, b, c), 0.01);
+        assert_close(&format!("F_SR for {a} x {b} at {c}"), solved.form_factor("S", "R"), parallel_rectangles(a, b, c), 0.01);
+    }
+}
+
+#[test]
+fn perpendicular_rectangles_sharing_an_edge_match_howell_c14() {
+    for (k, (w, h, l)) in [(1.0, 1.0, 1.0), (2.0, 0.5, 1.0), (0.5, 2.0, 3.0)].into_iter().enumerate() {
+        // Floor R: x in [0, w], y in [0, l]; wall S: x = 0, y in [0, l], z in [0, h].
+        let mut scene = QuadScene { camera: ([2.0 * w, 0.5 * l, 2.0 * h], [0.0, 0.5 * l, 0.0]), ..Default::default() };
+        scene.material("receiving", 0.5, 0.0).material("emitting", 0.0, 1.0);
+        scene.quad("R", "receiving", rectangle(2, 0.0, [0.0, 0.0], [w, l]), [0.0, 0.0, 1.0]);
+        scene.quad("S", "emitting", rectangle(0, 0.0, [0.0, 0.0], [l, h]), [1.0, 0.0, 0.0]);
+        let solved = solve(&format!("c14_{k}"), &scene, &FINE);
+        assert_close(&format!("F for w={w} h={h} l={l}"), solved.form_factor("R", "S"), perpendicular_rectangles(w, h, l), 0.01);
+    }
+}
+
+#[test]
+fn floor_irradiance_under_a_square_emitter_matches_lambert() {
+    let (rho, height) = (0.5, 1.0);
+    let mut scene = QuadScene { camera: ([0.0, -3.0, 2.0], [0.0, 0.0, 0.0]), ..Default::default() };
+    scene.material("floor", rho, 0.0).material("lamp", 0.0, 1.0);
+    scene.quad("floor", "floor", rectangle(2, 0.0, [-2.0, -2.0], [2.0, 2.0]), [0.0, 0.0, 1.0]);
+    scene.quad("lamp", "lamp", rectangle(2, height, [-0.5, -0.5], [0.5, 0.5]), [0.0, 0.0, -1.0]);
+    let dir = scratch("lambert");
+    let scene_path = scene.write(&dir);
+    let (mesh_path, manifest_path, solution_path) = prepare_and_solve(&dir, &scene_path, &["--eps", "1e-4", "--min-area", "1e-5"]);
+    let solved = load(&mesh_path, &manifest_path, &solution_path);
+    let (mesh, _) = Mesh::read(&mesh_path).unwrap();
+    let manifest = read_ron::<Manifest>(&manifest_path).unwrap().value;
+    let origin = manifest.world_from_mesh_translation;
+    let mut checked = 0;
+    for (object, _, b, i) in solved.leaves() {
+        if object != "floor" {
+            continue;
+        }
+        let e = &solved.solution.elements[i];
+        let t = &mesh.triangles[e.triangle as usize];
+        let p = |k: usize| mesh.positions[t.vertices[k] as usize].map(f64::from);
+        let (p0, p1, p2) = (p(0), p(1), p(2));
+        let centroid_uv = [0, 1].map(|axis| e.corners.iter().map(|c| f64::from(c[axis])).sum::<f64>() / 3.0);
+        let world = |axis: usize| p0[axis] + (p1[axis] - p0[axis]) * centroid_uv[0] + (p2[axis] - p0[axis]) * centroid_uv[1] + origin[axis];
+        let (x, y) = (world(0), world(1));
+        let exact = point_to_rectangle(x, y, [-0.5, 0.5, -0.5, 0.5], height);
+        if exact < 0.05 {
+            continue;
+        }
+        assert_close(&format!("irradiance at ({x:.3}, {y:.3})"), b / rho, exact, 0.005);
+        checked += 1;
+    }
+    assert!(checked > 100, "only {checked} floor elements under the lamp");
+}
+
+fn energy_balance(test: &str, rho: f64) {
+    let (size, emission) = (1.0, 10.0);
+    let solved = solve(test, &closed_box(size, rho, emission), &["--eps", "1e-3", "--min-area", "1e-3", "--tolerance", "1e-7"]);
+    let lamp_area = (size / 3.0) * (size / 3.0);
+    let total_area = 6.0 * size * size;
+    let expected = emission * lamp_area / ((1.0 - rho) * total_area);
+    let (mut weighted, mut area) = (0.0, 0.0);
+    for (_, a, b, i) in solved.leaves() {
+        let rgb = solved.solution.elements[i].radiosity;
+        assert!(rgb.iter().all(|x| x.is_finite() && *x >= 0.0), "element {i} has radiosity {rgb:?}");
+        weighted += a * b;
+        area += a;
+    }
+    assert_close("total area", area, total_area, 1e-6);
+    assert_close(&format!("mean radiosity, rho = {rho}"), weighted / area, expected, 0.01);
+}
+
+#[test]
+fn closed_box_conserves_energy_rho_0_5() {
+    energy_balance("energy_0_5", 0.5);
+}
+
+#[test]
+fn closed_box_conserves_energy_rho_0_9() {
+    energy_balance("energy_0_9", 0.9);
+}
