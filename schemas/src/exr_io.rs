@@ -340,13 +340,7 @@ mod tests {
     }
 
     fn provenance() -> Provenance {
-        Provenance {
-            stage: "test".into(),
-            stage_version: "0".into(),
-            command_line: vec!["test".into()],
-            parameters: ron::Value::Unit,
-            inputs: vec![],
-        }
+        Provenance::in_memory("test")
     }
 
     #[test]

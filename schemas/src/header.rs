@@ -37,10 +37,25 @@ pub struct Provenance {
     pub stage_version: String,
     /// The full command line, program name first.
     pub command_line: Vec<String>,
-    /// The effective parameters, as the stage's `--print-params` shows them.
-    pub parameters: ron::Value,
+    /// The effective parameters, as RON text a `--params` file may hold
+    /// (kept as text: an untyped RON value would lose enum variant names).
+    pub parameters: Box<ron::value::RawValue>,
     /// Each input file: path, content hash, and the provenance it carried.
     pub inputs: Vec<Input>,
+}
+
+impl Provenance {
+    /// The provenance of data made in memory by `maker` (a test, an
+    /// example) rather than by a stage run: no command line, no inputs.
+    pub fn in_memory(maker: &str) -> Self {
+        Provenance {
+            stage: maker.into(),
+            stage_version: "0".into(),
+            command_line: Vec::new(),
+            parameters: ron::value::RawValue::from_rust(&()).expect("unit serializes"),
+            inputs: Vec::new(),
+        }
+    }
 }
 
 /// One input file of a run.

@@ -43,8 +43,7 @@ impl Run {
             stage: self.stage.into(),
             stage_version: self.version.into(),
             command_line: std::env::args().collect(),
-            // Our parameter types always serialize to valid RON.
-            parameters: ron::from_str(&to_ron_text(params)).unwrap_or(ron::Value::Unit),
+            parameters: ron::value::RawValue::from_rust(params).expect("parameter types serialize to RON"),
             inputs: self.inputs.clone(),
         }
     }

@@ -5,13 +5,7 @@ use schemas::header::{Provenance, Schema};
 use schemas::solution::{Element, NONE};
 
 fn provenance() -> Provenance {
-    Provenance {
-        stage: "test".into(),
-        stage_version: "0".into(),
-        command_line: vec![],
-        parameters: ron::Value::Unit,
-        inputs: vec![],
-    }
+    Provenance::in_memory("test")
 }
 
 fn image(width: usize, height: usize, rgb: Vec<[f32; 3]>, coverage: Vec<f32>) -> HdrImage {

@@ -9,13 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn provenance() -> Provenance {
-    Provenance {
-        stage: "test".into(),
-        stage_version: "0".into(),
-        command_line: vec![],
-        parameters: ron::Value::Unit,
-        inputs: vec![],
-    }
+    Provenance::in_memory("test")
 }
 
 fn scratch(test: &str) -> PathBuf {

@@ -14,13 +14,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 fn provenance() -> Provenance {
-    Provenance {
-        stage: "test".into(),
-        stage_version: "0".into(),
-        command_line: vec![],
-        parameters: ron::Value::Unit,
-        inputs: vec![],
-    }
+    Provenance::in_memory("test")
 }
 
 /// A mesh of the given triangles (corners counter-clockwise from the front).

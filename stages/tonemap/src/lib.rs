@@ -24,8 +24,7 @@
 //! ```
 //! use tonemap::{tonemap, Params};
 //! # use schemas::header::{Schema, Provenance};
-//! # let provenance = Provenance { stage: "doc".into(), stage_version: "0".into(),
-//! #     command_line: vec![], parameters: ron::Value::Unit, inputs: vec![] };
+//! # let provenance = Provenance::in_memory("doc");
 //! let image = schemas::image::HdrImage {
 //!     header: schemas::image::HdrImage::header(provenance),
 //!     width: 2, height: 1,
@@ -359,13 +358,7 @@ mod tests {
     use schemas::header::{Provenance, Schema};
 
     fn image(width: usize, height: usize, rgb: Vec<[f32; 3]>, coverage: Vec<f32>) -> HdrImage {
-        let provenance = Provenance {
-            stage: "test".into(),
-            stage_version: "0".into(),
-            command_line: vec![],
-            parameters: ron::Value::Unit,
-            inputs: vec![],
-        };
+        let provenance = Provenance::in_memory("test");
         HdrImage { header: HdrImage::header(provenance), width, height, rgb, coverage }
     }
 

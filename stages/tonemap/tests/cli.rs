@@ -15,13 +15,7 @@ fn scratch(test: &str) -> PathBuf {
 }
 
 fn write_image(path: &Path, rgb: Vec<[f32; 3]>, width: usize) {
-    let provenance = Provenance {
-        stage: "test".into(),
-        stage_version: "0".into(),
-        command_line: vec![],
-        parameters: ron::Value::Unit,
-        inputs: vec![],
-    };
+    let provenance = Provenance::in_memory("test");
     let height = rgb.len() / width;
     let coverage = vec![1.0; rgb.len()];
     HdrImage { header: HdrImage::header(provenance), width, height, rgb, coverage }.write(path).unwrap();
