@@ -47,7 +47,8 @@ pub fn parse_ron<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
 /// version first, then parses the body strictly (unknown fields are errors).
 pub fn read_ron<T: RonArtifact>(path: &Path) -> Result<Loaded<T>> {
     let bytes = read_bytes(path)?;
-    let text = std::str::from_utf8(&bytes).map_err(|e| Error::parse(path, None, format!("not UTF-8 text: {e}")))?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|_| Error::schema(path, format!("not a text file; expected a '{}' artifact (RON)", T::NAME)))?;
     let untyped: ron::Value = parse_ron(path, text)?;
     let tag: HeaderTag = header_of(&untyped)
         .and_then(|h| h.clone().into_rust().ok())

@@ -127,7 +127,7 @@ pub fn check_writable(path: &Path) -> Result<()> {
         _ => Path::new("."),
     };
     let probe = dir.join(format!(".{}.probe", std::process::id()));
-    std::fs::write(&probe, b"").map_err(|e| Error::io(path, e))?;
+    std::fs::write(&probe, b"").map_err(|e| Error::invalid(path, None, format!("cannot write into {}: {e}", dir.display())))?;
     std::fs::remove_file(&probe).map_err(|e| Error::io(path, e))
 }
 
