@@ -22,7 +22,7 @@ endif
 OUT ?= out/$(SCENE_NAME)
 
 # --- knobs (defaults are the stages' own) -------------------------------
-EPS ?= 1e-3
+EPS ?= 2e-4
 MIN_AREA ?= 1e-4
 VISIBILITY_RAYS ?= 16
 TOLERANCE ?= 1e-5

@@ -13,7 +13,7 @@
 //!
 //! | name | meaning | default |
 //! |---|---|---|
-//! | `eps` | BF threshold, as a fraction of the largest emitted radiosity | 1e-3 |
+//! | `eps` | BF threshold, as a fraction of the largest emitted radiosity | 2e-4 |
 //! | `min_area` | smallest element area, as a fraction of the scene's total area | 1e-4 |
 //! | `visibility_rays` | rays per link for its visibility | 16 |
 //! | `tolerance` | convergence: largest relative change of a leaf's radiosity | 1e-5 |
@@ -57,7 +57,7 @@ pub struct Params {
 
 impl Default for Params {
     fn default() -> Self {
-        Params { eps: 1e-3, min_area: 1e-4, visibility_rays: 16, tolerance: 1e-5, max_iterations: 2000, max_passes: 8, seed: 1 }
+        Params { eps: 2e-4, min_area: 1e-4, visibility_rays: 16, tolerance: 1e-5, max_iterations: 2000, max_passes: 8, seed: 1 }
     }
 }
 

@@ -132,7 +132,7 @@ fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3]) -> AreaFactor {
 pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
 
 /// Deepest 1:4 split of the receiver the adaptive quadrature makes.
-pub const QUADRATURE_DEPTH: u32 = 7;
+pub const QUADRATURE_DEPTH: u32 = 5;
 
 /// Area-averaged form factor from a receiver triangle to a sender polygon:
 ///
