@@ -20,11 +20,7 @@ pub struct Sample {
     pub weight: f64,
 }
 
-/// Luminance of linear Rec. 709 primaries (ITU-R BT.709):
-/// `L = 0.2126 R + 0.7152 G + 0.0722 B`.
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
-}
+pub use radiometry::color::luminance;
 
 /// The error of A against reference B. With weights `w` (all 1 for
 /// images), sums over the samples `s` and channels `c`:

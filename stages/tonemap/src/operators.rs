@@ -20,12 +20,7 @@ pub const KEY_RANGE: (f64, f64) = (0.045, 0.72);
 /// source seen directly, do not decide the key).
 pub const ROBUST_PERCENTILES: (f64, f64) = (0.01, 0.99);
 
-/// Luminance of linear Rec. 709 / sRGB primaries (ITU-R BT.709, relative
-/// luminance Y): `L = 0.2126 R + 0.7152 G + 0.0722 B`. Same unit as the
-/// input (radiance in, luminance-weighted radiance out).
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
-}
+pub use radiometry::color::luminance;
 
 /// Log-average luminance (Reinhard et al. 2002, "Photographic tone
 /// reproduction for digital images", SIGGRAPH, Eq. 1):
