@@ -11,6 +11,7 @@
 //! |---|---|---|---|
 //! | [`mesh::Mesh`] | `mesh.exr` | `mesh` 1 | mesh-prep |
 //! | [`mesh::Manifest`] | `manifest.ron` | `manifest` 1 | mesh-prep |
+//! | [`cluster::Clusters`] | `clusters.exr` | `clusters` 1 | cluster |
 //! | [`solution::Solution`] | `solution.exr` | `solution` 1 | hierarchical-solve |
 //! | [`image::HdrImage`] | `*.exr` | `image` 1 | grid-gather |
 //! | [`report::Report`] | `*.report.ron` | `report` 1 | every stage |
@@ -21,6 +22,7 @@
 //! ```
 
 pub mod atomic;
+pub mod cluster;
 pub mod error;
 pub mod exr_io;
 pub mod header;

@@ -1,6 +1,8 @@
 //! The radiosity solution artifact (`solution.exr`), written by
 //! `hierarchical-solve`: the element hierarchy with radiosity per element,
-//! and every link of every level (the final gather reads them).
+//! the radiosity of every cluster (when solved with the cluster hierarchy
+//! of `clusters.exr`), and every link of every level, between elements or
+//! clusters (the final gather reads them).
 
 use crate::error::{Error, Result};
 use crate::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer};
@@ -39,13 +41,52 @@ impl Element {
     }
 }
 
+/// One end of a link: an element of the solution, or a cluster of the
+/// cluster hierarchy it was solved with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Node {
+    /// Index into [`Solution::elements`].
+    Element(u32),
+    /// Index into the cluster hierarchy (and [`Solution::clusters`]).
+    Cluster(u32),
+}
+
+impl Node {
+    fn index(self) -> u32 {
+        match self {
+            Node::Element(i) | Node::Cluster(i) => i,
+        }
+    }
+
+    fn is_cluster(self) -> u32 {
+        matches!(self, Node::Cluster(_)) as u32
+    }
+
+    fn new(index: u32, is_cluster: u32) -> Self {
+        if is_cluster == 0 {
+            Node::Element(index)
+        } else {
+            Node::Cluster(index)
+        }
+    }
+}
+
+/// The radiosity of one cluster, as the solve used it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClusterRadiosity {
+    /// Total surface area in the cluster, m².
+    pub area: f32,
+    /// Area-weighted mean radiosity of the cluster's surfaces, W/m², RGB.
+    pub radiosity: [f32; 3],
+}
+
 /// One link: light gathered by `receiver` from `sender`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Link {
-    /// Receiving element.
-    pub receiver: u32,
-    /// Sending element.
-    pub sender: u32,
+    /// Receiving element or cluster.
+    pub receiver: Node,
+    /// Sending element or cluster.
+    pub sender: Node,
     /// Unoccluded form factor F_rs (fraction of the energy leaving the
     /// receiver that would reach the sender; by reciprocity the receiver's
     /// irradiance is F_rs B_s).
@@ -66,6 +107,9 @@ pub struct Solution {
     pub header: Header,
     /// Elements; input triangle `t` is element `t`, children follow.
     pub elements: Vec<Element>,
+    /// Per cluster of the hierarchy the solve used; empty without
+    /// clustering.
+    pub clusters: Vec<ClusterRadiosity>,
     /// Links, sorted by receiver then sender.
     pub links: Vec<Link>,
 }
@@ -109,8 +153,10 @@ impl Solution {
             "link",
             l.len(),
             vec![
-                Channel::u32("receiver", "receiving element", column(l, |x| x.receiver)),
-                Channel::u32("sender", "sending element", column(l, |x| x.sender)),
+                Channel::u32("receiver", "receiving element or cluster", column(l, |x| x.receiver.index())),
+                Channel::u32("receiver_is_cluster", "1: receiver indexes the clusters", column(l, |x| x.receiver.is_cluster())),
+                Channel::u32("sender", "sending element or cluster", column(l, |x| x.sender.index())),
+                Channel::u32("sender_is_cluster", "1: sender indexes the clusters", column(l, |x| x.sender.is_cluster())),
                 Channel::f32("F", "unoccluded form factor receiver->sender", column(l, |x| x.form_factor)),
                 Channel::f32("V", "visible fraction of rays", column(l, |x| x.visibility)),
                 Channel::f32("Eu.R", "unoccluded irradiance F*B_sender, W/m^2", column(l, |x| x.unoccluded_irradiance[0])),
@@ -119,7 +165,18 @@ impl Solution {
                 Channel::f32("occluder_distance", "receiver to nearest occluder, m (inf = none)", column(l, |x| x.occluder_distance)),
             ],
         );
-        write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![element, link] })
+        let c = &self.clusters;
+        let cluster = Layer::table(
+            "cluster",
+            c.len(),
+            vec![
+                Channel::f32("area", "surface area in the cluster, m^2", column(c, |x| x.area)),
+                Channel::f32("B.R", "area-weighted mean radiosity, W/m^2", column(c, |x| x.radiosity[0])),
+                Channel::f32("B.G", "area-weighted mean radiosity, W/m^2", column(c, |x| x.radiosity[1])),
+                Channel::f32("B.B", "area-weighted mean radiosity, W/m^2", column(c, |x| x.radiosity[2])),
+            ],
+        );
+        write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![element, cluster, link] })
     }
 
     /// Reads `solution.exr` and checks the hierarchy's indices.
@@ -150,24 +207,34 @@ impl Solution {
                 return Err(Error::invalid(path, None, format!("element {i} links outside the element table")));
             }
         }
+        let cl = artifact.layer(path, "cluster")?;
+        let (cluster_area, cb) = (cl.f32s(path, "area")?, [cl.f32s(path, "B.R")?, cl.f32s(path, "B.G")?, cl.f32s(path, "B.B")?]);
+        let clusters: Vec<ClusterRadiosity> =
+            (0..cl.len()).map(|i| ClusterRadiosity { area: cluster_area[i], radiosity: [cb[0][i], cb[1][i], cb[2][i]] }).collect();
         let li = artifact.layer(path, "link")?;
         let (receiver, sender) = (li.u32s(path, "receiver")?, li.u32s(path, "sender")?);
+        let (receiver_kind, sender_kind) = (li.u32s(path, "receiver_is_cluster")?, li.u32s(path, "sender_is_cluster")?);
         let (ff, vis, dist) = (li.f32s(path, "F")?, li.f32s(path, "V")?, li.f32s(path, "occluder_distance")?);
         let eu = [li.f32s(path, "Eu.R")?, li.f32s(path, "Eu.G")?, li.f32s(path, "Eu.B")?];
         let mut links = Vec::with_capacity(li.len());
+        let in_range = |node: Node| match node {
+            Node::Element(e) => (e as usize) < n,
+            Node::Cluster(c) => (c as usize) < clusters.len(),
+        };
         for i in 0..li.len() {
-            if receiver[i] as usize >= n || sender[i] as usize >= n {
-                return Err(Error::invalid(path, None, format!("link {i} names an element out of range")));
+            let (r, s) = (Node::new(receiver[i], receiver_kind[i]), Node::new(sender[i], sender_kind[i]));
+            if !in_range(r) || !in_range(s) {
+                return Err(Error::invalid(path, None, format!("link {i} names an element or cluster out of range")));
             }
             links.push(Link {
-                receiver: receiver[i],
-                sender: sender[i],
+                receiver: r,
+                sender: s,
                 form_factor: ff[i],
                 visibility: vis[i],
                 unoccluded_irradiance: [eu[0][i], eu[1][i], eu[2][i]],
                 occluder_distance: dist[i],
             });
         }
-        Ok((Solution { header: artifact.header, elements, links }, input))
+        Ok((Solution { header: artifact.header, elements, clusters, links }, input))
     }
 }

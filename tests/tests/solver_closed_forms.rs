@@ -7,7 +7,7 @@ use end_to_end::scenes::{closed_box, rectangle, QuadScene};
 use end_to_end::{prepare_and_solve, scratch};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
-use schemas::solution::Solution;
+use schemas::solution::{Node, Solution};
 use std::path::Path;
 
 /// The solved scene, with each element's object name.
@@ -48,8 +48,12 @@ impl Solved {
             .solution
             .links
             .iter()
-            .filter(|l| self.object_of_element[l.receiver as usize] == r && self.object_of_element[l.sender as usize] == s)
-            .map(|l| f64::from(e[l.receiver as usize].area) * f64::from(l.form_factor))
+            .filter_map(|l| match (l.receiver, l.sender) {
+                (Node::Element(re), Node::Element(se)) => Some((re as usize, se as usize, l)),
+                _ => None,
+            })
+            .filter(|(re, se, _)| self.object_of_element[*re] == r && self.object_of_element[*se] == s)
+            .map(|(re, _, l)| f64::from(e[re].area) * f64::from(l.form_factor))
             .sum();
         flux / area_of(r)
     }

@@ -35,7 +35,7 @@ fn write_solution(path: &Path, radiosity: [f32; 3]) {
         area: 0.5,
         radiosity,
     };
-    Solution { header: Solution::header(provenance()), elements: vec![e], links: vec![] }.write(path).unwrap();
+    Solution { header: Solution::header(provenance()), elements: vec![e], clusters: vec![], links: vec![] }.write(path).unwrap();
 }
 
 fn compare(args: &[&Path], flags: &[&str]) -> Output {

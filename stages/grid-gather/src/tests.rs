@@ -87,7 +87,7 @@ fn solution(triangle_count: usize, depth: u32, b: impl Fn(u32, &Corners) -> f32)
         }
         frontier = next;
     }
-    Solution { header: Solution::header(provenance()), elements, links: vec![] }
+    Solution { header: Solution::header(provenance()), elements, clusters: vec![], links: vec![] }
 }
 
 /// The unit square in z = 0 facing +z, split along its diagonal (0,0)-(1,1):

@@ -61,7 +61,7 @@ fn write_scene(dir: &Path, roots: u32) {
         area: 0.5,
         radiosity: [1.0 + 2.0 * t as f32; 3],
     };
-    let solution = Solution { header: Solution::header(provenance()), elements: (0..roots).map(root).collect(), links: vec![] };
+    let solution = Solution { header: Solution::header(provenance()), elements: (0..roots).map(root).collect(), clusters: vec![], links: vec![] };
     solution.write(&dir.join("solution.exr")).unwrap();
 }
 

@@ -129,6 +129,8 @@ pub struct Progress {
 pub struct Solved {
     /// Elements with radiosity.
     pub elements: Vec<solution::Element>,
+    /// Radiosity per cluster (empty without clustering).
+    pub clusters: Vec<solution::ClusterRadiosity>,
     /// Links, sorted by receiver then sender.
     pub links: Vec<solution::Link>,
     /// Work done.
@@ -218,7 +220,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &dyn F
     work.links = all_links.len();
     work.elements = h.elements.len();
     work.leaves = h.elements.iter().filter(|e| e.is_leaf()).count();
-    Ok(Solved { elements: output_elements(&h, &b), links: output_links(&all_links, &b), work })
+    Ok(Solved { elements: output_elements(&h, &b), clusters: Vec::new(), links: output_links(&all_links, &b), work })
 }
 
 /// `offsets[e]..offsets[e + 1]` indexes the links into element `e` of
@@ -258,8 +260,8 @@ fn output_links(links: &[Link], b: &[[f64; 3]]) -> Vec<solution::Link> {
     links
         .iter()
         .map(|l| solution::Link {
-            receiver: l.receiver,
-            sender: l.sender,
+            receiver: solution::Node::Element(l.receiver),
+            sender: solution::Node::Element(l.sender),
             form_factor: l.form_factor as f32,
             visibility: l.visibility.unwrap_or(1.0),
             unoccluded_irradiance: f32x3(b[l.sender as usize].map(|x| x * l.form_factor)),

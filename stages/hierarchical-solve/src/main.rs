@@ -126,7 +126,12 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         "hierarchical-solve: {} passes, {} links, {} elements ({} leaves), {} rays, {} iterations",
         w.passes, w.links, w.elements, w.leaves, w.rays, w.iterations
     );
-    let solution = Solution { header: Solution::header(run.provenance(&params)), elements: solved.elements, links: solved.links };
+    let solution = Solution {
+        header: Solution::header(run.provenance(&params)),
+        elements: solved.elements,
+        clusters: solved.clusters,
+        links: solved.links,
+    };
     let mut outputs = Outputs::new();
     outputs.write(output, |p| solution.write(p))?;
     if let Some(report) = &args.report {
