@@ -54,7 +54,8 @@ endef
 $(OUT) $(OUT)/params:
 	@mkdir -p $@
 
-include pipelines/hierarchical.mk
+# Every pipeline fragment; each is self-contained.
+include $(sort $(wildcard pipelines/*.mk))
 
 test: $(BINS)
 	cargo test --release --workspace
