@@ -1,0 +1,98 @@
+//! `cluster`: see the library's documentation and `cluster --help`.
+
+use clap::Parser;
+use cluster::{build, Params};
+use schemas::cluster::Clusters;
+use schemas::header::Schema;
+use schemas::mesh::{Manifest, Mesh};
+use schemas::ron_io::read_ron;
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, Outputs, Run};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Build the cluster hierarchy over a prepared mesh (a surface-area-heuristic
+/// BVH from obvhs), with per-cluster bounds, area, reflectance-weighted
+/// area and normal cone. Writes clusters.exr for hierarchical-solve
+/// --clusters and the final gather.
+#[derive(Parser, Debug)]
+#[command(name = "cluster", version)]
+struct Args {
+    /// Input: mesh.exr from mesh-prep.
+    #[arg(long, required_unless_present = "print_params")]
+    mesh: Option<PathBuf>,
+    /// Input: manifest.ron from mesh-prep (materials).
+    #[arg(long, required_unless_present = "print_params")]
+    manifest: Option<PathBuf>,
+    /// Output: the cluster hierarchy.
+    #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
+    output: Option<PathBuf>,
+    /// Output: a report of the run (RON, with wall time).
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Read parameters from this RON file; flags below override it.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Print the effective parameters as RON and exit.
+    #[arg(long)]
+    print_params: bool,
+    /// Most triangles in a leaf cluster (1..=255).
+    #[arg(long)]
+    leaf_size: Option<u32>,
+}
+
+fn run(args: Args) -> schemas::Result<ExitCode> {
+    let mut params: Params = load_params(args.params.as_deref())?;
+    params.leaf_size = args.leaf_size.unwrap_or(params.leaf_size);
+    if !(1..=255).contains(&params.leaf_size) {
+        return Err(bad_parameter(format!("leaf_size must be in 1..=255, not {}", params.leaf_size)));
+    }
+    if args.print_params {
+        print_params(&params);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
+        unreachable!("clap requires the inputs and output without --print-params")
+    };
+    for path in [Some(output), args.report.as_ref()].into_iter().flatten() {
+        check_writable(path)?;
+    }
+    let mut run = Run::start("cluster", env!("CARGO_PKG_VERSION"));
+    let (mesh, mesh_input) = Mesh::read(mesh_path)?;
+    let manifest = read_ron::<Manifest>(manifest_path)?;
+    manifest.value.check_mesh(mesh_path, &mesh)?;
+    run.input(mesh_input);
+    run.input(manifest.input);
+    let started = Instant::now();
+    let triangles = radiometry::geometry::mesh_triangles(&mesh);
+    let reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.value.materials[t.material as usize].diffuse).collect();
+    let hierarchy = build(&triangles, &reflectance, &params);
+    let seconds = started.elapsed().as_secs_f64();
+    let leaves = hierarchy.nodes.iter().filter(|n| n.is_leaf()).count();
+    let isotropic = hierarchy.nodes.iter().filter(|n| n.normal_cos <= -1.0).count();
+    eprintln!("cluster: {} clusters ({leaves} leaves, {isotropic} isotropic) over {} triangles", hierarchy.nodes.len(), triangles.len());
+    let clusters = Clusters { header: Clusters::header(run.provenance(&params)), nodes: hierarchy.nodes, order: hierarchy.order };
+    let mut outputs = Outputs::new();
+    outputs.write(output, |p| clusters.write(p))?;
+    if let Some(report) = &args.report {
+        let counters = BTreeMap::from([
+            ("clusters".to_string(), clusters.nodes.len() as f64),
+            ("leaf_clusters".to_string(), leaves as f64),
+            ("isotropic_clusters".to_string(), isotropic as f64),
+            ("triangles".to_string(), clusters.order.len() as f64),
+            ("build_seconds".to_string(), seconds),
+        ]);
+        let mut notes = Vec::new();
+        if !manifest.value.effects.fine_clustered_geometry {
+            notes.push("the manifest does not flag fine geometry: clustering may not pay on this scene".to_string());
+        }
+        outputs.write(report, |p| run.write_report(p, &params, counters, vec![], notes))?;
+    }
+    outputs.keep();
+    Ok(ExitCode::SUCCESS)
+}
+
+fn main() -> ExitCode {
+    exit_code("cluster", run(Args::parse()))
+}
