@@ -1,0 +1,228 @@
+//! # mask: where the eye cannot see small errors
+//!
+//! Paper 000 Sec. 5.1-5.2: the final gather may interpolate a sender
+//! wherever its error stays below what a viewer can see. This stage turns a
+//! tone-mapped preview (grid-gather `--mode preview`, then `tonemap`) into a
+//! per-pixel visibility threshold:
+//!
+//! ```text
+//! dL_thr(x) = TVI(L_a(x)) * T_e(x)        (cd/m², display luminance)
+//! c_thr(x)  = dL_thr(x) / max(L_d(x), L_black)   (dimensionless)
+//! ```
+//!
+//! - `L_d` is the display luminance of the pixel: the sRGB pixel decoded to
+//!   linear, Rec. 709 luminance, times the display's peak luminance
+//!   (`display_max_cd_m2`).
+//! - `L_a` is the adaptation luminance: `L_d` blurred over about one
+//!   degree of visual angle (the pyramid level whose blur radius is closest
+//!   to `pixels_per_degree` pixels).
+//! - `TVI` is the threshold-versus-intensity function of Ferwerda,
+//!   Pattanaik, Shirley and Greenberg 1996 ([`tvi`]).
+//! - `T_e >= 1` is the threshold elevation of the masking model of
+//!   Ramasubramanian, Pattanaik and Greenberg 1999, paper 000's reference
+//!   [15] ([`elevation`]).
+//! - `c_thr`, the threshold as a contrast (a Weber fraction), is what
+//!   grid-gather reads: it multiplies it by its own radiance estimate at a
+//!   grid vertex. That equals mapping `dL_thr` back through a tone curve
+//!   that is linear through the origin; for a compressive curve (Reinhard)
+//!   the true slope is lower than the ratio, so the radiance threshold it
+//!   gives is smaller than the exact one: conservative.
+//!
+//! ## Parameters
+//!
+//! | name | type | meaning | default |
+//! |---|---|---|---|
+//! | `display_max_cd_m2` | cd/m² | luminance of display white (sRGB 255) | 100 |
+//! | `display_black` | fraction of white | darkest luminance the display shows; floors `L_d` and `L_a` | 0.005 |
+//! | `pixels_per_degree` | pixels | image pixels per degree of visual angle (a 512-pixel image 16 degrees wide: 32) | 32 |
+//! | `levels` | count | band-pass levels of the contrast pyramid | 6 |
+//! | `masking_slope` | exponent | `s` of the masking function `max(1, C^s)` | 0.7 |
+//!
+//! Everything here takes data, not paths, and never prints.
+
+pub mod model;
+
+use model::{band_frequency_cpd, contrast_sensitivity, elevation_image, luminance_pyramid, tvi};
+use schemas::error::{Error, Result};
+use schemas::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer, LayerKind};
+use schemas::header::{Header, Input, Schema};
+use schemas::stage::bad_parameter;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+pub use model::elevation;
+
+/// The stage's parameters (`--params file.ron`, overridden by flags).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// Luminance of display white, cd/m².
+    pub display_max_cd_m2: f64,
+    /// Darkest displayed luminance, as a fraction of white, in (0, 1).
+    pub display_black: f64,
+    /// Image pixels per degree of visual angle, > 0.
+    pub pixels_per_degree: f64,
+    /// Band-pass levels of the contrast pyramid, 1..=12.
+    pub levels: u32,
+    /// Exponent of the masking function, in (0, 1].
+    pub masking_slope: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params { display_max_cd_m2: 100.0, display_black: 0.005, pixels_per_degree: 32.0, levels: 6, masking_slope: 0.7 }
+    }
+}
+
+impl Params {
+    /// Checks every value's range; the error names the parameter.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.display_max_cd_m2.is_finite() && self.display_max_cd_m2 > 0.0) {
+            return Err(bad_parameter(format!("display_max_cd_m2 must be > 0, got {}", self.display_max_cd_m2)));
+        }
+        if !(self.display_black > 0.0 && self.display_black < 1.0) {
+            return Err(bad_parameter(format!("display_black must be in (0, 1), got {}", self.display_black)));
+        }
+        if !(self.pixels_per_degree.is_finite() && self.pixels_per_degree > 0.0) {
+            return Err(bad_parameter(format!("pixels_per_degree must be > 0, got {}", self.pixels_per_degree)));
+        }
+        if !(1..=12).contains(&self.levels) {
+            return Err(bad_parameter(format!("levels must be in 1..=12, got {}", self.levels)));
+        }
+        if !(self.masking_slope > 0.0 && self.masking_slope <= 1.0) {
+            return Err(bad_parameter(format!("masking_slope must be in (0, 1], got {}", self.masking_slope)));
+        }
+        Ok(())
+    }
+}
+
+/// The per-pixel threshold, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Thresholds {
+    /// Pixels per row.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Display luminance `L_d`, cd/m².
+    pub luminance: Vec<f32>,
+    /// Adaptation luminance `L_a`, cd/m².
+    pub adaptation: Vec<f32>,
+    /// Masking threshold elevation `T_e >= 1`.
+    pub elevation: Vec<f32>,
+    /// `TVI(L_a) T_e`, cd/m².
+    pub threshold: Vec<f32>,
+    /// `threshold / max(L_d, L_black)`: the threshold as a contrast.
+    pub contrast: Vec<f32>,
+    /// Work counters for the report.
+    pub counters: BTreeMap<String, f64>,
+}
+
+/// The sRGB electro-optical transfer (IEC 61966-2-1): an encoded value in
+/// [0, 1] to linear light in [0, 1].
+pub fn srgb_decode(v: f64) -> f64 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Display luminance, cd/m², of 8-bit sRGB pixels on a display whose white
+/// is `display_max_cd_m2`.
+pub fn display_luminance(pixels: &[[u8; 3]], display_max_cd_m2: f64) -> Vec<f64> {
+    pixels
+        .iter()
+        .map(|p| display_max_cd_m2 * radiometry::color::luminance(p.map(|c| srgb_decode(f64::from(c) / 255.0))))
+        .collect()
+}
+
+/// Runs the model over a `width` x `height` image of display luminances
+/// (cd/m², row-major).
+pub fn thresholds(params: &Params, width: usize, height: usize, luminance: &[f64]) -> Result<Thresholds> {
+    params.validate()?;
+    if width == 0 || height == 0 || luminance.len() != width * height {
+        return Err(bad_parameter(format!("image of {width}x{height} pixels with {} values", luminance.len())));
+    }
+    let black = params.display_black * params.display_max_cd_m2;
+    let floored: Vec<f64> = luminance.iter().map(|&l| l.max(black)).collect();
+    // Enough blur levels for the adaptation scale, at least the bands.
+    let adaptation_level = (params.pixels_per_degree.log2().round().max(1.0) as usize).min(14);
+    let depth = (params.levels as usize + 1).max(adaptation_level + 1);
+    let pyramid = luminance_pyramid(width, height, &floored, depth);
+    let elevation = elevation_image(&pyramid, params.levels as usize, params.pixels_per_degree, params.masking_slope);
+    let adaptation = &pyramid[adaptation_level];
+    let mut out = Thresholds {
+        width,
+        height,
+        luminance: luminance.iter().map(|&l| l as f32).collect(),
+        adaptation: adaptation.iter().map(|&l| l as f32).collect(),
+        elevation: elevation.iter().map(|&e| e as f32).collect(),
+        threshold: Vec::with_capacity(luminance.len()),
+        contrast: Vec::with_capacity(luminance.len()),
+        counters: BTreeMap::new(),
+    };
+    for i in 0..luminance.len() {
+        let threshold = tvi(adaptation[i].max(black)) * elevation[i];
+        out.threshold.push(threshold as f32);
+        out.contrast.push((threshold / floored[i]) as f32);
+    }
+    let n = luminance.len() as f64;
+    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
+    out.counters.insert("pixels".into(), n);
+    out.counters.insert("bands".into(), f64::from(params.levels));
+    out.counters.insert("mean_elevation".into(), mean(&out.elevation));
+    out.counters.insert("max_elevation".into(), out.elevation.iter().fold(0.0f64, |m, &e| m.max(f64::from(e))));
+    out.counters.insert("mean_contrast_threshold".into(), mean(&out.contrast));
+    out.counters.insert("peak_band_cpd".into(), {
+        let bands: Vec<f64> = (0..params.levels as usize).map(|k| band_frequency_cpd(k, params.pixels_per_degree)).collect();
+        bands.iter().copied().fold((0.0, 0.0), |(bf, bs), f| if contrast_sensitivity(f) > bs { (f, contrast_sensitivity(f)) } else { (bf, bs) }).0
+    });
+    Ok(out)
+}
+
+/// The `threshold` artifact (`threshold.exr`): one image layer with the
+/// channels `L` (display luminance, cd/m²), `La` (adaptation luminance,
+/// cd/m²), `elevation` (masking threshold elevation, >= 1), `threshold`
+/// (TVI x elevation, cd/m²) and `contrast` (threshold / luminance).
+///
+/// The contract belongs in `schemas` (it is read by grid-gather, which
+/// declares the same name and version for its reader); it lives here until
+/// it moves there.
+pub struct ThresholdImage;
+
+impl Schema for ThresholdImage {
+    const NAME: &'static str = "threshold";
+    const VERSION: u32 = 1;
+}
+
+impl ThresholdImage {
+    /// Writes `thresholds` with `header` atomically.
+    pub fn write(path: &Path, header: Header, t: &Thresholds) -> Result<()> {
+        let layer = Layer {
+            name: String::new(),
+            kind: LayerKind::Image { width: t.width, height: t.height },
+            channels: vec![
+                Channel::f32("L", "display luminance, cd/m^2", t.luminance.clone()),
+                Channel::f32("La", "adaptation luminance (about 1 degree), cd/m^2", t.adaptation.clone()),
+                Channel::f32("elevation", "masking threshold elevation (Ramasubramanian et al. 1999), >= 1", t.elevation.clone()),
+                Channel::f32("threshold", "TVI(La) x elevation, cd/m^2", t.threshold.clone()),
+                Channel::f32("contrast", "threshold / max(L, display black): smallest visible contrast", t.contrast.clone()),
+            ],
+        };
+        write_exr(path, &ExrArtifact { header, layers: vec![layer] })
+    }
+
+    /// Reads a threshold image: `(width, height, contrast)`.
+    pub fn read_contrast(path: &Path) -> Result<((usize, usize, Vec<f32>), Input)> {
+        let (artifact, input) = read_exr::<ThresholdImage>(path)?;
+        let layer = artifact.layer(path, "")?;
+        let LayerKind::Image { width, height } = layer.kind else {
+            return Err(Error::invalid(path, None, "threshold layer is a table"));
+        };
+        Ok(((width, height, layer.f32s(path, "contrast")?.to_vec()), input))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,109 @@
+//! `mask PREVIEW.png -o threshold.exr`: per-pixel visibility thresholds of
+//! a tone-mapped preview (TVI x masking elevation). See the library docs.
+
+use clap::Parser;
+use mask::{display_luminance, thresholds, Params, ThresholdImage};
+use schemas::header::{Input, Schema};
+use schemas::ron_io::read_bytes;
+use schemas::stage::{check_writable, exit_code, load_params, print_params, Run};
+use schemas::{Error, Result};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+const STAGE: &str = "mask";
+
+/// Visibility threshold per pixel of a tone-mapped image: threshold versus
+/// intensity (Ferwerda et al. 1996) times the masking threshold elevation
+/// (Ramasubramanian, Pattanaik, Greenberg 1999).
+#[derive(Parser, Debug)]
+#[command(name = STAGE, version)]
+struct Args {
+    /// Tone-mapped preview (8-bit sRGB PNG from tonemap).
+    #[arg(value_name = "IMAGE.png", required_unless_present = "print_params")]
+    image: Option<PathBuf>,
+    /// Output threshold image (EXR: L, La, elevation, threshold, contrast).
+    #[arg(short = 'o', long = "output", value_name = "THRESHOLD.exr", required_unless_present = "print_params")]
+    output: Option<PathBuf>,
+    /// Luminance of display white, cd/m^2 [default: 100].
+    #[arg(long, value_name = "CD_M2")]
+    display_max_cd_m2: Option<f64>,
+    /// Darkest displayed luminance, fraction of white [default: 0.005].
+    #[arg(long, value_name = "FRACTION")]
+    display_black: Option<f64>,
+    /// Image pixels per degree of visual angle [default: 32].
+    #[arg(long, value_name = "PIXELS")]
+    pixels_per_degree: Option<f64>,
+    /// Band-pass levels of the contrast pyramid [default: 6].
+    #[arg(long, value_name = "N")]
+    levels: Option<u32>,
+    /// Exponent s of the masking function max(1, C^s) [default: 0.7].
+    #[arg(long, value_name = "S")]
+    masking_slope: Option<f64>,
+    /// Parameters file (RON); flags override its values.
+    #[arg(long, value_name = "PARAMS.ron")]
+    params: Option<PathBuf>,
+    /// Print the effective parameters as RON on stdout and exit.
+    #[arg(long)]
+    print_params: bool,
+    /// Write a report (work counters, wall time).
+    #[arg(long, value_name = "REPORT.ron")]
+    report: Option<PathBuf>,
+}
+
+impl Args {
+    fn params(&self) -> Result<Params> {
+        let mut p: Params = load_params(self.params.as_deref())?;
+        if let Some(v) = self.display_max_cd_m2 {
+            p.display_max_cd_m2 = v;
+        }
+        if let Some(v) = self.display_black {
+            p.display_black = v;
+        }
+        if let Some(v) = self.pixels_per_degree {
+            p.pixels_per_degree = v;
+        }
+        if let Some(v) = self.levels {
+            p.levels = v;
+        }
+        if let Some(v) = self.masking_slope {
+            p.masking_slope = v;
+        }
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+fn run(args: &Args) -> Result<ExitCode> {
+    let params = args.params()?;
+    if args.print_params {
+        print_params(&params);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let (Some(input), Some(output)) = (&args.image, &args.output) else {
+        return Err(schemas::stage::bad_parameter("IMAGE and -o are required"));
+    };
+    check_writable(output)?;
+    let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
+    let bytes = read_bytes(input)?;
+    run.input(Input::new(input, &bytes, None));
+    let decoded = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .map_err(|e| Error::parse(input, None, format!("not a readable PNG: {e}")))?
+        .to_rgb8();
+    let (width, height) = (decoded.width() as usize, decoded.height() as usize);
+    let pixels: Vec<[u8; 3]> = decoded.pixels().map(|p| p.0).collect();
+    let luminance = display_luminance(&pixels, params.display_max_cd_m2);
+    let t = thresholds(&params, width, height, &luminance).map_err(|e| Error::invalid(input, None, e.to_string()))?;
+    ThresholdImage::write(output, ThresholdImage::header(run.provenance(&params)), &t)?;
+    if let Some(report) = &args.report {
+        if let Err(e) = run.write_report(report, &params, t.counters.clone(), Vec::new(), Vec::new()) {
+            let _ = std::fs::remove_file(output);
+            return Err(e);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    exit_code(STAGE, run(&args))
+}
