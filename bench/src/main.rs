@@ -350,7 +350,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let mut raw_count = 0;
     for k in 1..=args.runs {
         let started = Instant::now();
-        let solved = solve(&mesh, &manifest, &params, &|_| {})
+        let solved = solve(&mesh, &manifest, None, &params, &|_| {})
             .map_err(|message| schemas::Error::invalid(Path::new(&scene_name), None, message))?;
         let solve_seconds = started.elapsed().as_secs_f64();
         let w = solved.work;

@@ -3,6 +3,7 @@
 //! created in a deterministic order, four at a time, so element indices do
 //! not depend on threads.
 
+use crate::nodes::ClusterTree;
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
@@ -45,11 +46,13 @@ pub struct Hierarchy {
     pub reflectance: Vec<[f64; 3]>,
     /// Emitted radiosity of each input triangle, W/m².
     pub emission: Vec<[f64; 3]>,
+    /// The clusters above the input triangles, when solving with them.
+    pub clusters: Option<ClusterTree>,
 }
 
 impl Hierarchy {
-    /// One root element per input triangle.
-    pub fn new(mesh: &Mesh, manifest: &Manifest) -> Self {
+    /// One root element per input triangle, under `clusters` if given.
+    pub fn new(mesh: &Mesh, manifest: &Manifest, clusters: Option<schemas::cluster::Clusters>) -> Self {
         let triangles = radiometry::geometry::mesh_triangles(mesh);
         let elements = triangles
             .iter()
@@ -65,12 +68,10 @@ impl Hierarchy {
             })
             .collect();
         let material = |t: &schemas::mesh::Triangle| &manifest.materials[t.material as usize];
-        Hierarchy {
-            elements,
-            reflectance: mesh.triangles.iter().map(|t| material(t).diffuse).collect(),
-            emission: mesh.triangles.iter().map(|t| material(t).emission).collect(),
-            triangles,
-        }
+        let reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| material(t).diffuse).collect();
+        let areas: Vec<f64> = triangles.iter().map(|t| t.area).collect();
+        let clusters = clusters.map(|c| ClusterTree::new(c, &areas, &reflectance));
+        Hierarchy { elements, reflectance, emission: mesh.triangles.iter().map(|t| material(t).emission).collect(), triangles, clusters }
     }
 
     /// Unit front normal of element `e` (its triangle's).

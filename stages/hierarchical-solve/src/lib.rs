@@ -15,7 +15,8 @@
 //! |---|---|---|
 //! | `eps` | BF threshold, as a fraction of the largest emitted radiosity | 2e-4 |
 //! | `min_area` | smallest element area, as a fraction of the scene's total area | 1e-4 |
-//! | `visibility_rays` | rays per link for its visibility | 16 |
+//! | `visibility_rays` | rays per link between two elements | 16 |
+//! | `cluster_samples` | point pairs (and rays) per link with a cluster end | 16 |
 //! | `tolerance` | convergence: largest relative change of a leaf's radiosity | 1e-5 |
 //! | `max_iterations` | Jacobi iterations per solve, at most | 2000 |
 //! | `max_passes` | refine-and-solve passes, at most | 8 |
@@ -24,10 +25,14 @@
 pub mod elements;
 pub mod gather;
 pub mod links;
+pub mod nodes;
+pub mod transfer;
 pub mod visibility;
 
 use elements::Hierarchy;
-use links::{children_links, decide, link, Link, Split};
+use links::{children_links, decide, link, self_link, Link, Linking, Split};
+use schemas::cluster::Clusters;
+use schemas::solution::Node;
 use radiometry::rays::SceneRays;
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
@@ -43,8 +48,10 @@ pub struct Params {
     pub eps: f64,
     /// Smallest element area relative to the total area.
     pub min_area: f64,
-    /// Rays per link.
+    /// Rays per element-element link.
     pub visibility_rays: usize,
+    /// Point pairs per link with a cluster end.
+    pub cluster_samples: usize,
     /// Relative change at which gathering stops.
     pub tolerance: f64,
     /// Jacobi iterations per solve, at most.
@@ -57,7 +64,16 @@ pub struct Params {
 
 impl Default for Params {
     fn default() -> Self {
-        Params { eps: 2e-4, min_area: 1e-4, visibility_rays: 16, tolerance: 1e-5, max_iterations: 2000, max_passes: 8, seed: 1 }
+        Params {
+            eps: 2e-4,
+            min_area: 1e-4,
+            visibility_rays: 16,
+            cluster_samples: 16,
+            tolerance: 1e-5,
+            max_iterations: 2000,
+            max_passes: 8,
+            seed: 1,
+        }
     }
 }
 
@@ -73,6 +89,9 @@ impl Params {
         }
         if self.visibility_rays == 0 || self.visibility_rays > 4096 {
             return Some(format!("visibility_rays must be in 1..=4096, not {}", self.visibility_rays));
+        }
+        if self.cluster_samples == 0 || self.cluster_samples > 4096 {
+            return Some(format!("cluster_samples must be in 1..=4096, not {}", self.cluster_samples));
         }
         if !positive(self.tolerance) || self.max_iterations == 0 || self.max_passes == 0 {
             return Some("tolerance must be positive, max_iterations and max_passes at least 1".into());
@@ -93,6 +112,8 @@ pub struct Work {
     pub passes: usize,
     /// Links in the result.
     pub links: usize,
+    /// Of them, links with a cluster at an end.
+    pub cluster_links: usize,
     /// Elements in the result, and of them leaves.
     pub elements: usize,
     /// Leaf elements.
@@ -137,75 +158,98 @@ pub struct Solved {
     pub work: Work,
 }
 
-/// Solves the scene. `progress` is called after each pass.
-pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &dyn Fn(&Progress)) -> Result<Solved, String> {
+/// Solves the scene, with the cluster hierarchy `clusters` if given (then
+/// one self-link of the root cluster starts the refinement; without, every
+/// pair of input triangles). `progress` is called after each pass.
+pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, params: &Params, progress: &dyn Fn(&Progress)) -> Result<Solved, String> {
     if let Some(problem) = params.problem() {
         return Err(problem);
     }
     let n = mesh.triangles.len();
-    if n.saturating_mul(n) > MAX_INITIAL_PAIRS {
-        return Err(format!("{n} triangles need {} initial links without clustering; the limit is {MAX_INITIAL_PAIRS}", n * n));
+    let clustered = clusters.is_some();
+    if !clustered && n.saturating_mul(n) > MAX_INITIAL_PAIRS {
+        return Err(format!("{n} triangles need {} initial links without clustering (limit {MAX_INITIAL_PAIRS}); give a cluster hierarchy", n * n));
     }
-    let mut h = Hierarchy::new(mesh, manifest);
-    let total_area: f64 = h.elements.iter().map(|e| e.area).sum();
+    let mut h = Hierarchy::new(mesh, manifest, clusters);
+    let total_area: f64 = (0..n).map(|t| h.elements[t].area).sum();
     let min_area = params.min_area * total_area;
     let largest_emission = h.emission.iter().flatten().copied().fold(0.0, f64::max);
     let threshold = params.eps * largest_emission;
+    let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed };
     let scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
     let mut work = Work::default();
-    let mut b: Vec<[f64; 3]> = h.emission.clone();
+    let mut b: Vec<[f64; 3]> = vec![[0.0; 3]; h.cluster_count()];
+    b.extend(h.emission.iter().copied());
+    gather::pull(&h, &mut b);
 
     let started = Instant::now();
-    let mut all_links: Vec<Link> = (0..n as u32)
-        .into_par_iter()
-        .flat_map_iter(|r| {
-            let h = &h;
-            (0..n as u32).filter_map(move |s| link(h, r, s))
-        })
-        .collect();
-    work.form_factors += (n * n) as u64;
+    let mut all_links: Vec<Link> = if clustered {
+        vec![self_link(Node::Cluster(0))]
+    } else {
+        work.form_factors += (n * n) as u64;
+        (0..n as u32)
+            .into_par_iter()
+            .flat_map_iter(|r| {
+                let h = &h;
+                (0..n as u32).filter_map(move |s| link(h, Node::Element(r), Node::Element(s), linking))
+            })
+            .collect()
+    };
     work.refine_seconds += started.elapsed().as_secs_f64();
     // A scene without reflectors needs one pass: direct light only.
     let passes = if manifest.effects.diffuse_interreflection { params.max_passes } else { 1 };
-    let mut offsets = Vec::new();
     for pass in 1..=passes {
         let started = Instant::now();
         let mut refined_any = false;
-        loop {
-            let decisions: Vec<Split> = all_links.par_iter().map(|l| decide(&h, l, &b, threshold, min_area)).collect();
-            if decisions.iter().all(|d| *d == Split::Keep) {
-                break;
-            }
-            refined_any = true;
-            for (l, d) in all_links.iter().zip(&decisions) {
-                let split = match d {
-                    Split::Keep | Split::Larger => continue,
+        let mut active = std::mem::take(&mut all_links);
+        while !active.is_empty() {
+            let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, threshold, min_area)).collect();
+            for (l, d) in active.iter().zip(&decisions) {
+                let node = match d {
                     Split::Sender => l.sender,
                     Split::Receiver => l.receiver,
+                    _ => continue,
                 };
-                if h.elements[split as usize].is_leaf() {
-                    let first = h.subdivide(split) as usize;
-                    b.resize(first + 4, b[split as usize]);
+                let before = h.elements.len();
+                h.ensure_children(node);
+                if h.elements.len() > before {
+                    let parent_b = b[h.flat(node)];
+                    b.resize(b.len() + 4, parent_b);
                 }
             }
-            work.form_factors += decisions.iter().filter(|d| **d != Split::Keep).count() as u64 * 4;
-            all_links = all_links.par_iter().zip(&decisions).flat_map_iter(|(l, d)| children_links(&h, l, *d)).collect();
+            let split = decisions.iter().filter(|d| **d != Split::Keep).count();
+            refined_any |= decisions.iter().any(|d| matches!(d, Split::Sender | Split::Receiver));
+            all_links.extend(active.iter().zip(&decisions).filter(|(_, d)| **d == Split::Keep).map(|(l, _)| *l));
+            active = active
+                .par_iter()
+                .zip(&decisions)
+                .filter(|(_, d)| **d != Split::Keep)
+                .flat_map_iter(|(l, d)| children_links(&h, l, *d, linking))
+                .collect();
+            work.form_factors += active.len() as u64;
+            if split == 0 {
+                break;
+            }
         }
         work.refine_seconds += started.elapsed().as_secs_f64();
 
         let started = Instant::now();
-        let new_rays = all_links.iter().filter(|l| l.visibility.is_none()).count() as u64 * params.visibility_rays as u64;
-        all_links.par_iter_mut().filter(|l| l.visibility.is_none()).for_each(|l| {
-            let (v, d) = visibility::estimate(&h, &scene, l.receiver, l.sender, params.visibility_rays, params.seed);
-            l.visibility = Some(v);
-            l.occluder_distance = d;
-        });
-        work.rays += new_rays;
+        let rays: usize = all_links
+            .par_iter_mut()
+            .filter(|l| l.visibility.is_none())
+            .map(|l| {
+                let (v, d, cast) = visibility::of_link(&h, &scene, l, params.visibility_rays, linking);
+                l.visibility = Some(v);
+                l.occluder_distance = d;
+                cast
+            })
+            .sum();
+        work.rays += rays as u64;
         work.visibility_seconds += started.elapsed().as_secs_f64();
 
         let started = Instant::now();
-        all_links.par_sort_unstable_by_key(|l| (l.receiver, l.sender));
-        offsets = csr_offsets(&all_links, h.elements.len());
+        all_links.par_sort_unstable_by_key(|l| (h.flat(l.receiver), h.flat(l.sender)));
+        let offsets = csr_offsets(&h, &all_links, b.len());
         let convergence = gather::solve(&h, &all_links, &offsets, &mut b, params.tolerance, params.max_iterations);
         work.iterations += convergence.iterations;
         work.relative_change = convergence.relative_change;
@@ -216,22 +260,25 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &dyn F
             break;
         }
     }
-    debug_assert_eq!(offsets.len(), h.elements.len() + 1);
     work.links = all_links.len();
+    work.cluster_links = all_links.iter().filter(|l| matches!(l.receiver, Node::Cluster(_)) || matches!(l.sender, Node::Cluster(_))).count();
     work.elements = h.elements.len();
     work.leaves = h.elements.iter().filter(|e| e.is_leaf()).count();
-    Ok(Solved { elements: output_elements(&h, &b), clusters: Vec::new(), links: output_links(&all_links, &b), work })
+    let clusters_out = (0..h.cluster_count())
+        .map(|c| solution::ClusterRadiosity { area: h.area(Node::Cluster(c as u32)) as f32, radiosity: f32x3(b[c]) })
+        .collect();
+    Ok(Solved { elements: output_elements(&h, &b), clusters: clusters_out, links: output_links(&h, &all_links, &b), work })
 }
 
-/// `offsets[e]..offsets[e + 1]` indexes the links into element `e` of
-/// `links` (sorted by receiver).
-fn csr_offsets(links: &[Link], elements: usize) -> Vec<usize> {
-    let mut offsets = vec![0usize; elements + 1];
+/// `offsets[i]..offsets[i + 1]` indexes the links into the node of dense
+/// index `i` in `links` (sorted by receiver).
+fn csr_offsets(h: &Hierarchy, links: &[Link], nodes: usize) -> Vec<usize> {
+    let mut offsets = vec![0usize; nodes + 1];
     for l in links {
-        offsets[l.receiver as usize + 1] += 1;
+        offsets[h.flat(l.receiver) + 1] += 1;
     }
-    for e in 0..elements {
-        offsets[e + 1] += offsets[e];
+    for i in 0..nodes {
+        offsets[i + 1] += offsets[i];
     }
     offsets
 }
@@ -243,7 +290,7 @@ fn f32x3(v: [f64; 3]) -> [f32; 3] {
 fn output_elements(h: &Hierarchy, b: &[[f64; 3]]) -> Vec<solution::Element> {
     h.elements
         .iter()
-        .zip(b)
+        .zip(&b[h.cluster_count()..])
         .map(|(e, b)| solution::Element {
             triangle: e.triangle,
             parent: e.parent,
@@ -256,15 +303,15 @@ fn output_elements(h: &Hierarchy, b: &[[f64; 3]]) -> Vec<solution::Element> {
         .collect()
 }
 
-fn output_links(links: &[Link], b: &[[f64; 3]]) -> Vec<solution::Link> {
+fn output_links(h: &Hierarchy, links: &[Link], b: &[[f64; 3]]) -> Vec<solution::Link> {
     links
         .iter()
         .map(|l| solution::Link {
-            receiver: solution::Node::Element(l.receiver),
-            sender: solution::Node::Element(l.sender),
+            receiver: l.receiver,
+            sender: l.sender,
             form_factor: l.form_factor as f32,
             visibility: l.visibility.unwrap_or(1.0),
-            unoccluded_irradiance: f32x3(b[l.sender as usize].map(|x| x * l.form_factor)),
+            unoccluded_irradiance: f32x3(b[h.flat(l.sender)].map(|x| x * l.form_factor)),
             occluder_distance: l.occluder_distance,
         })
         .collect()

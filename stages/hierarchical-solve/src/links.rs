@@ -5,17 +5,23 @@
 //! children of one of the two.
 
 use crate::elements::Hierarchy;
+use crate::transfer;
+use glam::DVec3;
 use radiometry::form_factor::triangle_to_polygon;
+use schemas::solution::Node;
+use std::f64::consts::PI;
 
 /// A link: `receiver` gathers from `sender`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Link {
-    /// Receiving element.
-    pub receiver: u32,
-    /// Sending element.
-    pub sender: u32,
-    /// Unoccluded form factor F_rs: receiver-area mean of Lambert's
-    /// point-to-polygon factor to the sender (002 Eq. 3).
+    /// Receiving element or cluster.
+    pub receiver: Node,
+    /// Sending element or cluster.
+    pub sender: Node,
+    /// Unoccluded form factor F_rs: between elements, the receiver-area
+    /// mean of Lambert's point-to-polygon factor to the sender (002 Eq. 3);
+    /// with a cluster at either end, the Monte Carlo estimate of
+    /// [`transfer`].
     pub form_factor: f64,
     /// Largest minus smallest point factor over the receiver's quadrature
     /// points: how much the transport varies over the receiver.
@@ -38,13 +44,63 @@ pub enum Split {
     /// Split whichever of the two is larger (oracle's wish only; resolved
     /// to `Sender` or `Receiver` before any link is split).
     Larger,
+    /// A cluster's self-link: replace by links between all pairs of its
+    /// children (and their self-links).
+    Both,
 }
 
-/// The link from `sender` to `receiver`, or `None` where no light can pass:
-/// the sender lies wholly behind the receiver's plane or the receiver wholly
+/// How a solve links nodes: rays and samples for cluster links.
+#[derive(Clone, Copy, Debug)]
+pub struct Linking {
+    /// Point pairs per link with a cluster end.
+    pub cluster_samples: usize,
+    /// Seed of their random streams.
+    pub seed: u64,
+}
+
+/// The link `receiver <- sender`, or `None` where no light can pass.
+pub fn link(h: &Hierarchy, receiver: Node, sender: Node, linking: Linking) -> Option<Link> {
+    match (receiver, sender) {
+        (Node::Element(r), Node::Element(s)) => element_link(h, r, s),
+        _ => {
+            if behind(h, receiver, sender) || behind(h, sender, receiver) {
+                return None;
+            }
+            let e = transfer::estimate(h, None, receiver, sender, linking.cluster_samples, linking.seed);
+            Some(Link { receiver, sender, form_factor: e.form_factor, spread: e.spread, visibility: None, occluder_distance: f32::INFINITY })
+        }
+    }
+}
+
+/// A cluster's self-link: it carries no light itself and is always split.
+pub fn self_link(cluster: Node) -> Link {
+    Link { receiver: cluster, sender: cluster, form_factor: 0.0, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY }
+}
+
+/// Whether `other` lies wholly behind element `node`'s plane (its bounding
+/// box's corners all on the back side); false for a cluster `node`.
+fn behind(h: &Hierarchy, node: Node, other: Node) -> bool {
+    let Node::Element(e) = node else { return false };
+    let (origin, normal) = (h.elements[e as usize].points[0], h.normal(e));
+    let (lo, hi) = h.bounds(other);
+    let tolerance = 1e-9 * (hi - lo).length().max(h.elements[e as usize].area.sqrt());
+    (0..8).all(|i| {
+        let corner = DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
+        (corner - origin).dot(normal) <= tolerance
+    })
+}
+
+/// Distance between two axis-aligned boxes (0 where they overlap).
+fn box_distance(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> f64 {
+    let gap = (b.0 - a.1).max(a.0 - b.1).max(DVec3::ZERO);
+    gap.length()
+}
+
+/// The link between two elements, or `None` where no light can pass: the
+/// sender lies wholly behind the receiver's plane or the receiver wholly
 /// behind the sender's (both are one-sided), which includes coplanar
 /// elements and an element with itself.
-pub fn link(h: &Hierarchy, receiver: u32, sender: u32) -> Option<Link> {
+fn element_link(h: &Hierarchy, receiver: u32, sender: u32) -> Option<Link> {
     let (r, s) = (&h.elements[receiver as usize], &h.elements[sender as usize]);
     let (nr, ns) = (h.normal(receiver), h.normal(sender));
     // Heights above the other's plane, against a tolerance scaled to the
@@ -59,13 +115,56 @@ pub fn link(h: &Hierarchy, receiver: u32, sender: u32) -> Option<Link> {
     }
     let f = triangle_to_polygon(&r.points, nr, &s.points);
     (f.mean > 0.0).then_some(Link {
-        receiver,
-        sender,
+        receiver: Node::Element(receiver),
+        sender: Node::Element(sender),
         form_factor: f.mean,
         spread: f.max - f.min,
         visibility: None,
         occluder_distance: f32::INFINITY,
     })
+}
+
+/// The refinement oracle. A cluster's self-link always splits. A link with
+/// a cluster at an end uses the BF criterion with the conservative bound of
+/// Smits, Arvo and Greenberg (1994): no point of the sender can contribute a
+/// form factor larger than `A_s / (pi d_min^2)`, `d_min` the distance
+/// between the two bounding boxes, so the link may misplace at most
+/// `rho_r B_s A_s / (pi d_min^2)`; above `threshold` the larger node (by
+/// bounding box) is split, or the other where the larger cannot be.
+/// Between elements, see [`decide_elements`].
+pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64, min_area: f64) -> Split {
+    let (r, s) = (link.receiver, link.sender);
+    if r == s {
+        return Split::Both;
+    }
+    let wanted = match (r, s) {
+        (Node::Element(_), Node::Element(_)) => decide_elements(h, link, radiosity, threshold),
+        _ => {
+            let rho = h.node_reflectance(r);
+            let b = radiosity[h.flat(s)];
+            let reflected = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);
+            let distance = box_distance(h.bounds(r), h.bounds(s));
+            let bound = if distance > 0.0 { h.area(s) / (PI * distance * distance) } else { f64::INFINITY };
+            if reflected * bound <= threshold {
+                Split::Keep
+            } else {
+                Split::Larger
+            }
+        }
+    };
+    let (can_r, can_s) = (h.can_split(r, min_area), h.can_split(s, min_area));
+    let size = |n: Node| {
+        let (lo, hi) = h.bounds(n);
+        (hi - lo).length_squared()
+    };
+    let larger = if size(s) > size(r) { Split::Sender } else { Split::Receiver };
+    match (wanted, can_r, can_s) {
+        (Split::Receiver, true, _) | (Split::Sender, _, true) => wanted,
+        (Split::Larger, true, true) => larger,
+        (Split::Larger, true, false) => Split::Receiver,
+        (Split::Larger, false, true) => Split::Sender,
+        _ => Split::Keep,
+    }
 }
 
 /// The refinement oracle: HSA's BF criterion, with the "F" replaced by an
@@ -87,20 +186,23 @@ pub fn link(h: &Hierarchy, receiver: u32, sender: u32) -> Option<Link> {
 /// the sender, so that buys nothing, and it multiplies links whose small
 /// same-signed errors then add up on the receiver. The largest term above
 /// `threshold` decides which element is split, unless its children would be
-/// smaller than `min_area`: then a shadow edge splits the other element,
-/// and the other errors keep the link (splitting the other element would
-/// not reduce them).
-pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64, min_area: f64) -> Split {
-    let rho = h.reflectance_of(link.receiver);
-    let b = radiosity[link.sender as usize];
+/// smaller than `min_area` (see [`decide`]): then a shadow edge splits the
+/// other element, and the other errors keep the link (splitting the other
+/// element would not reduce them).
+fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64) -> Split {
+    let (Node::Element(receiver), Node::Element(sender)) = (link.receiver, link.sender) else {
+        unreachable!("an element link")
+    };
+    let rho = h.reflectance_of(receiver);
+    let b = radiosity[h.flat(link.sender)];
     let reflected = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);
-    let sender = &h.elements[link.sender as usize];
-    let sender_variation = if sender.is_leaf() {
+    let sender_element = &h.elements[sender as usize];
+    let sender_variation = if sender_element.is_leaf() {
         0.0
     } else {
-        (sender.first_child..sender.first_child + 4)
+        (sender_element.first_child..sender_element.first_child + 4)
             .flat_map(|child| (0..3).map(move |c| (child, c)))
-            .map(|(child, c)| rho[c] * (radiosity[child as usize][c] - b[c]).abs())
+            .map(|(child, c)| rho[c] * (radiosity[h.flat(Node::Element(child))][c] - b[c]).abs())
             .fold(0.0, f64::max)
     };
     let v = f64::from(link.visibility.unwrap_or(1.0));
@@ -111,31 +213,31 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64
     ];
     let (error, wanted) = errors.into_iter().fold((0.0, Split::Keep), |best, e| if e.0 > best.0 { e } else { best });
     if error <= threshold {
-        return Split::Keep;
-    }
-    let (ar, as_) = (h.elements[link.receiver as usize].area, sender.area);
-    let (can_r, can_s) = (ar / 4.0 >= min_area, as_ / 4.0 >= min_area);
-    let larger = if as_ > ar { Split::Sender } else { Split::Receiver };
-    match (wanted, can_r, can_s) {
-        (Split::Receiver, true, _) | (Split::Sender, _, true) => wanted,
-        (Split::Larger, true, true) => larger,
-        (Split::Larger, true, false) => Split::Receiver,
-        (Split::Larger, false, true) => Split::Sender,
-        _ => Split::Keep,
+        Split::Keep
+    } else {
+        wanted
     }
 }
 
 /// The links replacing `link` after `split` (children already exist).
-pub fn children_links(h: &Hierarchy, link: &Link, split: Split) -> Vec<Link> {
+pub fn children_links(h: &Hierarchy, link: &Link, split: Split, linking: Linking) -> Vec<Link> {
     match split {
         Split::Keep | Split::Larger => vec![*link],
-        Split::Sender => {
-            let first = h.elements[link.sender as usize].first_child;
-            (first..first + 4).filter_map(|s| self::link(h, link.receiver, s)).collect()
-        }
-        Split::Receiver => {
-            let first = h.elements[link.receiver as usize].first_child;
-            (first..first + 4).filter_map(|r| self::link(h, r, link.sender)).collect()
+        Split::Sender => h.children(link.sender).into_iter().filter_map(|s| self::link(h, link.receiver, s, linking)).collect(),
+        Split::Receiver => h.children(link.receiver).into_iter().filter_map(|r| self::link(h, r, link.sender, linking)).collect(),
+        Split::Both => {
+            let children = h.children(link.receiver);
+            let mut links = Vec::new();
+            for &r in &children {
+                for &s in &children {
+                    if r != s {
+                        links.extend(self::link(h, r, s, linking));
+                    } else if matches!(r, Node::Cluster(_)) {
+                        links.push(self_link(r));
+                    }
+                }
+            }
+            links
         }
     }
 }

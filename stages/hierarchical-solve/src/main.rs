@@ -2,6 +2,7 @@
 
 use clap::Parser;
 use hierarchical_solve::{solve, Params};
+use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::{Effects, Manifest, Mesh};
 use schemas::ron_io::read_ron;
@@ -26,6 +27,10 @@ struct Args {
     /// Input: manifest.ron from mesh-prep.
     #[arg(long, required_unless_present = "print_params")]
     manifest: Option<PathBuf>,
+    /// Input: clusters.exr from cluster; without it every pair of input
+    /// triangles starts linked (no clustering).
+    #[arg(long)]
+    clusters: Option<PathBuf>,
     /// Output: the solution (EXR tables of elements and links).
     #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
     output: Option<PathBuf>,
@@ -44,9 +49,12 @@ struct Args {
     /// Smallest element area, as a fraction of the scene's total area.
     #[arg(long)]
     min_area: Option<f64>,
-    /// Visibility rays per link.
+    /// Visibility rays per link between two elements.
     #[arg(long)]
     visibility_rays: Option<usize>,
+    /// Point pairs (and rays) per link with a cluster at an end.
+    #[arg(long)]
+    cluster_samples: Option<usize>,
     /// Stop gathering when no leaf changes by more than this fraction of the largest radiosity.
     #[arg(long)]
     tolerance: Option<f64>,
@@ -66,6 +74,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.eps = args.eps.unwrap_or(p.eps);
     p.min_area = args.min_area.unwrap_or(p.min_area);
     p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
+    p.cluster_samples = args.cluster_samples.unwrap_or(p.cluster_samples);
     p.tolerance = args.tolerance.unwrap_or(p.tolerance);
     p.max_iterations = args.max_iterations.unwrap_or(p.max_iterations);
     p.max_passes = args.max_passes.unwrap_or(p.max_passes);
@@ -92,7 +101,6 @@ fn skipped(effects: &Effects) -> Vec<String> {
     note(effects.textures, "textures: radiosity uses each material's mean diffuse reflectance");
     note(effects.alpha_masks, "alpha masks: surfaces are treated as opaque");
     note(effects.normal_maps, "normal maps: radiosity uses geometric normals");
-    note(effects.fine_clustered_geometry, "clustering: not available yet; every pair of input triangles starts linked");
     skipped
 }
 
@@ -114,8 +122,17 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     manifest.value.check_mesh(mesh_path, &mesh)?;
     run.input(mesh_input);
     run.input(manifest.input);
+    let clusters = match &args.clusters {
+        Some(path) => {
+            let (clusters, input) = Clusters::read(path, mesh.triangles.len())?;
+            run.input(input);
+            Some(clusters)
+        }
+        None => None,
+    };
+    let clustered = clusters.is_some();
     let bar = progress(params.max_passes as u64, "passes");
-    let solved = solve(&mesh, &manifest.value, &params, &|p| {
+    let solved = solve(&mesh, &manifest.value, clusters, &params, &|p| {
         bar.set_position(p.pass as u64);
         bar.set_message(format!("{} links", p.links));
     })
@@ -138,6 +155,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         let counters = BTreeMap::from([
             ("passes".to_string(), w.passes as f64),
             ("links".to_string(), w.links as f64),
+            ("cluster_links".to_string(), w.cluster_links as f64),
             ("elements".to_string(), w.elements as f64),
             ("leaves".to_string(), w.leaves as f64),
             ("form_factors".to_string(), w.form_factors as f64),
@@ -149,7 +167,11 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("gather_seconds".to_string(), w.gather_seconds),
             ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
         ]);
-        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.value.effects), vec![]))?;
+        let mut skipped = skipped(&manifest.value.effects);
+        if !clustered && manifest.value.effects.fine_clustered_geometry {
+            skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
+        }
+        outputs.write(report, |p| run.write_report(p, &params, counters, skipped, vec![]))?;
     }
     outputs.keep();
     Ok(ExitCode::SUCCESS)

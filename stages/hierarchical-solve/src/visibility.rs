@@ -4,8 +4,29 @@
 //! gather sizes penumbrae from it, paper 000 Section 5.3).
 
 use crate::elements::Hierarchy;
+use crate::links::{Link, Linking};
+use crate::transfer;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
+use schemas::solution::Node;
+
+/// Visible fraction and nearest occluder of `link`: rays between stratified
+/// points for two elements ([`estimate`], `rays` of them), the kernel-weighted
+/// pairs of [`transfer::estimate`] where a cluster is at an end. Returns the
+/// rays cast too.
+pub fn of_link(h: &Hierarchy, scene: &SceneRays, link: &Link, rays: usize, linking: Linking) -> (f32, f32, usize) {
+    match (link.receiver, link.sender) {
+        (Node::Element(r), Node::Element(s)) => {
+            let (v, d) = estimate(h, scene, r, s, rays, linking.seed);
+            (v, d, rays)
+        }
+        (r, s) => {
+            let e = transfer::estimate(h, Some(scene), r, s, linking.cluster_samples, linking.seed);
+            let (v, d) = e.visibility.unwrap_or((1.0, f32::INFINITY));
+            (v, d, linking.cluster_samples)
+        }
+    }
+}
 
 /// Clear fraction and nearest-occluder distance (+inf if no ray was
 /// blocked) of the link `receiver <- sender`, with `rays` rays. The random

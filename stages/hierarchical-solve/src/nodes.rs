@@ -1,0 +1,228 @@
+//! Nodes of the link hierarchy: elements (input triangles and their 1:4
+//! subdivisions) and, with clustering, the clusters above them. Links join
+//! two nodes; this module answers what links need to know of a node
+//! whatever its kind: area, bounds, reflectance, children, and random
+//! points on its surfaces.
+
+use crate::elements::Hierarchy;
+use glam::DVec3;
+use radiometry::sampling::{square_to_triangle, stratified_point, Stream};
+use schemas::cluster::Clusters;
+use schemas::solution::Node;
+
+/// The cluster hierarchy as the solver uses it: the artifact's nodes with
+/// f64 areas and mean reflectances recomputed from the triangles, the leaf
+/// cluster of each triangle, and prefix sums of triangle areas in cluster
+/// order for area-weighted sampling.
+pub struct ClusterTree {
+    /// The artifact.
+    pub clusters: Clusters,
+    /// Surface area below each cluster, m².
+    pub area: Vec<f64>,
+    /// Area-weighted mean reflectance below each cluster.
+    pub reflectance: Vec<[f64; 3]>,
+    /// Leaf cluster holding each triangle.
+    pub leaf_of_triangle: Vec<u32>,
+    /// `cumulative[i]`: area of the triangles `order[..i]`.
+    cumulative: Vec<f64>,
+}
+
+impl ClusterTree {
+    /// Prepares `clusters` over triangles with these areas and reflectances.
+    pub fn new(clusters: Clusters, triangle_area: &[f64], triangle_reflectance: &[[f64; 3]]) -> Self {
+        let mut cumulative = Vec::with_capacity(clusters.order.len() + 1);
+        cumulative.push(0.0);
+        let mut sum = 0.0;
+        for &t in &clusters.order {
+            sum += triangle_area[t as usize];
+            cumulative.push(sum);
+        }
+        let mut leaf_of_triangle = vec![0u32; triangle_area.len()];
+        let mut area = Vec::with_capacity(clusters.nodes.len());
+        let mut reflectance = Vec::with_capacity(clusters.nodes.len());
+        for (c, node) in clusters.nodes.iter().enumerate() {
+            let range = node.first_triangle as usize..(node.first_triangle + node.triangle_count) as usize;
+            let a = cumulative[range.end] - cumulative[range.start];
+            let mut rho = [0.0; 3];
+            for &t in &clusters.order[range.clone()] {
+                for k in 0..3 {
+                    rho[k] += triangle_reflectance[t as usize][k] * triangle_area[t as usize];
+                }
+                if node.is_leaf() {
+                    leaf_of_triangle[t as usize] = c as u32;
+                }
+            }
+            area.push(a);
+            reflectance.push(rho.map(|x| if a > 0.0 { x / a } else { 0.0 }));
+        }
+        ClusterTree { clusters, area, reflectance, leaf_of_triangle, cumulative }
+    }
+
+    /// Number of clusters.
+    pub fn len(&self) -> usize {
+        self.clusters.nodes.len()
+    }
+
+    /// Whether there is no cluster.
+    pub fn is_empty(&self) -> bool {
+        self.clusters.nodes.is_empty()
+    }
+
+    /// An input triangle below cluster `c`, drawn with probability
+    /// proportional to its area.
+    fn sample_triangle(&self, c: u32, stream: &mut Stream) -> u32 {
+        let node = &self.clusters.nodes[c as usize];
+        let (first, last) = (node.first_triangle as usize, (node.first_triangle + node.triangle_count) as usize);
+        let (lo, hi) = (self.cumulative[first], self.cumulative[last]);
+        let target = lo + stream.next_f64() * (hi - lo);
+        let k = self.cumulative[first + 1..last].partition_point(|&x| x <= target);
+        self.clusters.order[first + k]
+    }
+}
+
+/// A point on a node's surfaces with its front normal and input triangle.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    /// Position, mesh frame.
+    pub point: DVec3,
+    /// Unit front normal.
+    pub normal: DVec3,
+    /// Input triangle (rays skip it).
+    pub triangle: u32,
+}
+
+impl Hierarchy {
+    /// Dense index of a node: clusters first, then elements.
+    pub fn flat(&self, node: Node) -> usize {
+        match node {
+            Node::Cluster(c) => c as usize,
+            Node::Element(e) => self.cluster_count() + e as usize,
+        }
+    }
+
+    /// Number of clusters (0 without clustering).
+    pub fn cluster_count(&self) -> usize {
+        self.clusters.as_ref().map_or(0, ClusterTree::len)
+    }
+
+    /// Surface area of a node, m².
+    pub fn area(&self, node: Node) -> f64 {
+        match node {
+            Node::Element(e) => self.elements[e as usize].area,
+            Node::Cluster(c) => self.tree().area[c as usize],
+        }
+    }
+
+    /// Mean diffuse reflectance of a node's surfaces.
+    pub fn node_reflectance(&self, node: Node) -> [f64; 3] {
+        match node {
+            Node::Element(e) => self.reflectance_of(e),
+            Node::Cluster(c) => self.tree().reflectance[c as usize],
+        }
+    }
+
+    /// Axis-aligned bounds of a node.
+    pub fn bounds(&self, node: Node) -> (DVec3, DVec3) {
+        match node {
+            Node::Element(e) => {
+                let p = &self.elements[e as usize].points;
+                (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+            }
+            Node::Cluster(c) => {
+                let n = &self.tree().clusters.nodes[c as usize];
+                (DVec3::from(n.bounds_min.map(f64::from)), DVec3::from(n.bounds_max.map(f64::from)))
+            }
+        }
+    }
+
+    /// The cluster tree; only called on cluster nodes, which exist only
+    /// with one.
+    fn tree(&self) -> &ClusterTree {
+        self.clusters.as_ref().expect("cluster nodes exist only with a cluster tree")
+    }
+
+    /// Whether splitting `node` is allowed: clusters always split (into
+    /// clusters or triangles), elements down to `min_area`.
+    pub fn can_split(&self, node: Node, min_area: f64) -> bool {
+        match node {
+            Node::Cluster(_) => true,
+            Node::Element(e) => self.elements[e as usize].area / 4.0 >= min_area,
+        }
+    }
+
+    /// Makes sure `node`'s children exist (subdividing an element).
+    pub fn ensure_children(&mut self, node: Node) {
+        if let Node::Element(e) = node {
+            self.subdivide(e);
+        }
+    }
+
+    /// The children of a node whose children exist: child clusters, the
+    /// input triangles of a leaf cluster, or an element's four children.
+    pub fn children(&self, node: Node) -> Vec<Node> {
+        match node {
+            Node::Element(e) => {
+                let first = self.elements[e as usize].first_child;
+                (first..first + 4).map(Node::Element).collect()
+            }
+            Node::Cluster(c) => {
+                let tree = self.tree();
+                let n = &tree.clusters.nodes[c as usize];
+                if n.is_leaf() {
+                    let range = n.first_triangle as usize..(n.first_triangle + n.triangle_count) as usize;
+                    tree.clusters.order[range].iter().map(|&t| Node::Element(t)).collect()
+                } else {
+                    (n.first_child..n.first_child + n.child_count).map(Node::Cluster).collect()
+                }
+            }
+        }
+    }
+
+    /// The parent of a node in the whole hierarchy: an input triangle's is
+    /// its leaf cluster.
+    pub fn parent(&self, node: Node) -> Option<Node> {
+        match node {
+            Node::Element(e) => {
+                let element = &self.elements[e as usize];
+                if element.parent != schemas::solution::NONE {
+                    Some(Node::Element(element.parent))
+                } else {
+                    self.clusters.as_ref().map(|t| Node::Cluster(t.leaf_of_triangle[element.triangle as usize]))
+                }
+            }
+            Node::Cluster(c) => {
+                let parent = self.tree().clusters.nodes[c as usize].parent;
+                (parent != schemas::solution::NONE).then_some(Node::Cluster(parent))
+            }
+        }
+    }
+
+    /// The `k`-th of `n` random points on a node: stratified on an element,
+    /// area-weighted over the triangles of a cluster.
+    pub fn sample(&self, node: Node, k: usize, n: usize, stream: &mut Stream) -> SurfacePoint {
+        match node {
+            Node::Element(e) => {
+                let element = &self.elements[e as usize];
+                SurfacePoint {
+                    point: stratified_point(&element.points, k, n, stream),
+                    normal: self.triangles[element.triangle as usize].normal,
+                    triangle: element.triangle,
+                }
+            }
+            Node::Cluster(c) => {
+                let t = self.tree().sample_triangle(c, stream);
+                let g = &self.triangles[t as usize];
+                let b = square_to_triangle(stream.next_f64(), stream.next_f64());
+                SurfacePoint { point: g.corners[0] * b[0] + g.corners[1] * b[1] + g.corners[2] * b[2], normal: g.normal, triangle: t }
+            }
+        }
+    }
+}
+
+/// A 64-bit key of a node, for seeding random streams.
+pub fn key(node: Node) -> u64 {
+    match node {
+        Node::Element(e) => u64::from(e) << 1,
+        Node::Cluster(c) => (u64::from(c) << 1) | 1,
+    }
+}
