@@ -7,11 +7,15 @@
 //!   radiosity is interpolated from the solution's leaf elements (Gouraud
 //!   over vertex radiosity, see [`gouraud`]) and turned into radiance
 //!   `L = B / pi`. Cheap, continuous, but only as sharp as the elements.
-//! - **full** (a later issue): the final gather of paper 000 Sec. 4
-//!   (perspective grid over the view frustum, sender
-//!   classification per grid vertex, resampling of critical senders,
-//!   interpolation of the rest), steered by a threshold-elevation image.
-//!   Asking for it is an error for now.
+//! - **full**: the final gather of paper 000 Sec. 4-5 (perspective grid
+//!   over the view frustum, sender classification per grid vertex,
+//!   resampling of critical senders, interpolation of the rest, the
+//!   surface-based gather where the solution is finer than the grid,
+//!   view-dependent shadow samples), optionally steered by the mask
+//!   stage's threshold image. See [`full`].
+//! - **brute**: the classic final gather it is measured against: every
+//!   link of the hit point's element chain resampled at every camera
+//!   sample ([`full::brute_irradiance`]).
 //!
 //! ## Parameters
 //!
@@ -24,12 +28,28 @@
 //! | `crease_angle_deg` | degrees | leaves whose normals differ more do not blend at a shared corner | 30 |
 //! | `weld_tolerance` | fraction of the bounding-box diagonal | corners closer than this are one point | 1e-7 |
 //! | `material_seams` | bool | leaves of different materials do not blend at a shared corner | true |
+//! | `grid` | `"perspective"` / `"regular"` | full: grid uniform in post-perspective space, or cubes | `"perspective"` |
+//! | `grid_pixels` | pixels | full: grid spacing on screen | 16 |
+//! | `grid_depth` | count | full: cells along the view axis (perspective) | 16 |
+//! | `samples` | count | full: N of Eq. 1, classification samples shared by a vertex's senders | 128 |
+//! | `min_samples` | count | full: fewest samples per sender (classification and shadows) | 4 |
+//! | `max_shadow_samples` | count | full: most visibility samples per resampled sender | 128 |
+//! | `contrast` | fraction | full: smallest visible contrast where no mask is given; a sender is resampled when its error exceeds `contrast x` the vertex's radiosity | 0.02 |
+//! | `allowed_hits` | 1 or 2 | full: hits a classification ray may cross unblocked (1: double-sided sheets, 2: single-sided solids; Fig. 2) | 1 |
+//! | `interior_rays` | count | full: rays from a vertex inside a sender cluster | 100 |
+//! | `surface_gather` | bool | full: surface-based gather where leaves are finer than the grid (Sec. 4.5) | true |
+//! | `view_dependent` | bool | full: shadow samples bounded by penumbra size and contrast (Sec. 5.3) | true |
+//! | `brute_samples` | count | brute: visibility rays per link per camera sample | 64 |
 //!
 //! Same inputs and parameters give bit-identical images, whatever the
 //! number of threads.
 
+pub mod final_gather;
+pub mod full;
 pub mod gouraud;
+pub mod grid;
 pub mod render;
+pub mod senders;
 
 use gouraud::{Gouraud, Smoothing};
 use radiometry::camera::Pinhole;
@@ -44,9 +64,6 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// The message for `--mode full` until the full gather exists.
-pub const FULL_NOT_IMPLEMENTED: &str = "full gather not implemented yet (preview only)";
-
 /// Which gather to run. Written as the strings `"preview"` / `"full"` (the
 /// CLI's values), so that the parameters recorded in provenance, which go
 /// through `ron::Value` and would drop a unit variant's name, keep it.
@@ -56,8 +73,10 @@ pub enum Mode {
     /// Interpolate the solution's radiosity (Gouraud over element corners).
     #[default]
     Preview,
-    /// Final gather with sender classification (not implemented yet).
+    /// Final gather with sender classification (paper 000).
     Full,
+    /// Classic final gather: every link resampled at every camera sample.
+    Brute,
 }
 
 impl From<Mode> for String {
@@ -65,6 +84,7 @@ impl From<Mode> for String {
         match mode {
             Mode::Preview => "preview".into(),
             Mode::Full => "full".into(),
+            Mode::Brute => "brute".into(),
         }
     }
 }
@@ -76,7 +96,41 @@ impl TryFrom<String> for Mode {
         match name.as_str() {
             "preview" => Ok(Mode::Preview),
             "full" => Ok(Mode::Full),
-            _ => Err(format!("unknown mode {name:?}, expected \"preview\" or \"full\"")),
+            "brute" => Ok(Mode::Brute),
+            _ => Err(format!("unknown mode {name:?}, expected \"preview\", \"full\" or \"brute\"")),
+        }
+    }
+}
+
+/// The full gather's grid (000 Sec. 4.2). Written as strings, like
+/// [`Mode`].
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[serde(into = "String", try_from = "String")]
+pub enum GridKind {
+    /// Uniform in post-perspective space: constant spacing on screen.
+    #[default]
+    Perspective,
+    /// Cubes over the scene's bounding box.
+    Regular,
+}
+
+impl From<GridKind> for String {
+    fn from(kind: GridKind) -> String {
+        match kind {
+            GridKind::Perspective => "perspective".into(),
+            GridKind::Regular => "regular".into(),
+        }
+    }
+}
+
+impl TryFrom<String> for GridKind {
+    type Error = String;
+
+    fn try_from(name: String) -> std::result::Result<Self, String> {
+        match name.as_str() {
+            "perspective" => Ok(GridKind::Perspective),
+            "regular" => Ok(GridKind::Regular),
+            _ => Err(format!("unknown grid {name:?}, expected \"perspective\" or \"regular\"")),
         }
     }
 }
@@ -104,11 +158,60 @@ pub struct Params {
     /// Leaves of different materials do not blend at a shared corner (B
     /// jumps where emission or reflectance does, even on a flat surface).
     pub material_seams: bool,
+    /// Full: the grid's kind.
+    pub grid: GridKind,
+    /// Full: grid spacing on screen, pixels, at least 1.
+    pub grid_pixels: u32,
+    /// Full: cells along the view axis (perspective grid), at least 1.
+    pub grid_depth: u32,
+    /// Full: N of 000 Eq. 1, the classification samples a vertex shares
+    /// among its senders in proportion to their unoccluded irradiance.
+    pub samples: u32,
+    /// Full: fewest samples per sender, at least 1.
+    pub min_samples: u32,
+    /// Full: most visibility samples per resampled sender.
+    pub max_shadow_samples: u32,
+    /// Full: smallest visible contrast (a Weber fraction) where no mask
+    /// threshold is given, in (0, 1].
+    pub contrast: f64,
+    /// Full: surfaces a classification ray may cross and still count as
+    /// unblocked: 1 for double-sided sheets, 2 for single-sided solids
+    /// (000 Fig. 2).
+    pub allowed_hits: u32,
+    /// Full: rays from a vertex inside a sender cluster (000 Sec. 4.3).
+    pub interior_rays: u32,
+    /// Full: surface-based gather where leaves are finer than the grid.
+    pub surface_gather: bool,
+    /// Full: view-dependent shadow sample counts (000 Sec. 5.3).
+    pub view_dependent: bool,
+    /// Brute: visibility rays per link per camera sample, at least 1.
+    pub brute_samples: u32,
 }
 
 impl Default for Params {
     fn default() -> Self {
-        Params { mode: Mode::Preview, width: None, height: None, spp: 4, seed: 0, crease_angle_deg: 30.0, weld_tolerance: 1e-7, material_seams: true }
+        Params {
+            mode: Mode::Preview,
+            width: None,
+            height: None,
+            spp: 4,
+            seed: 0,
+            crease_angle_deg: 30.0,
+            weld_tolerance: 1e-7,
+            material_seams: true,
+            grid: GridKind::Perspective,
+            grid_pixels: 16,
+            grid_depth: 16,
+            samples: 128,
+            min_samples: 4,
+            max_shadow_samples: 128,
+            contrast: 0.02,
+            allowed_hits: 1,
+            interior_rays: 100,
+            surface_gather: true,
+            view_dependent: true,
+            brute_samples: 64,
+        }
     }
 }
 
@@ -127,8 +230,30 @@ impl Params {
         if !(self.weld_tolerance > 0.0 && self.weld_tolerance <= 1e-3) {
             return Err(bad_parameter(format!("weld_tolerance must be in (0, 1e-3], got {}", self.weld_tolerance)));
         }
+        if self.grid_pixels == 0 || self.grid_depth == 0 || self.grid_depth > 4096 {
+            return Err(bad_parameter("grid_pixels must be at least 1 and grid_depth in 1..=4096"));
+        }
+        if self.min_samples == 0 || self.brute_samples == 0 || self.max_shadow_samples < self.min_samples {
+            return Err(bad_parameter("min_samples and brute_samples must be at least 1, max_shadow_samples at least min_samples"));
+        }
+        if !(self.contrast > 0.0 && self.contrast <= 1.0) {
+            return Err(bad_parameter(format!("contrast must be in (0, 1], got {}", self.contrast)));
+        }
+        if !(1..=2).contains(&self.allowed_hits) {
+            return Err(bad_parameter(format!("allowed_hits must be 1 or 2, got {}", self.allowed_hits)));
+        }
         Ok(())
     }
+}
+
+/// What the full gather reads besides the scene: the cluster hierarchy of
+/// a clustered solution, and the mask's threshold image.
+#[derive(Clone, Copy, Default)]
+pub struct Extras<'a> {
+    /// The cluster hierarchy the solution was solved with.
+    pub clusters: Option<&'a schemas::cluster::Clusters>,
+    /// The mask stage's contrast threshold per pixel.
+    pub threshold: Option<&'a final_gather::ContrastImage>,
 }
 
 /// The inputs of a gather. The paths only name the files in error
@@ -172,10 +297,13 @@ pub fn image_size(params: &Params, manifest: &Manifest) -> (u32, u32) {
 /// of image rows finished (from worker threads), for a progress display;
 /// the image has [`image_size`]`.1` rows.
 pub fn gather(params: &Params, scene: &Scene, rows_done: &(dyn Fn(u64) + Sync)) -> Result<Rendered> {
+    gather_with(params, scene, Extras::default(), rows_done).map(|(r, _)| r)
+}
+
+/// [`gather`] with the full gather's extra inputs; also returns the full
+/// and brute gathers' diagnostics.
+pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(dyn Fn(u64) + Sync)) -> Result<(Rendered, Option<final_gather::Diagnostics>)> {
     params.validate()?;
-    if params.mode == Mode::Full {
-        return Err(bad_parameter(FULL_NOT_IMPLEMENTED));
-    }
     let (width, height) = image_size(params, scene.manifest);
     let camera = Pinhole::new(&scene.manifest.camera, width, height).ok_or_else(|| {
         Error::invalid(
@@ -185,6 +313,9 @@ pub fn gather(params: &Params, scene: &Scene, rows_done: &(dyn Fn(u64) + Sync)) 
         )
     })?;
     let triangles = mesh_triangles(scene.mesh);
+    if params.mode != Mode::Preview {
+        return full_gather(params, scene, extras, &camera, &triangles, (width, height), rows_done).map(|(r, d)| (r, Some(d)));
+    }
     let smoothing = Smoothing {
         crease_angle_deg: params.crease_angle_deg,
         weld_tolerance: params.weld_tolerance,
@@ -208,14 +339,66 @@ pub fn gather(params: &Params, scene: &Scene, rows_done: &(dyn Fn(u64) + Sync)) 
         ("leaf_elements".to_string(), shading.leaves() as f64),
         ("vertices".to_string(), shading.vertices() as f64),
     ]);
-    Ok(Rendered {
-        width: width as usize,
-        height: height as usize,
-        rgb: film.rgb,
-        coverage: film.coverage,
-        counters,
-        skipped: skipped_in_preview(scene.manifest),
-    })
+    Ok((
+        Rendered {
+            width: width as usize,
+            height: height as usize,
+            rgb: film.rgb,
+            coverage: film.coverage,
+            counters,
+            skipped: skipped_in_preview(scene.manifest),
+        },
+        None,
+    ))
+}
+
+/// The full or brute-force gather.
+fn full_gather(
+    params: &Params,
+    scene: &Scene,
+    extras: Extras,
+    camera: &Pinhole,
+    triangles: &[radiometry::geometry::TriangleGeometry],
+    (width, height): (u32, u32),
+    rows_done: &(dyn Fn(u64) + Sync),
+) -> Result<(Rendered, final_gather::Diagnostics)> {
+    // The same structural checks as the preview's, with the same message.
+    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
+    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams };
+    Gouraud::new(triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
+    if let Some(c) = extras.clusters {
+        if c.nodes.len() != scene.solution.clusters.len() && !scene.solution.clusters.is_empty() {
+            return Err(Error::invalid(scene.solution_path, None, format!("solution has {} clusters, the hierarchy {}", scene.solution.clusters.len(), c.nodes.len())));
+        }
+    } else if scene.solution.links.iter().any(|l| matches!(l.receiver, schemas::solution::Node::Cluster(_)) || matches!(l.sender, schemas::solution::Node::Cluster(_))) {
+        return Err(Error::invalid(scene.solution_path, None, "solution has links between clusters: pass the hierarchy with --clusters"));
+    }
+    let surfaces: Vec<full::Surface> = scene
+        .mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let m = scene.manifest.materials.get(t.material as usize);
+            full::Surface { reflectance: m.map_or([0.0; 3], |m| m.diffuse), emission: m.map_or([0.0; 3], |m| m.emission) }
+        })
+        .collect();
+    if triangles.is_empty() {
+        let n = width as usize * height as usize;
+        let rendered = Rendered { width: width as usize, height: height as usize, rgb: vec![[0.0; 3]; n], coverage: vec![0.0; n], counters: BTreeMap::new(), skipped: Vec::new() };
+        return Ok((rendered, final_gather::Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
+    }
+    let full_scene = final_gather::FullScene { triangles, surfaces: &surfaces, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera };
+    let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
+    let mut counters = image.counters;
+    counters.insert("triangles".into(), triangles.len() as f64);
+    counters.insert("elements".into(), scene.solution.elements.len() as f64);
+    counters.insert("links".into(), scene.solution.links.len() as f64);
+    let mut skipped = skipped_in_preview(scene.manifest);
+    skipped.remove(0);
+    Ok((
+        Rendered { width: width as usize, height: height as usize, rgb: image.rgb, coverage: image.coverage, counters, skipped },
+        image.diagnostics,
+    ))
 }
 
 /// What preview mode leaves out, and why, given the scene's effects.

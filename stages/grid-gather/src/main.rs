@@ -2,18 +2,90 @@
 //! mode: Gouraud interpolation of element radiosity). See the library docs.
 
 use clap::Parser;
-use grid_gather::{gather, image_size, Mode, Params, Scene, FULL_NOT_IMPLEMENTED};
-use schemas::header::Schema;
+use grid_gather::final_gather::{ContrastImage, Diagnostics, CLASS_NAMES_PIXEL};
+use grid_gather::{gather_with, image_size, Extras, GridKind, Mode, Params, Scene};
+use schemas::cluster::Clusters;
+use schemas::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer, LayerKind};
+use schemas::header::{Header, Schema};
 use schemas::image::HdrImage;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, exit_code, load_params, print_params, progress, Run};
-use schemas::Result;
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, Outputs, Run};
+use schemas::{Error, Result};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 const STAGE: &str = "grid-gather";
+
+/// The mask stage's `threshold` artifact, as this stage reads it (the
+/// contract's writer is `mask::ThresholdImage`; both declare this name and
+/// version until the contract moves into `schemas`).
+struct ThresholdImage;
+
+impl Schema for ThresholdImage {
+    const NAME: &'static str = "threshold";
+    const VERSION: u32 = 1;
+}
+
+/// The diagnostics artifact of a full or brute-force gather: image layer
+/// `pixel` (work and classes per camera sample), table layer `vertex`
+/// (class counts per built grid vertex).
+struct GatherDiagnostics;
+
+impl Schema for GatherDiagnostics {
+    const NAME: &'static str = "gather-diagnostics";
+    const VERSION: u32 = 1;
+}
+
+fn read_threshold(path: &std::path::Path) -> Result<(ContrastImage, schemas::header::Input)> {
+    let (artifact, input) = read_exr::<ThresholdImage>(path)?;
+    let layer = artifact.layer(path, "")?;
+    let LayerKind::Image { width, height } = layer.kind else {
+        return Err(Error::invalid(path, None, "threshold layer is a table"));
+    };
+    let contrast = layer.f32s(path, "contrast")?.to_vec();
+    if width == 0 || height == 0 {
+        return Err(Error::invalid(path, None, "threshold image is empty"));
+    }
+    Ok((ContrastImage { width, height, contrast }, input))
+}
+
+fn write_diagnostics(path: &std::path::Path, header: Header, d: &Diagnostics) -> Result<()> {
+    let mut pixel = vec![
+        Channel::f32("visibility_rays", "visibility rays per camera sample", d.visibility_rays.clone()),
+        Channel::f32("form_factors", "form-factor evaluations per camera sample", d.form_factors.clone()),
+        Channel::f32("surface", "fraction of camera samples shaded by the surface-based gather", d.surface.clone()),
+    ];
+    for (k, name) in CLASS_NAMES_PIXEL.iter().enumerate() {
+        pixel.push(Channel::f32(name, "senders per camera sample in this class (000 Sec. 4.3)", d.classes[k].clone()));
+    }
+    let v = &d.vertices;
+    let u = |f: &dyn Fn(&grid_gather::final_gather::VertexRecord) -> u32| v.iter().map(f).collect::<Vec<u32>>();
+    let f = |f: &dyn Fn(&grid_gather::final_gather::VertexRecord) -> f32| v.iter().map(f).collect::<Vec<f32>>();
+    let vertex = Layer::table(
+        "vertex",
+        v.len(),
+        vec![
+            Channel::u32("i", "grid vertex x index", u(&|r| r.ijk[0])),
+            Channel::u32("j", "grid vertex y index (down the image)", u(&|r| r.ijk[1])),
+            Channel::u32("k", "grid vertex depth index", u(&|r| r.ijk[2])),
+            Channel::f32("P.X", "position, mesh frame, m", f(&|r| r.position[0])),
+            Channel::f32("P.Y", "position, mesh frame, m", f(&|r| r.position[1])),
+            Channel::f32("P.Z", "position, mesh frame, m", f(&|r| r.position[2])),
+            Channel::u32("rv_rf", "senders: resample visibility, resample form factor", u(&|r| r.classes[0])),
+            Channel::u32("rv_if", "senders: resample visibility, interpolate form factor", u(&|r| r.classes[1])),
+            Channel::u32("iv_rf", "senders: interpolate visibility, resample form factor", u(&|r| r.classes[2])),
+            Channel::u32("iv_if", "senders: interpolate visibility, interpolate form factor", u(&|r| r.classes[3])),
+            Channel::u32("skipped", "senders skipped: fully occluded by every link", u(&|r| r.skipped)),
+            Channel::f32("contrast", "contrast threshold (mask average or parameter)", f(&|r| r.contrast)),
+            Channel::u32("rays", "visibility rays cast to classify", u(&|r| r.rays)),
+            Channel::u32("factors", "form-factor evaluations to classify", u(&|r| r.factors)),
+        ],
+    );
+    let image = Layer { name: "pixel".into(), kind: LayerKind::Image { width: d.width, height: d.height }, channels: pixel };
+    write_exr(path, &ExrArtifact { header, layers: vec![image, vertex] })
+}
 
 /// Render the radiosity solution through the manifest camera to a linear HDR
 /// image (R, G, B radiance in W/(m^2 sr), A coverage).
@@ -32,13 +104,61 @@ struct Args {
     /// Output image.
     #[arg(short = 'o', long = "output", value_name = "IMAGE.exr", required_unless_present = "print_params")]
     output: Option<PathBuf>,
-    /// Gather mode: preview interpolates the solution; full (not implemented
-    /// yet) resamples critical senders.
+    /// Gather mode: preview interpolates the solution; full classifies and
+    /// resamples critical senders (paper 000); brute resamples every link.
     #[arg(long, value_enum)]
     mode: Option<Mode>,
-    /// Threshold-elevation image steering the full gather (full mode only).
-    #[arg(long, value_name = "IMAGE.exr")]
+    /// The classic brute-force final gather (same as --mode brute).
+    #[arg(long)]
+    brute: bool,
+    /// Threshold image from the mask stage steering the full gather.
+    #[arg(long, value_name = "THRESHOLD.exr")]
     threshold: Option<PathBuf>,
+    /// Cluster hierarchy (clusters.exr) of a clustered solution.
+    #[arg(long, value_name = "CLUSTERS.exr")]
+    clusters: Option<PathBuf>,
+    /// Per-pixel samples and classes, per-vertex class counts (full, brute).
+    #[arg(long, value_name = "DIAGNOSTICS.exr")]
+    diagnostics: Option<PathBuf>,
+    /// Full: grid kind [default: perspective].
+    #[arg(long, value_enum)]
+    grid: Option<GridKind>,
+    /// Full: grid spacing on screen, pixels [default: 16].
+    #[arg(long, value_name = "PIXELS")]
+    grid_pixels: Option<u32>,
+    /// Full: cells along the view axis [default: 16].
+    #[arg(long, value_name = "N")]
+    grid_depth: Option<u32>,
+    /// Full: N of Eq. 1, classification samples per vertex [default: 128].
+    #[arg(long, value_name = "N")]
+    samples: Option<u32>,
+    /// Full: fewest samples per sender [default: 4].
+    #[arg(long, value_name = "N")]
+    min_samples: Option<u32>,
+    /// Full: most shadow samples per resampled sender [default: 128].
+    #[arg(long, value_name = "N")]
+    max_shadow_samples: Option<u32>,
+    /// Full: smallest visible contrast without a mask [default: 0.02].
+    #[arg(long, value_name = "FRACTION")]
+    contrast: Option<f64>,
+    /// Full: surfaces a classification ray may cross unblocked, 1 or 2 [default: 1].
+    #[arg(long, value_name = "N")]
+    allowed_hits: Option<u32>,
+    /// Full: surface-based gather where leaves are finer than the grid [default: on].
+    #[arg(long, overrides_with = "no_surface_gather")]
+    surface_gather: bool,
+    /// Full: grid gather everywhere.
+    #[arg(long, overrides_with = "surface_gather")]
+    no_surface_gather: bool,
+    /// Full: view-dependent shadow samples [default: on].
+    #[arg(long, overrides_with = "no_view_dependent")]
+    view_dependent: bool,
+    /// Full: shadow samples from Eq. 1 only.
+    #[arg(long, overrides_with = "view_dependent")]
+    no_view_dependent: bool,
+    /// Brute: visibility rays per link per camera sample [default: 64].
+    #[arg(long, value_name = "N")]
+    brute_samples: Option<u32>,
     /// Image width in pixels [default: the manifest camera's].
     #[arg(long, value_name = "W")]
     width: Option<u32>,
@@ -109,6 +229,28 @@ impl Args {
         if self.no_material_seams {
             p.material_seams = false;
         }
+        if self.brute {
+            p.mode = Mode::Brute;
+        }
+        if let Some(g) = self.grid {
+            p.grid = g;
+        }
+        macro_rules! set {
+            ($($f:ident),*) => { $(if let Some(v) = self.$f { p.$f = v; })* };
+        }
+        set!(grid_pixels, grid_depth, samples, min_samples, max_shadow_samples, contrast, allowed_hits, brute_samples);
+        if self.surface_gather {
+            p.surface_gather = true;
+        }
+        if self.no_surface_gather {
+            p.surface_gather = false;
+        }
+        if self.view_dependent {
+            p.view_dependent = true;
+        }
+        if self.no_view_dependent {
+            p.view_dependent = false;
+        }
         p.validate()?;
         Ok(p)
     }
@@ -120,11 +262,11 @@ fn run(args: &Args) -> Result<ExitCode> {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
-    if params.mode == Mode::Full {
-        return Err(bad_parameter(FULL_NOT_IMPLEMENTED));
-    }
-    if args.threshold.is_some() {
+    if args.threshold.is_some() && params.mode != Mode::Full {
         return Err(bad_parameter("--threshold is read only by --mode full"));
+    }
+    if args.diagnostics.is_some() && params.mode == Mode::Preview {
+        return Err(bad_parameter("--diagnostics is written only by --mode full and brute"));
     }
     // clap requires these unless --print-params.
     let (Some(mesh_path), Some(manifest_path), Some(solution_path), Some(output)) =
@@ -133,6 +275,10 @@ fn run(args: &Args) -> Result<ExitCode> {
         return Err(bad_parameter("--mesh, --manifest, --solution and -o are required"));
     };
 
+    check_writable(output)?;
+    if let Some(d) = &args.diagnostics {
+        check_writable(d)?;
+    }
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
     let (mesh, input) = Mesh::read(mesh_path)?;
     run.input(input);
@@ -143,23 +289,46 @@ fn run(args: &Args) -> Result<ExitCode> {
     let (solution, input) = Solution::read(solution_path)?;
     run.input(input);
 
-    let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path, solution: &solution, solution_path };
-    let bar = progress(image_size(&params, &manifest).1.into(), "rows");
-    let rendered = gather(&params, &scene, &|rows| bar.inc(rows));
-    bar.finish_and_clear();
-    let rendered = rendered?;
+    let clusters = match &args.clusters {
+        Some(path) => {
+            let (c, input) = Clusters::read(path, mesh.triangles.len())?;
+            run.input(input);
+            Some(c)
+        }
+        None => None,
+    };
+    let threshold = match &args.threshold {
+        Some(path) => {
+            let (t, input) = read_threshold(path)?;
+            run.input(input);
+            Some(t)
+        }
+        None => None,
+    };
 
-    HdrImage {
+    let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path, solution: &solution, solution_path };
+    let extras = Extras { clusters: clusters.as_ref(), threshold: threshold.as_ref() };
+    let bar = progress(image_size(&params, &manifest).1.into(), "rows");
+    let rendered = gather_with(&params, &scene, extras, &|rows| bar.inc(rows));
+    bar.finish_and_clear();
+    let (rendered, diagnostics) = rendered?;
+
+    let mut outputs = Outputs::new();
+    let image = HdrImage {
         header: HdrImage::header(run.provenance(&params)),
         width: rendered.width,
         height: rendered.height,
         rgb: rendered.rgb,
         coverage: rendered.coverage,
+    };
+    outputs.write(output, |p| image.write(p))?;
+    if let (Some(path), Some(d)) = (&args.diagnostics, &diagnostics) {
+        outputs.write(path, |p| write_diagnostics(p, GatherDiagnostics::header(run.provenance(&params)), d))?;
     }
-    .write(output)?;
     if let Some(report) = &args.report {
-        run.write_report(report, &params, rendered.counters, rendered.skipped, Vec::new())?;
+        outputs.write(report, |p| run.write_report(p, &params, rendered.counters, rendered.skipped, Vec::new()))?;
     }
+    outputs.keep();
     Ok(ExitCode::SUCCESS)
 }
 

@@ -334,16 +334,6 @@ fn a_solution_of_another_mesh_is_refused_naming_the_file() {
 }
 
 #[test]
-fn full_mode_is_refused_until_it_exists() {
-    let mesh = mesh(&square());
-    let m = front_camera();
-    let sol = solution(2, 0, |_, _| 1.0);
-    let scene = Scene { mesh: &mesh, manifest: &m, manifest_path: Path::new("m.ron"), solution: &sol, solution_path: Path::new("s.exr") };
-    let err = gather(&Params { mode: Mode::Full, ..Params::default() }, &scene, &|_| {}).unwrap_err();
-    assert!(err.to_string().contains("full gather not implemented yet (preview only)"));
-}
-
-#[test]
 fn params_round_trip_through_ron_and_refuse_typos() {
     let p = Params { width: Some(320), spp: 16, ..Params::default() };
     let text = schemas::ron_io::to_ron_text(&p);
@@ -356,3 +346,5 @@ fn params_round_trip_through_ron_and_refuse_typos() {
     let value: ron::Value = ron::from_str(&text).unwrap();
     assert_eq!(value.into_rust::<Params>().unwrap(), p);
 }
+
+mod full;

@@ -119,7 +119,8 @@ fn errors_are_one_line_naming_the_file_and_leave_no_output() {
     write_scene(&dir, 2);
     let out = gather(&dir, &["--mode", "full", "--threshold", "t.exr"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("full gather not implemented yet (preview only)"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("t.exr") && stderr.lines().count() == 1, "{stderr}");
     let out = gather(&dir, &["--threshold", "t.exr"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--threshold"));

@@ -1,0 +1,398 @@
+//! The solution as the full gather reads it: the links arriving at a
+//! surface point (its leaf element, the leaf's ancestors, and, in a
+//! clustered solution, the clusters holding its triangle), the links
+//! arriving near a grid vertex, and the senders' shapes, radiosities and
+//! fixed sample points.
+//!
+//! A sender is a link end ([`Node`]): an element (a sub-triangle of an
+//! input triangle) or a cluster of `clusters.exr`. Elements are sampled
+//! uniformly over their triangle; clusters over their triangles in
+//! proportion to area. Either way sample `k` of a sender is the same point
+//! for every pixel and every vertex (paper 000 Sec. 4.4.1: fixed positions
+//! trade noise for a small bias), from a Halton sequence (bases 2, 3, 5)
+//! shifted by a rotation keyed by the sender (Cranley-Patterson), so any
+//! prefix of the sequence is well stratified whatever the sample count.
+
+use glam::DVec3;
+use radiometry::form_factor::point_to_polygon;
+use radiometry::geometry::TriangleGeometry;
+use radiometry::sampling::{square_to_triangle, Stream};
+use schemas::cluster::Clusters;
+use schemas::solution::{Node, Solution, NONE};
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::ops::Range;
+use std::sync::OnceLock;
+
+/// Form-factor samples used for a cluster sender, whose shape is not one
+/// polygon: the point-to-area kernel summed over this many of its fixed
+/// samples.
+pub const CLUSTER_FACTOR_SAMPLES: usize = 32;
+
+/// An axis-aligned box, m.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: DVec3,
+    /// Largest corner.
+    pub max: DVec3,
+}
+
+impl Aabb {
+    /// The box around `points`.
+    pub fn around(points: impl IntoIterator<Item = DVec3>) -> Aabb {
+        points.into_iter().fold(Aabb { min: DVec3::INFINITY, max: DVec3::NEG_INFINITY }, |b, p| Aabb { min: b.min.min(p), max: b.max.max(p) })
+    }
+
+    /// Whether the two boxes share a point.
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
+    }
+
+    /// Whether `p` is inside.
+    pub fn contains(&self, p: DVec3) -> bool {
+        self.min.cmple(p).all() && p.cmple(self.max).all()
+    }
+}
+
+/// Radical inverse of `k` in base `b` (van der Corput).
+fn radical_inverse(mut k: u64, b: u64) -> f64 {
+    let (mut inv, mut f) = (0.0, 1.0 / b as f64);
+    while k > 0 {
+        inv += (k % b) as f64 * f;
+        k /= b;
+        f /= b as f64;
+    }
+    inv
+}
+
+/// One fixed sample on a sender.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SenderSample {
+    /// The point, mesh frame.
+    pub point: DVec3,
+    /// The mesh triangle it lies on.
+    pub triangle: u32,
+}
+
+/// The solution, indexed for the gather.
+pub struct Senders<'a> {
+    /// Triangle geometry, mesh frame.
+    pub triangles: &'a [TriangleGeometry],
+    /// The solution.
+    pub solution: &'a Solution,
+    /// The cluster hierarchy the solution was solved with, if any.
+    pub clusters: Option<&'a Clusters>,
+    links_of: HashMap<Node, Range<usize>>,
+    /// Leaf cluster of every triangle (clustered solutions).
+    leaf_cluster: Vec<u32>,
+    /// Per cluster: cumulative area over its triangles (in `order`), built
+    /// on first use.
+    cluster_cdf: Vec<OnceLock<Vec<f64>>>,
+    /// Triangles binned in a uniform grid over the scene's box.
+    bins: Vec<Vec<u32>>,
+    bin_box: Aabb,
+    bin_n: usize,
+    seed: u64,
+}
+
+impl<'a> Senders<'a> {
+    /// Indexes `solution` (whose links are sorted by receiver) over
+    /// `triangles`, with the cluster hierarchy if given; `seed` keys the
+    /// senders' sample rotations.
+    pub fn new(triangles: &'a [TriangleGeometry], solution: &'a Solution, clusters: Option<&'a Clusters>, seed: u64) -> Self {
+        let mut links_of: HashMap<Node, Range<usize>> = HashMap::new();
+        let mut start = 0;
+        for i in 1..=solution.links.len() {
+            if i == solution.links.len() || solution.links[i].receiver != solution.links[start].receiver {
+                links_of.entry(solution.links[start].receiver).or_insert(start..i);
+                start = i;
+            }
+        }
+        let mut leaf_cluster = vec![NONE; triangles.len()];
+        if let Some(c) = clusters {
+            for (i, node) in c.nodes.iter().enumerate() {
+                if node.is_leaf() {
+                    for &t in &c.order[node.first_triangle as usize..(node.first_triangle + node.triangle_count) as usize] {
+                        leaf_cluster[t as usize] = i as u32;
+                    }
+                }
+            }
+        }
+        let cluster_cdf = (0..clusters.map_or(0, |c| c.nodes.len())).map(|_| OnceLock::new()).collect();
+        let bin_box = Aabb::around(triangles.iter().flat_map(|t| t.corners));
+        let bin_n = ((triangles.len() as f64).cbrt() * 2.0).ceil().clamp(1.0, 64.0) as usize;
+        let mut senders =
+            Senders { triangles, solution, clusters, links_of, leaf_cluster, cluster_cdf, bins: vec![Vec::new(); bin_n.pow(3)], bin_box, bin_n, seed };
+        for (t, tri) in triangles.iter().enumerate() {
+            let b = Aabb::around(tri.corners);
+            let (lo, hi) = (senders.bin(b.min), senders.bin(b.max));
+            for z in lo[2]..=hi[2] {
+                for y in lo[1]..=hi[1] {
+                    for x in lo[0]..=hi[0] {
+                        senders.bins[(z * bin_n + y) * bin_n + x].push(t as u32);
+                    }
+                }
+            }
+        }
+        senders
+    }
+
+    fn bin(&self, p: DVec3) -> [usize; 3] {
+        let extent = (self.bin_box.max - self.bin_box.min).max(DVec3::splat(1e-30));
+        let g = (p - self.bin_box.min) / extent * self.bin_n as f64;
+        g.to_array().map(|x| (x.floor().max(0.0) as usize).min(self.bin_n - 1))
+    }
+
+    /// Link indices arriving at `receiver`.
+    pub fn links_of(&self, receiver: Node) -> Range<usize> {
+        self.links_of.get(&receiver).cloned().unwrap_or(0..0)
+    }
+
+    /// World corners of element `e`.
+    pub fn element_corners(&self, e: u32) -> [DVec3; 3] {
+        let el = &self.solution.elements[e as usize];
+        self.triangles[el.triangle as usize].element(&el.corners.map(|c| c.map(f64::from)))
+    }
+
+    /// The leaf element under `triangle` holding barycentric `uv`, and the
+    /// links arriving at it, its ancestors, and the clusters holding the
+    /// triangle (leaf cluster up to the root): every link whose light
+    /// reaches the point, each sender once (000 Sec. 4.1: "each link
+    /// arriving at the hit object").
+    pub fn chain(&self, triangle: u32, uv: [f64; 2], links: &mut Vec<usize>) -> u32 {
+        links.clear();
+        let mut local = [1.0 - uv[0] - uv[1], uv[0], uv[1]].map(|l| l.max(0.0));
+        let sum: f64 = local.iter().sum();
+        local = if sum > 0.0 { local.map(|l| l / sum) } else { [1.0 / 3.0; 3] };
+        let mut element = triangle;
+        links.extend(self.links_of(Node::Element(element)));
+        while self.solution.elements[element as usize].first_child != NONE {
+            let (k, child_local) = radiometry::subdivision::locate_child(local);
+            local = child_local;
+            element = self.solution.elements[element as usize].first_child + k as u32;
+            links.extend(self.links_of(Node::Element(element)));
+        }
+        if let Some(c) = self.clusters {
+            let mut cluster = self.leaf_cluster[triangle as usize];
+            while cluster != NONE {
+                links.extend(self.links_of(Node::Cluster(cluster)));
+                cluster = c.nodes[cluster as usize].parent;
+            }
+        }
+        element
+    }
+
+    /// Link indices arriving at every receiver that overlaps `region`: the
+    /// clusters overlapping it and the clusters above them (000 Sec. 4.3),
+    /// and the elements overlapping it on the triangles overlapping it and
+    /// their ancestors. Sorted, each once.
+    pub fn links_near(&self, region: &Aabb) -> Vec<usize> {
+        let mut out = Vec::new();
+        if let Some(c) = self.clusters {
+            let mut stack = vec![0u32];
+            while let Some(i) = stack.pop() {
+                let node = &c.nodes[i as usize];
+                let b = Aabb { min: DVec3::from(node.bounds_min.map(f64::from)), max: DVec3::from(node.bounds_max.map(f64::from)) };
+                if !b.overlaps(region) {
+                    continue;
+                }
+                out.extend(self.links_of(Node::Cluster(i)));
+                if !node.is_leaf() {
+                    stack.extend(node.first_child..node.first_child + node.child_count);
+                }
+            }
+        }
+        let (lo, hi) = (self.bin(region.min), self.bin(region.max));
+        let mut candidates = Vec::new();
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    candidates.extend_from_slice(&self.bins[(z * self.bin_n + y) * self.bin_n + x]);
+                }
+            }
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
+        for t in candidates {
+            if !Aabb::around(self.triangles[t as usize].corners).overlaps(region) {
+                continue;
+            }
+            let mut stack = vec![t];
+            while let Some(e) = stack.pop() {
+                if !Aabb::around(self.element_corners(e)).overlaps(region) {
+                    continue;
+                }
+                out.extend(self.links_of(Node::Element(e)));
+                let first = self.solution.elements[e as usize].first_child;
+                if first != NONE {
+                    stack.extend(first..first + 4);
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Input triangles under a sender.
+    pub fn triangles_of(&self, node: Node) -> &[u32] {
+        match (node, self.clusters) {
+            (Node::Cluster(c), Some(cl)) => {
+                let n = &cl.nodes[c as usize];
+                &cl.order[n.first_triangle as usize..(n.first_triangle + n.triangle_count) as usize]
+            }
+            (Node::Element(e), _) => std::slice::from_ref(&self.solution.elements[e as usize].triangle),
+            _ => &[],
+        }
+    }
+
+    /// Radiosity of a sender, W/m², RGB.
+    pub fn radiosity(&self, node: Node) -> [f64; 3] {
+        match node {
+            Node::Element(e) => self.solution.elements[e as usize].radiosity.map(f64::from),
+            Node::Cluster(c) => self.solution.clusters.get(c as usize).map_or([0.0; 3], |c| c.radiosity.map(f64::from)),
+        }
+    }
+
+    /// Centre of a sender (element centroid, cluster box centre), m.
+    pub fn centre(&self, node: Node) -> DVec3 {
+        match node {
+            Node::Element(e) => self.element_corners(e).iter().sum::<DVec3>() / 3.0,
+            Node::Cluster(c) => self.cluster_box(c).map_or(DVec3::ZERO, |b| 0.5 * (b.min + b.max)),
+        }
+    }
+
+    /// Size of a sender: its longest element edge, or its cluster box's
+    /// diagonal, m.
+    pub fn size(&self, node: Node) -> f64 {
+        match node {
+            Node::Element(e) => {
+                let c = self.element_corners(e);
+                (0..3).map(|i| c[i].distance(c[(i + 1) % 3])).fold(0.0, f64::max)
+            }
+            Node::Cluster(c) => self.cluster_box(c).map_or(0.0, |b| (b.max - b.min).length()),
+        }
+    }
+
+    /// A cluster's bounding box.
+    pub fn cluster_box(&self, c: u32) -> Option<Aabb> {
+        let n = self.clusters?.nodes.get(c as usize)?;
+        Some(Aabb { min: DVec3::from(n.bounds_min.map(f64::from)), max: DVec3::from(n.bounds_max.map(f64::from)) })
+    }
+
+    /// Surface area of a sender, m².
+    pub fn area(&self, node: Node) -> f64 {
+        match node {
+            Node::Element(e) => {
+                let el = &self.solution.elements[e as usize];
+                self.triangles[el.triangle as usize].area * 0.25f64.powi(el.level as i32)
+            }
+            Node::Cluster(_) => self.triangles_of(node).iter().map(|&t| self.triangles[t as usize].area).sum(),
+        }
+    }
+
+    /// Fixed sample `k` on `node` (the same point for every caller).
+    pub fn sample(&self, node: Node, k: usize) -> SenderSample {
+        let key = match node {
+            Node::Element(e) => u64::from(e),
+            Node::Cluster(c) => u64::from(c) | 1 << 40,
+        };
+        let mut rotation = Stream::new(self.seed, key, 0x5e4d);
+        let shift = [rotation.next_f64(), rotation.next_f64(), rotation.next_f64()];
+        let h = |b: u64, s: f64| (radical_inverse(k as u64 + 1, b) + s).fract();
+        let (u, v) = (h(3, shift[1]), h(5, shift[2]));
+        match node {
+            Node::Element(e) => {
+                let corners = self.element_corners(e);
+                let b = square_to_triangle(u, v);
+                SenderSample { point: corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2], triangle: self.solution.elements[e as usize].triangle }
+            }
+            Node::Cluster(c) => {
+                let tris = self.triangles_of(node);
+                if tris.is_empty() {
+                    return SenderSample { point: self.centre(node), triangle: NONE };
+                }
+                let cdf = self.cluster_cdf[c as usize].get_or_init(|| {
+                    let mut acc = 0.0;
+                    tris.iter().map(|&t| {
+                        acc += self.triangles[t as usize].area;
+                        acc
+                    }).collect()
+                });
+                let total = *cdf.last().unwrap_or(&0.0);
+                let x = h(2, shift[0]) * total;
+                let i = cdf.partition_point(|&a| a <= x).min(tris.len() - 1);
+                let t = &self.triangles[tris[i] as usize];
+                let b = square_to_triangle(u, v);
+                SenderSample { point: t.corners[0] * b[0] + t.corners[1] * b[1] + t.corners[2] * b[2], triangle: tris[i] }
+            }
+        }
+    }
+
+    /// Form factor from a differential area at `p` with unit normal
+    /// `normal` to the sender: Lambert's closed form (002 Eq. 3) for an
+    /// element; for a cluster the point-to-area kernel
+    /// `sum_k (A / K) cos+(theta_p) cos+(theta_k) / (pi r_k^2)` over its
+    /// first [`CLUSTER_FACTOR_SAMPLES`] fixed samples (front faces only;
+    /// the near singularity is cut at `r^2 >= A / K`, the area one sample
+    /// stands for). Returns the factor and the number of kernel
+    /// evaluations.
+    pub fn form_factor(&self, node: Node, p: DVec3, normal: DVec3) -> (f64, u64) {
+        match node {
+            Node::Element(e) => (point_to_polygon(p, normal, &self.element_corners(e)), 1),
+            Node::Cluster(_) => {
+                let area = self.area(node);
+                let k = CLUSTER_FACTOR_SAMPLES;
+                let mut sum = 0.0;
+                for s in 0..k {
+                    let sample = self.sample(node, s);
+                    if sample.triangle == NONE {
+                        continue;
+                    }
+                    let d = sample.point - p;
+                    let r2 = d.length_squared().max(area / k as f64);
+                    let dir = d.normalize_or_zero();
+                    let cos_p = normal.dot(dir).max(0.0);
+                    let cos_s = (-dir).dot(self.triangles[sample.triangle as usize].normal).max(0.0);
+                    sum += area / k as f64 * cos_p * cos_s / (PI * r2);
+                }
+                (sum.min(1.0), k as u64)
+            }
+        }
+    }
+
+    /// Whether sender `a` is `b` or lies above it in the hierarchy
+    /// (elements: the parent chain; clusters: the cluster chain, and a
+    /// cluster holds the elements on its triangles).
+    pub fn covers(&self, a: Node, b: Node) -> bool {
+        match (a, b) {
+            (Node::Element(x), Node::Element(mut y)) => loop {
+                if x == y {
+                    return true;
+                }
+                y = self.solution.elements[y as usize].parent;
+                if y == NONE {
+                    return false;
+                }
+            },
+            (Node::Cluster(x), Node::Element(y)) => {
+                let t = self.solution.elements[y as usize].triangle;
+                self.covers(a, Node::Cluster(self.leaf_cluster[t as usize])) || (x != NONE && self.leaf_cluster[t as usize] == x)
+            }
+            (Node::Cluster(x), Node::Cluster(mut y)) => {
+                let Some(c) = self.clusters else { return false };
+                loop {
+                    if x == y {
+                        return true;
+                    }
+                    if y == NONE || y as usize >= c.nodes.len() {
+                        return false;
+                    }
+                    y = c.nodes[y as usize].parent;
+                }
+            }
+            (Node::Element(_), Node::Cluster(_)) => false,
+        }
+    }
+}

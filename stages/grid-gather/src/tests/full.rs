@@ -1,0 +1,199 @@
+//! The full gather against the brute-force gather and closed forms.
+
+use crate::final_gather::Diagnostics;
+use crate::grid::{barycentric, Grid};
+use crate::{gather_with, Extras, Mode, Params, Rendered, Scene};
+use glam::{dvec3, DVec3};
+use radiometry::camera::Pinhole;
+use radiometry::geometry::TriangleGeometry;
+use radiometry::sampling::Stream;
+use schemas::header::{Provenance, Schema};
+use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
+use schemas::solution::{Element, Link, Node, Solution, NONE};
+use std::path::Path;
+
+fn material(name: &str, diffuse: f64, emission: f64) -> Material {
+    let black = [0.0; 3];
+    Material {
+        name: name.into(),
+        diffuse: [diffuse; 3],
+        emission: [emission; 3],
+        specular_reflectance: black,
+        specular_transmittance: black,
+        diffuse_transmittance: black,
+        diffuse_map: None,
+        alpha_map: None,
+        normal_map: None,
+    }
+}
+
+/// A 2 m floor (material 0, rho 0.5) under a 0.4 m square emitter facing
+/// down 1.5 m above it (material 1, exitance 20 W/m²), nothing between:
+/// the floor's only light is the emitter, unoccluded.
+struct Room {
+    mesh: Mesh,
+    manifest: Manifest,
+    solution: Solution,
+}
+
+fn room() -> Room {
+    let quad = |a: DVec3, b: DVec3, c: DVec3, d: DVec3| [[a, b, c], [a, c, d]];
+    let mut tris: Vec<([DVec3; 3], u32)> = Vec::new();
+    for t in quad(dvec3(-1.0, 0.0, 1.0), dvec3(1.0, 0.0, 1.0), dvec3(1.0, 0.0, -1.0), dvec3(-1.0, 0.0, -1.0)) {
+        tris.push((t, 0));
+    }
+    for t in quad(dvec3(-0.2, 1.5, -0.2), dvec3(0.2, 1.5, -0.2), dvec3(0.2, 1.5, 0.2), dvec3(-0.2, 1.5, 0.2)) {
+        tris.push((t, 1));
+    }
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for (t, m) in &tris {
+        let base = positions.len() as u32;
+        positions.extend(t.iter().map(|p| p.as_vec3().to_array()));
+        let g = TriangleGeometry::new(*t);
+        assert!(g.normal.y.abs() > 0.99);
+        triangles.push(Triangle { vertices: [base, base + 1, base + 2], material: *m, object: 0, area: g.area as f32, normal: g.normal.as_vec3().to_array() });
+    }
+    let mesh = Mesh { header: Mesh::header(Provenance::in_memory("test")), positions, triangles };
+    let manifest = Manifest {
+        header: Manifest::header(Provenance::in_memory("test")),
+        world_from_mesh_translation: [0.0; 3],
+        camera: Camera { eye: [0.0, 1.2, 2.4], target: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], vertical_fov_deg: 50.0, width: 48, height: 32 },
+        materials: vec![material("floor", 0.5, 0.0), material("light", 0.0, 20.0)],
+        objects: vec!["room".into()],
+        goniometric_lights: vec![],
+        effects: Effects::default(),
+        statistics: MeshStatistics::default(),
+    };
+    let element = |t: u32, b: f32| Element {
+        triangle: t,
+        parent: NONE,
+        first_child: NONE,
+        level: 0,
+        corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+        area: 1.0,
+        radiosity: [b; 3],
+    };
+    // F of a 0.4 m square 1.5 m away, roughly A cos^2 / (pi r^2) = 0.023
+    // per floor point: the links' values steer sample counts only.
+    let link = |r: u32, s: u32| Link {
+        receiver: Node::Element(r),
+        sender: Node::Element(s),
+        form_factor: 0.01,
+        visibility: 1.0,
+        unoccluded_irradiance: [0.2; 3],
+        occluder_distance: f32::INFINITY,
+    };
+    let solution = Solution {
+        header: Solution::header(Provenance::in_memory("test")),
+        elements: vec![element(0, 0.1), element(1, 0.1), element(2, 20.0), element(3, 20.0)],
+        clusters: vec![],
+        links: vec![link(0, 2), link(0, 3), link(1, 2), link(1, 3)],
+    };
+    Room { mesh, manifest, solution }
+}
+
+fn run(room: &Room, params: &Params) -> (Rendered, Diagnostics) {
+    let scene = Scene { mesh: &room.mesh, manifest: &room.manifest, manifest_path: Path::new("m.ron"), solution: &room.solution, solution_path: Path::new("s.exr") };
+    let (r, d) = gather_with(params, &scene, Extras::default(), &|_| {}).expect("gather");
+    (r, d.expect("diagnostics"))
+}
+
+/// Luminance-free: the red channel of every covered floor pixel.
+fn floor_values(image: &Rendered) -> Vec<f64> {
+    image.rgb.iter().map(|p| f64::from(p[0])).collect()
+}
+
+fn relative_rmse(a: &[f64], b: &[f64]) -> f64 {
+    let (mut e, mut n) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        if *y > 0.0 {
+            e += ((x - y) / y).powi(2);
+            n += 1.0;
+        }
+    }
+    (e / n).sqrt()
+}
+
+#[test]
+fn without_occluders_every_sender_interpolates_visibility_and_matches_brute_force() {
+    let room = room();
+    let full = Params { mode: Mode::Full, spp: 2, grid_pixels: 8, grid_depth: 6, ..Params::default() };
+    let (image, diagnostics) = run(&room, &full);
+    assert!(!diagnostics.vertices.is_empty());
+    for v in &diagnostics.vertices {
+        assert_eq!(v.classes[0] + v.classes[1], 0, "vertex {:?} resamples visibility: {:?}", v.ijk, v.classes);
+    }
+    assert_eq!(image.counters["visibility_rays"], 0.0, "no shadow ray at render time");
+    let brute = Params { mode: Mode::Brute, spp: 2, brute_samples: 4, ..Params::default() };
+    let (reference, _) = run(&room, &brute);
+    assert!(reference.counters["visibility_rays"] > 0.0);
+    let e = relative_rmse(&floor_values(&image), &floor_values(&reference));
+    assert!(e < 0.01, "relative RMSE {e}");
+}
+
+#[test]
+fn random_points_of_a_perspective_cell_lie_in_exactly_one_tetrahedron_with_linear_weights() {
+    let camera = Camera { eye: [0.3, 0.2, 3.0], target: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], vertical_fov_deg: 45.0, width: 64, height: 48 };
+    let pinhole = Pinhole::new(&camera, 64, 48).unwrap();
+    let grid = Grid::perspective(&pinhole, 64, 48, 0.5, 6.0, [8, 6, 5]);
+    let linear = |p: DVec3| 0.7 * p.x - 1.3 * p.y + 2.1 * p.z + 0.4;
+    let mut stream = Stream::new(3, 0, 0);
+    for cell in [[0, 0, 0], [3, 2, 1], [4, 2, 1], [7, 5, 4]] {
+        let corners = grid.cell_vertices(cell);
+        for _ in 0..500 {
+            let g: [f64; 3] = std::array::from_fn(|a| cell[a] as f64 + 0.001 + 0.998 * stream.next_f64());
+            let p = grid.point(g);
+            let back = grid.coordinates(p).unwrap();
+            assert!((0..3).all(|a| (back[a] - g[a]).abs() < 1e-9), "{back:?} vs {g:?}");
+            let containing: Vec<usize> = Grid::tetrahedra(cell)
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| barycentric(&t.map(|m| grid.vertex(corners[m])), p).iter().all(|&w| w >= -1e-12))
+                .map(|(k, _)| k)
+                .collect();
+            assert_eq!(containing.len(), 1, "point {g:?} of cell {cell:?} in tetrahedra {containing:?}");
+            let location = grid.locate(p).unwrap();
+            assert_eq!((location.cell, location.tetrahedron), (cell, containing[0]));
+            let sum: f64 = location.weights.iter().sum();
+            assert!((sum - 1.0).abs() < 1e-12);
+            let interpolated: f64 = (0..4).map(|i| location.weights[i] * linear(grid.vertex(grid.vertex_of(location.vertices[i])))).sum();
+            assert!((interpolated - linear(p)).abs() < 1e-9, "{interpolated} vs {}", linear(p));
+        }
+    }
+    // Neighbouring cells split their shared face along the same diagonal:
+    // the face's points get the same weights from both sides.
+    let (a, b) = ([3, 2, 1], [4, 2, 1]);
+    for _ in 0..200 {
+        let g = [4.0, 2.0 + stream.next_f64(), 1.0 + stream.next_f64()];
+        let p = grid.point(g);
+        let (la, lb) = (grid.locate_in(a, p), grid.locate_in(b, p));
+        let weight = |l: &crate::grid::Location, v: usize| (0..4).filter(|&i| l.vertices[i] == v).map(|i| l.weights[i]).sum::<f64>();
+        for v in la.vertices.iter().chain(&lb.vertices) {
+            assert!((weight(&la, *v) - weight(&lb, *v)).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn a_row_of_pixels_crossing_cell_faces_shows_no_jump_above_the_brute_force_noise() {
+    let room = room();
+    let mut room = room;
+    room.manifest.camera.width = 96;
+    room.manifest.camera.height = 48;
+    room.manifest.camera.vertical_fov_deg = 10.0;
+    // Every second cell face crosses the row; interpolated and resampled
+    // senders meet there.
+    let full = Params { mode: Mode::Full, spp: 1, grid_pixels: 6, grid_depth: 4, samples: 16, ..Params::default() };
+    let brute = Params { mode: Mode::Brute, spp: 1, brute_samples: 8, ..Params::default() };
+    let (image, _) = run(&room, &full);
+    let (reference, _) = run(&room, &brute);
+    let row = |img: &Rendered| -> Vec<f64> { (0..96).map(|x| f64::from(img.rgb[24 * 96 + x][0])).collect() };
+    let (f, b) = (row(&image), row(&reference));
+    assert!(f.iter().all(|&v| v > 0.0), "the row sees the lit floor");
+    let second = |v: &[f64]| -> Vec<f64> { (1..v.len() - 1).map(|i| (v[i + 1] - 2.0 * v[i] + v[i - 1]).abs()).collect() };
+    let noise = second(&b).into_iter().fold(0.0, f64::max);
+    let worst = second(&f).into_iter().fold(0.0, f64::max);
+    let level = b.iter().sum::<f64>() / b.len() as f64;
+    assert!(worst <= noise + 1e-4 * level, "largest kink {worst} vs the brute-force floor {noise} (level {level})");
+}
