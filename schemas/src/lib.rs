@@ -12,7 +12,9 @@
 //! | [`mesh::Mesh`] | `mesh.exr` | `mesh` 1 | mesh-prep |
 //! | [`mesh::Manifest`] | `manifest.ron` | `manifest` 1 | mesh-prep |
 //! | [`cluster::Clusters`] | `clusters.exr` | `clusters` 1 | cluster |
-//! | [`solution::Solution`] | `solution.exr` | `solution` 1 | hierarchical-solve |
+//! | [`solution::Solution`] | `solution.exr` | `solution` 1 | hierarchical-solve, gpu-shoot |
+//! | [`lightmap::Lightmap`] | `lightmap.exr` | `lightmap` 1 | gpu-shoot |
+//! | [`lightmap::Convergence`] | `convergence.ron` | `convergence` 1 | gpu-shoot |
 //! | [`image::HdrImage`] | `*.exr` | `image` 1 | grid-gather |
 //! | [`report::Report`] | `*.report.ron` | `report` 1 | every stage |
 //!
@@ -27,6 +29,7 @@ pub mod error;
 pub mod exr_io;
 pub mod header;
 pub mod image;
+pub mod lightmap;
 pub mod mesh;
 pub mod report;
 pub mod ron_io;

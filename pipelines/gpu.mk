@@ -1,0 +1,42 @@
+# The GPU pipeline: mesh-prep -> gpu-shoot (progressive radiosity, wgpu; on
+# lavapipe where no GPU exists) -> grid-gather (preview) -> tonemap.
+# `make gpu` renders $(OUT)/gpu/image.png; `make bench-gpu` runs the GPU
+# benchmark. The mesh and manifest are the hierarchical pipeline's.
+
+GPU_OUT := $(OUT)/gpu
+GPU_TEXELS ?= 32768
+GPU_VISIBILITY ?= hemicube
+GPU_CONVERGENCE ?= 0.99
+GPU_SHOOT_LEVEL ?= 3
+GPU_RESOLUTION ?= 128
+GPU_OVERSHOOT ?= --overshoot
+
+.PHONY: gpu bench-gpu
+gpu: $(GPU_OUT)/image.png
+
+$(GPU_OUT) $(GPU_OUT)/params:
+	@mkdir -p $@
+
+$(BIN)/gpu-shoot $(BIN)/bench-gpu &: FORCE
+	@cargo build --release --quiet -p gpu-shoot --bins
+
+$(GPU_OUT)/params/gpu-shoot.ron: $(BIN)/gpu-shoot FORCE | $(GPU_OUT)/params
+	@$(BIN)/gpu-shoot --print-params --texels $(GPU_TEXELS) --visibility $(GPU_VISIBILITY) --convergence-target $(GPU_CONVERGENCE) \
+	  --shoot-level $(GPU_SHOOT_LEVEL) --resolution $(GPU_RESOLUTION) $(GPU_OVERSHOOT) > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
+
+$(GPU_OUT)/solution.exr $(GPU_OUT)/lightmap.exr &: $(BIN)/gpu-shoot $(GPU_OUT)/params/gpu-shoot.ron $(OUT)/mesh.exr $(OUT)/manifest.ron | $(GPU_OUT)
+	$(BIN)/gpu-shoot --params $(GPU_OUT)/params/gpu-shoot.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron \
+	  -o $(GPU_OUT)/solution.exr --lightmap $(GPU_OUT)/lightmap.exr --convergence $(GPU_OUT)/convergence.ron \
+	  --plot $(GPU_OUT)/convergence.svg --report $(GPU_OUT)/gpu-shoot.report.ron
+
+$(GPU_OUT)/preview.exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(GPU_OUT)/solution.exr
+	$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview \
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --solution $(GPU_OUT)/solution.exr -o $@ --report $(GPU_OUT)/gather.report.ron
+
+$(GPU_OUT)/image.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(GPU_OUT)/preview.exr
+	$(BIN)/tonemap --params $(OUT)/params/tonemap.ron $(GPU_OUT)/preview.exr -o $@ --report $(GPU_OUT)/tonemap.report.ron
+
+# Cornell box at about 127k texels to 90% convergence: hemicube vs
+# stereographic, with and without overshooting (see README, Performance).
+bench-gpu: $(BIN)/bench-gpu | out
+	$(BIN)/bench-gpu -o out/bench-gpu.ron

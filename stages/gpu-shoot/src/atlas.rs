@@ -1,0 +1,230 @@
+//! The lightmap atlas (paper 004, Sec. 2.3 and 4.2): a square region of
+//! texels per triangle, a texel size per object, coverage, the area each
+//! texel stands for, and the world position and normal of every covered
+//! texel, baked once.
+//!
+//! The paper rasterizes each triangle orthographically into its texture to
+//! find the covered texels and their positions. Here the covered texels of
+//! a region are known in closed form (see [`schemas::lightmap`]: texel
+//! `(i, j)` with centre at barycentric `((i+1/2)/n, (j+1/2)/n)`, covered
+//! when `i + j + 1 <= n`), so positions are computed on the CPU in f64 and
+//! uploaded once; the GPU then works on the compact list of covered texels.
+//!
+//! Substructuring (004 Sec. 2.3, "shooting from a coarser mipmap level"):
+//! the covered texels of a triangle are grouped into blocks of `2^level` x
+//! `2^level` texels; each block with at least one covered texel is one
+//! shooting sample. Texels are stored group by group, so each group is a
+//! contiguous range and the mip level is a sum over a range.
+
+use glam::DVec3;
+use radiometry::geometry::TriangleGeometry;
+use schemas::lightmap::Region;
+use schemas::mesh::{Manifest, Mesh};
+
+/// One covered texel, as the GPU reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Texel {
+    /// Atlas column.
+    pub x: u32,
+    /// Atlas row.
+    pub y: u32,
+    /// The triangle it lies on.
+    pub triangle: u32,
+    /// Texel centre, mesh frame, m.
+    pub position: [f32; 3],
+    /// Area it stands for, m².
+    pub area: f32,
+}
+
+/// One shooting sample: a group of covered texels of one triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Group {
+    /// First texel of the group in [`Atlas::texels`].
+    pub first: u32,
+    /// Number of texels.
+    pub count: u32,
+    /// Area-weighted centroid of the group's texel centres, mesh frame, m.
+    pub centroid: [f32; 3],
+    /// Total area of the group, m².
+    pub area: f32,
+}
+
+/// Per-triangle ranges into the texel and group lists.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleTexels {
+    /// First texel in [`Atlas::texels`].
+    pub first: u32,
+    /// Covered texels.
+    pub count: u32,
+    /// First group in [`Atlas::groups`].
+    pub group_first: u32,
+    /// Groups (shooting samples).
+    pub group_count: u32,
+}
+
+/// The baked atlas.
+#[derive(Clone, Debug)]
+pub struct Atlas {
+    /// Atlas width, texels.
+    pub width: u32,
+    /// Atlas height, texels.
+    pub height: u32,
+    /// One region per triangle.
+    pub regions: Vec<Region>,
+    /// Per-triangle ranges.
+    pub triangles: Vec<TriangleTexels>,
+    /// Covered texels, triangle by triangle, group by group.
+    pub texels: Vec<Texel>,
+    /// Shooting samples, triangle by triangle.
+    pub groups: Vec<Group>,
+    /// Texel size (interior texels per region side) per object.
+    pub object_sizes: Vec<u32>,
+}
+
+/// Covered texels of a region of `size` texels per side: `n (n + 1) / 2`.
+pub fn covered_count(size: u32) -> u32 {
+    size * (size + 1) / 2
+}
+
+/// The region size of every object, chosen from its area (004 Sec. 4.2:
+/// one size for all over- and under-samples mixed meshes). With a density
+/// of `texels / total area` texels per m², an object whose mean triangle
+/// area is `a` gets the size `n` whose covered count `n (n+1)/2` is nearest
+/// to `a x density`, clamped to `[min_size, max_size]`. All triangles of an
+/// object share it (a size varying across one object shows seams at the
+/// boundaries, 004 Sec. 4.2 footnote).
+pub fn object_sizes(mesh: &Mesh, objects: usize, texels: f64, min_size: u32, max_size: u32) -> Vec<u32> {
+    let total: f64 = mesh.triangles.iter().map(|t| t.area as f64).sum();
+    let density = texels / total.max(f64::MIN_POSITIVE);
+    let mut area = vec![0.0f64; objects];
+    let mut count = vec![0usize; objects];
+    for t in &mesh.triangles {
+        area[t.object as usize] += t.area as f64;
+        count[t.object as usize] += 1;
+    }
+    (0..objects)
+        .map(|o| {
+            if count[o] == 0 {
+                return min_size;
+            }
+            let want = area[o] / count[o] as f64 * density;
+            let n = ((1.0 + 8.0 * want).sqrt() - 1.0) / 2.0;
+            (n.round() as u32).clamp(min_size, max_size)
+        })
+        .collect()
+}
+
+/// Bakes the atlas: region sizes per object, shelf packing (regions sorted
+/// by decreasing size, then triangle index, into rows of a power-of-two
+/// wide atlas), covered texels with positions and areas, and groups of
+/// `2^level` x `2^level` texels for substructured shooting.
+pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_size: u32, level: u32) -> Atlas {
+    let sizes = object_sizes(mesh, manifest.objects.len(), texels, min_size, max_size);
+    let size_of = |t: usize| sizes[mesh.triangles[t].object as usize];
+    let footprint: u64 = (0..mesh.triangles.len()).map(|t| ((size_of(t) + 2) as u64).pow(2)).sum();
+    let largest = (0..mesh.triangles.len()).map(|t| size_of(t) + 2).max().unwrap_or(1);
+    let width = ((footprint as f64).sqrt().ceil() as u32).max(largest).next_power_of_two();
+    let mut order: Vec<usize> = (0..mesh.triangles.len()).collect();
+    order.sort_by_key(|&t| (std::cmp::Reverse(size_of(t)), t));
+    let mut regions = vec![Region { x: 0, y: 0, size: 0, covered: 0, texel_area: 0.0 }; mesh.triangles.len()];
+    let (mut x, mut y, mut row_height) = (0u32, 0u32, 0u32);
+    for &t in &order {
+        let side = size_of(t) + 2;
+        if x + side > width {
+            x = 0;
+            y += row_height;
+            row_height = 0;
+        }
+        let size = size_of(t);
+        let covered = covered_count(size);
+        regions[t] = Region { x, y, size, covered, texel_area: (mesh.triangles[t].area as f64 / covered as f64) as f32 };
+        x += side;
+        row_height = row_height.max(side);
+    }
+    let height = (y + row_height).max(1);
+    let g = 1u32 << level;
+    let mut triangles = Vec::with_capacity(mesh.triangles.len());
+    let mut all_texels = Vec::new();
+    let mut groups = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let geometry = TriangleGeometry::new(tri.vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from))));
+        let region = regions[t];
+        let n = region.size;
+        let (first, group_first) = (all_texels.len() as u32, groups.len() as u32);
+        let blocks = n.div_ceil(g);
+        for gj in 0..blocks {
+            for gi in 0..blocks {
+                let start = all_texels.len() as u32;
+                let mut sum = DVec3::ZERO;
+                for j in gj * g..((gj + 1) * g).min(n) {
+                    for i in gi * g..((gi + 1) * g).min(n) {
+                        if !region.is_covered(i, j) {
+                            continue;
+                        }
+                        let p = geometry.point(region.uv(i, j));
+                        sum += p;
+                        let (x, y) = region.texel(i, j);
+                        all_texels.push(Texel { x, y, triangle: t as u32, position: p.as_vec3().to_array(), area: region.texel_area });
+                    }
+                }
+                let count = all_texels.len() as u32 - start;
+                if count > 0 {
+                    let centroid = (sum / count as f64).as_vec3().to_array();
+                    groups.push(Group { first: start, count, centroid, area: region.texel_area * count as f32 });
+                }
+            }
+        }
+        triangles.push(TriangleTexels {
+            first,
+            count: all_texels.len() as u32 - first,
+            group_first,
+            group_count: groups.len() as u32 - group_first,
+        });
+    }
+    Atlas { width, height, regions, triangles, texels: all_texels, groups, object_sizes: sizes }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use schemas::header::{Provenance, Schema};
+    use schemas::mesh::Triangle;
+
+    pub(crate) fn two_triangle_mesh() -> (Mesh, Manifest) {
+        let positions = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 1.0], [0.1, 0.0, 1.0], [0.0, 0.1, 1.0]];
+        let triangles = vec![
+            Triangle { vertices: [0, 1, 2], material: 0, object: 0, area: 2.0, normal: [0.0, 0.0, 1.0] },
+            Triangle { vertices: [3, 4, 5], material: 0, object: 1, area: 0.005, normal: [0.0, 0.0, 1.0] },
+        ];
+        let mesh = Mesh { header: Mesh::header(Provenance::in_memory("test")), positions, triangles };
+        let manifest = crate::testing::manifest(2, vec![crate::testing::material([0.5; 3], [0.0; 3])]);
+        (mesh, manifest)
+    }
+
+    #[test]
+    fn texel_areas_sum_to_triangle_areas_and_regions_do_not_overlap() {
+        let (mesh, manifest) = two_triangle_mesh();
+        let atlas = bake(&mesh, &manifest, 2000.0, 2, 256, 2);
+        assert!(atlas.object_sizes[0] > atlas.object_sizes[1], "{:?}", atlas.object_sizes);
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let r = atlas.triangles[t];
+            let sum: f64 = atlas.texels[r.first as usize..(r.first + r.count) as usize].iter().map(|x| x.area as f64).sum();
+            assert!((sum - tri.area as f64).abs() < 1e-5 * tri.area as f64, "{sum} vs {}", tri.area);
+            let groups: u32 = atlas.groups[r.group_first as usize..(r.group_first + r.group_count) as usize].iter().map(|g| g.count).sum();
+            assert_eq!(groups, r.count);
+        }
+        let mut owner = vec![u32::MAX; (atlas.width * atlas.height) as usize];
+        for (t, r) in atlas.regions.iter().enumerate() {
+            for y in r.y..r.y + r.size + 2 {
+                for x in r.x..r.x + r.size + 2 {
+                    let k = (y * atlas.width + x) as usize;
+                    assert_eq!(owner[k], u32::MAX, "regions overlap at ({x}, {y})");
+                    owner[k] = t as u32;
+                }
+            }
+        }
+        // 2000 texels over 2.005 m^2: the large triangle holds about 1995.
+        let covered = atlas.triangles[0].count as f64;
+        assert!((covered - 1995.0).abs() < 80.0, "{covered}");
+    }
+}

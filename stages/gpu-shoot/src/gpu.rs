@@ -1,0 +1,483 @@
+//! The GPU side: device acquisition (kept apart from the work, so tests and
+//! benchmarks hand in their own device), buffers mirroring the shader
+//! structs, and one progressive-radiosity shot as a sequence of passes:
+//! residual reduction, shooter selection, sample preparation, visibility
+//! rendering, receiver pass, shooter reset (paper 004 Sec. 2.3, 4.2).
+//!
+//! Reproducibility: every sum runs in a fixed order (strided per-thread
+//! loops and fixed trees, each texel accumulating its samples in order),
+//! so reruns on the same adapter and driver give the same bits. Different
+//! adapters (lavapipe vs a hardware GPU) differ in rounding (FMA
+//! contraction, rasterization rules) and agree only within tolerances.
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+/// The error when no Vulkan adapter exists: says what to install.
+pub const NO_ADAPTER: &str =
+    "no GPU adapter found (Vulkan): install Mesa's software Vulkan driver lavapipe (Debian/Ubuntu: apt-get install mesa-vulkan-drivers) or a GPU driver";
+
+/// Acquires a device and queue on the best Vulkan adapter (a hardware GPU
+/// before lavapipe), with the adapter's own limits (the solver binds nine
+/// storage buffers to one stage; WebGPU's default allows eight).
+pub fn acquire() -> Result<(wgpu::Device, wgpu::Queue, wgpu::AdapterInfo), String> {
+    let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+    descriptor.backends = wgpu::Backends::VULKAN;
+    let instance = wgpu::Instance::new(descriptor);
+    let options = wgpu::RequestAdapterOptions { power_preference: wgpu::PowerPreference::HighPerformance, ..Default::default() };
+    let adapter = match pollster::block_on(instance.request_adapter(&options)) {
+        Ok(a) => a,
+        Err(_) => {
+            let fallback = wgpu::RequestAdapterOptions { force_fallback_adapter: true, ..options };
+            pollster::block_on(instance.request_adapter(&fallback)).map_err(|_| NO_ADAPTER.to_string())?
+        }
+    };
+    let info = adapter.get_info();
+    let descriptor = wgpu::DeviceDescriptor {
+        label: Some("gpu-shoot"),
+        required_features: wgpu::Features::empty(),
+        required_limits: adapter.limits(),
+        ..Default::default()
+    };
+    let (device, queue) =
+        pollster::block_on(adapter.request_device(&descriptor)).map_err(|e| format!("the GPU adapter '{}' refused a device: {e}", info.name))?;
+    Ok((device, queue, info))
+}
+
+/// One line naming an adapter.
+pub fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!("{} ({:?}, {} {})", info.name, info.device_type, info.driver, info.driver_info)
+}
+
+/// Host mirror of `Params` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuParams {
+    pub n_texels: u32,
+    pub n_tris: u32,
+    pub shooter: u32,
+    pub sample_first: u32,
+    pub sample_count: u32,
+    pub layers_per_sample: u32,
+    pub res: u32,
+    pub mode: u32,
+    pub overshoot: u32,
+    pub group_count: u32,
+    pub _pad0: [u32; 2],
+    pub tolerance: f32,
+    pub near: f32,
+    pub far: f32,
+    pub total_area: f32,
+    pub interreflection: [f32; 4],
+}
+
+/// Host mirror of `Texel` in solver.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuTexel {
+    pub position_area: [f32; 4],
+    /// xyz: normal; w: the triangle index's bits.
+    pub normal_triangle: [f32; 4],
+    pub rho: [f32; 4],
+}
+
+/// Host mirror of `Tri` in solver.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuTri {
+    pub first: u32,
+    pub count: u32,
+    pub group_first: u32,
+    pub group_count: u32,
+    pub area: f32,
+    pub _pad: [f32; 3],
+    pub rho: [f32; 4],
+}
+
+/// Host mirror of `Group` in solver.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuGroup {
+    pub first: u32,
+    pub count: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Host mirror of `Sample` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuSample {
+    pub position_area: [f32; 4],
+    pub t: [f32; 4],
+    pub b: [f32; 4],
+    pub n: [f32; 4],
+    /// rgb: unshot radiosity (area sample) or I_max in W/sr (light); w: 0 area, 1 light.
+    pub power: [f32; 4],
+}
+
+/// Host mirror of `Selection` in solver.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuSelection {
+    pub shooter: [u32; 4],
+    pub overshoot: [f32; 4],
+    pub ambient: [f32; 4],
+    pub unshot: [f32; 4],
+    pub unshot_abs: [f32; 4],
+    pub score: [f32; 4],
+}
+
+/// Everything the solver keeps on the device.
+pub struct Gpu {
+    pub texel_count: u32,
+    pub tri_count: u32,
+    params: wgpu::Buffer,
+    pub radiosity: wgpu::Buffer,
+    pub residual: wgpu::Buffer,
+    pub tri_power: wgpu::Buffer,
+    selection: wgpu::Buffer,
+    samples: wgpu::Buffer,
+    ldt: wgpu::Buffer,
+    vertex_count: u32,
+    compute_group: wgpu::BindGroup,
+    render_group: wgpu::BindGroup,
+    reduce: wgpu::ComputePipeline,
+    select: wgpu::ComputePipeline,
+    prepare: wgpu::ComputePipeline,
+    finish: wgpu::ComputePipeline,
+    receive: wgpu::ComputePipeline,
+    render: wgpu::RenderPipeline,
+    layer_views: Vec<wgpu::TextureView>,
+    depth_view: wgpu::TextureView,
+    /// Visibility map side, pixels.
+    pub res: u32,
+    /// Layers of the visibility array (samples per batch x layers per sample).
+    pub layers: u32,
+    /// Most samples the samples buffer holds.
+    pub sample_capacity: u32,
+}
+
+fn storage(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+/// What the GPU solver is built from.
+pub struct Setup<'a> {
+    pub texels: &'a [GpuTexel],
+    pub tris: &'a [GpuTri],
+    pub groups: &'a [GpuGroup],
+    /// Initial radiosity = residual = emission, per texel (rgb, 0).
+    pub emission: &'a [[f32; 4]],
+    /// Triangle corners, 3 per triangle (xyz, 1).
+    pub vertices: &'a [[f32; 4]],
+    /// Visibility map side, pixels.
+    pub res: u32,
+    /// Layers of the visibility texture array.
+    pub layers: u32,
+    /// Largest number of samples in one shot.
+    pub sample_capacity: u32,
+    /// Largest light distribution table, floats.
+    pub ldt_capacity: usize,
+}
+
+const SAMPLE_SIZE: u64 = std::mem::size_of::<GpuSample>() as u64;
+
+impl Gpu {
+    /// Uploads the atlas and builds the pipelines.
+    pub fn new(device: &wgpu::Device, setup: &Setup) -> Gpu {
+        let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            // A zero-sized storage binding is invalid: keep at least 16 bytes.
+            let mut bytes = contents.to_vec();
+            bytes.resize(bytes.len().max(16), 0);
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: &bytes, usage })
+        };
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<GpuParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let texels = init("texels", bytemuck::cast_slice(setup.texels), rw);
+        let radiosity = init("radiosity", bytemuck::cast_slice(setup.emission), rw);
+        let residual = init("residual", bytemuck::cast_slice(setup.emission), rw);
+        let tris = init("tris", bytemuck::cast_slice(setup.tris), rw);
+        let groups = init("groups", bytemuck::cast_slice(setup.groups), rw);
+        let tri_power = init("tri_power", &vec![0u8; setup.tris.len() * 32], rw);
+        let selection = init("selection", &[0u8; std::mem::size_of::<GpuSelection>()], rw);
+        let samples = init("samples", &vec![0u8; setup.sample_capacity.max(1) as usize * SAMPLE_SIZE as usize], rw);
+        let ldt = init("ldt", &vec![0u8; setup.ldt_capacity.max(4) * 4], rw);
+        let vertices = init("vertices", bytemuck::cast_slice(setup.vertices), wgpu::BufferUsages::STORAGE);
+
+        let visibility = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("visibility"),
+            size: wgpu::Extent3d { width: setup.res, height: setup.res, depth_or_array_layers: setup.layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let array_view = visibility.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let layer_views = (0..setup.layers)
+            .map(|layer| {
+                visibility.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("depth"),
+            size: wgpu::Extent3d { width: setup.res, height: setup.res, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let depth_view = depth.create_view(&Default::default());
+
+        let common = include_str!("shaders/common.wgsl");
+        let solver_source = format!("{common}\n{}", include_str!("shaders/solver.wgsl"));
+        let render_source = format!("{common}\n{}", include_str!("shaders/visibility.wgsl"));
+        let solver_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("solver.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(solver_source.into()),
+        });
+        let render_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("visibility.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(render_source.into()),
+        });
+
+        let c = wgpu::ShaderStages::COMPUTE;
+        let mut entries = vec![uniform(0, c)];
+        entries.extend((1..=9).map(|b| storage(b, c, false)));
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 10,
+            visibility: c,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            count: None,
+        });
+        let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("solver"), entries: &entries });
+        let buffers = [&params, &texels, &radiosity, &residual, &tris, &groups, &tri_power, &selection, &samples, &ldt];
+        let mut bind: Vec<wgpu::BindGroupEntry> =
+            buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+        bind.push(wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&array_view) });
+        let compute_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("solver"), layout: &compute_layout, entries: &bind });
+        let compute_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("solver"), bind_group_layouts: &[Some(&compute_layout)], immediate_size: 0 });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&compute_pipeline_layout),
+                module: &solver_module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+
+        let v = wgpu::ShaderStages::VERTEX;
+        let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("visibility"),
+            entries: &[uniform(0, v), storage(1, v, true), storage(2, v, true)],
+        });
+        let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("visibility"),
+            layout: &render_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: samples.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: vertices.as_entire_binding() },
+            ],
+        });
+        let render_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("visibility"), bind_group_layouts: &[Some(&render_layout)], immediate_size: 0 });
+        let render = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("visibility"),
+            layout: Some(&render_pipeline_layout),
+            vertex: wgpu::VertexState { module: &render_module, entry_point: Some("vs"), compilation_options: Default::default(), buffers: &[] },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &render_module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format: wgpu::TextureFormat::R32Float, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Gpu {
+            texel_count: setup.texels.len() as u32,
+            tri_count: setup.tris.len() as u32,
+            params,
+            radiosity,
+            residual,
+            tri_power,
+            selection,
+            samples,
+            ldt,
+            vertex_count: setup.vertices.len() as u32,
+            compute_group,
+            render_group,
+            reduce: pipeline("reduce"),
+            select: pipeline("select_shooter"),
+            prepare: pipeline("prepare_samples"),
+            finish: pipeline("finish_shooter"),
+            receive: pipeline("receive"),
+            render,
+            layer_views,
+            depth_view,
+            res: setup.res,
+            layers: setup.layers,
+            sample_capacity: setup.sample_capacity.max(1),
+        }
+    }
+
+    fn dispatch(&self, encoder: &mut wgpu::CommandEncoder, pipeline: &wgpu::ComputePipeline, x: u32, y: u32) {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.compute_group, &[]);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+
+    /// Reduction and selection (004 Sec. 2.3): returns the selection.
+    pub fn select(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams) -> GpuSelection {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let n = self.tri_count;
+        self.dispatch(&mut encoder, &self.reduce, n.min(32768), n.div_ceil(32768));
+        self.dispatch(&mut encoder, &self.select, 1, 1);
+        queue.submit([encoder.finish()]);
+        bytemuck::pod_read_unaligned(&read_buffer(device, queue, &self.selection, std::mem::size_of::<GpuSelection>() as u64))
+    }
+
+    /// Writes the samples of a shot (positions and frames; the powers of
+    /// area samples are filled in on the GPU by `prepare`) and, for a
+    /// light, its distribution table.
+    pub fn upload_samples(&self, queue: &wgpu::Queue, samples: &[GpuSample], ldt: Option<&[f32]>) {
+        queue.write_buffer(&self.samples, 0, bytemuck::cast_slice(samples));
+        if let Some(table) = ldt {
+            queue.write_buffer(&self.ldt, 0, bytemuck::cast_slice(table));
+        }
+    }
+
+    /// Fills the powers of the shooter's samples from its residual.
+    pub fn prepare(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams) {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.dispatch(&mut encoder, &self.prepare, params.group_count.div_ceil(64), 1);
+        queue.submit([encoder.finish()]);
+    }
+
+    /// Renders the visibility maps of one batch of samples and runs the
+    /// receiver pass over every texel.
+    pub fn shoot_batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool) {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        for sample in 0..params.sample_count {
+            for face in 0..params.layers_per_sample {
+                // A hemicube leaves out the face looking back (5) and needs
+                // only the top half of the side faces (up = the normal).
+                if hemicube && face == 5 {
+                    continue;
+                }
+                let layer = sample * params.layers_per_sample + face;
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: None,
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &self.layer_views[layer as usize],
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r: 1e30, g: 0.0, b: 0.0, a: 0.0 }), store: wgpu::StoreOp::Store },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &self.depth_view,
+                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.render);
+                pass.set_bind_group(0, &self.render_group, &[]);
+                if hemicube && face > 0 && params.mode == 0 {
+                    pass.set_scissor_rect(0, 0, self.res, self.res.div_ceil(2));
+                }
+                pass.draw(0..self.vertex_count, layer..layer + 1);
+            }
+        }
+        let groups = self.texel_count.div_ceil(64);
+        let (x, y) = if groups <= 65535 { (groups.max(1), 1) } else { (65535, groups.div_ceil(65535)) };
+        self.dispatch(&mut encoder, &self.receive, x, y);
+        queue.submit([encoder.finish()]);
+    }
+
+    /// Sets the shooter's residual to -dB' (0 without overshooting).
+    pub fn finish(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, shooter_texels: u32) {
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.dispatch(&mut encoder, &self.finish, shooter_texels.div_ceil(64).max(1), 1);
+        queue.submit([encoder.finish()]);
+    }
+
+    /// Reads back a vec4 buffer (radiosity, residual, tri_power).
+    pub fn read_vec4(&self, device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buffer, count: usize) -> Vec<[f32; 4]> {
+        let bytes = read_buffer(device, queue, buffer, (count * 16) as u64);
+        bytemuck::pod_collect_to_vec(&bytes)
+    }
+}
+
+/// Copies `size` bytes of `buffer` to a mappable buffer and reads them.
+pub fn read_buffer(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buffer, size: u64) -> Vec<u8> {
+    let size = size.max(4);
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    queue.submit([encoder.finish()]);
+    staging.map_async(wgpu::MapMode::Read, .., |result| result.expect("mapping a readback buffer"));
+    device.poll(wgpu::PollType::wait_indefinitely()).expect("waiting for the GPU");
+    let bytes = staging.get_mapped_range(..).expect("mapped range").to_vec();
+    staging.unmap();
+    bytes
+}

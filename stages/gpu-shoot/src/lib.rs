@@ -1,0 +1,454 @@
+//! # gpu-shoot: progressive radiosity on the GPU
+//!
+//! Paper 004 (chapters 2-4): every triangle gets a region of float
+//! lightmap atlases holding radiosity and residual (unshot) radiosity
+//! ([`atlas`]); each shot selects on the GPU the triangle with the largest
+//! residual power (with ambient overshooting, 004 Sec. 4.3.5: the largest
+//! `(dB + dB') A`), renders the scene from each of its substructured
+//! samples into visibility maps (a hemicube by rasterization, or the
+//! paper's single-pass stereographic projection), and lets every covered
+//! texel of the atlas test its depth against them and gather the
+//! disc-approximation form factor (Eq. 2.2 / 4.1) times the shot power,
+//! scaled by its reflectance (Eq. 4.2-4.3). Goniometric lights
+//! ([`photometry`]: EULUMDAT and IES) shoot first, as point sources with
+//! intensity `I_max LDT(C, gamma)` (Eq. 3.4) over a full cube of faces.
+//!
+//! The result is written as the lightmap atlas with its region table
+//! (`schemas::lightmap`), and as a `solution.exr` whose leaves average the
+//! atlas ([`output`]), so `grid-gather --mode preview`, `tonemap` and
+//! `compare` treat it like a hierarchical solution.
+//!
+//! | parameter | meaning | default |
+//! |---|---|---|
+//! | `texels` | covered texels to aim for over the whole scene | 32768 |
+//! | `min_size`, `max_size` | bounds of a region's side, texels | 2, 512 |
+//! | `shoot_level` | substructuring: shoot from groups of `2^level` x `2^level` texels | 3 |
+//! | `visibility` | `hemicube` or `stereographic` | `hemicube` |
+//! | `resolution` | side of a hemicube face / the stereographic map, pixels | 128 |
+//! | `tolerance` | relative depth tolerance of the visibility test | 0.02 |
+//! | `overshoot` | ambient overshooting (004 Eq. 4.9) | true |
+//! | `convergence` | stop when this fraction of the emitted power is shot | 0.99 |
+//! | `max_shots` | stop after this many shots | 100000 |
+//! | `ambient` | add `rho x ambient` (Eq. 2.4) to the solution's radiosity | true |
+//! | `texels_per_leaf` | solution leaves: about this many texels each | 4 |
+
+pub mod atlas;
+pub mod gpu;
+pub mod output;
+pub mod photometry;
+pub mod reference;
+pub mod testing;
+
+use atlas::Atlas;
+use glam::DVec3;
+use gpu::{Gpu, GpuGroup, GpuParams, GpuSample, GpuTexel, GpuTri, Setup};
+use schemas::lightmap::Shot;
+use schemas::mesh::{Manifest, Mesh};
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// How visibility from a shooting sample is found.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Visibility {
+    /// Five faces of a cube around the normal, by rasterization (Cohen and
+    /// Greenberg; 004 Table 4.1 "hc").
+    #[default]
+    Hemicube,
+    /// The hemisphere in one pass by the stereographic projection of the
+    /// vertices (004 Sec. 2.3; edges stay straight, so large triangles near
+    /// the horizon are distorted, 004 Fig. 4.4).
+    Stereographic,
+}
+
+/// The stage's parameters (see the table in the crate documentation).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// Covered texels to aim for over the scene.
+    pub texels: f64,
+    /// Smallest region side, texels.
+    pub min_size: u32,
+    /// Largest region side, texels.
+    pub max_size: u32,
+    /// Substructuring level: samples are groups of `2^level` squared texels.
+    pub shoot_level: u32,
+    /// Hemicube or stereographic projection.
+    pub visibility: Visibility,
+    /// Visibility map side, pixels.
+    pub resolution: u32,
+    /// Relative depth tolerance of the visibility test.
+    pub tolerance: f64,
+    /// Ambient overshooting.
+    pub overshoot: bool,
+    /// Stop when this fraction of the emitted power has been shot.
+    pub convergence: f64,
+    /// Stop after this many shots.
+    pub max_shots: usize,
+    /// Add rho x ambient to the solution's radiosity.
+    pub ambient: bool,
+    /// Texels per solution leaf, about.
+    pub texels_per_leaf: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            texels: 32768.0,
+            min_size: 2,
+            max_size: 512,
+            shoot_level: 3,
+            visibility: Visibility::Hemicube,
+            resolution: 128,
+            tolerance: 0.02,
+            overshoot: true,
+            convergence: 0.99,
+            max_shots: 100_000,
+            ambient: true,
+            texels_per_leaf: 4.0,
+        }
+    }
+}
+
+impl Params {
+    /// What is wrong with these parameters, if anything.
+    pub fn problem(&self) -> Option<String> {
+        if !(self.texels.is_finite() && self.texels >= 1.0) {
+            return Some(format!("texels must be at least 1, got {}", self.texels));
+        }
+        if self.min_size < 2 || self.max_size < self.min_size || self.max_size > 4096 {
+            return Some(format!("need 2 <= min_size <= max_size <= 4096, got {} and {}", self.min_size, self.max_size));
+        }
+        if self.shoot_level > 8 {
+            return Some(format!("shoot_level must be at most 8, got {}", self.shoot_level));
+        }
+        if !(8..=2048).contains(&self.resolution) {
+            return Some(format!("resolution must be in 8..=2048, got {}", self.resolution));
+        }
+        if !(self.tolerance.is_finite() && (0.0..0.5).contains(&self.tolerance)) {
+            return Some(format!("tolerance must be in [0, 0.5), got {}", self.tolerance));
+        }
+        if !(self.convergence.is_finite() && (0.0..=1.0).contains(&self.convergence)) {
+            return Some(format!("convergence must be in [0, 1], got {}", self.convergence));
+        }
+        if !(self.texels_per_leaf.is_finite() && self.texels_per_leaf >= 1.0) {
+            return Some(format!("texels_per_leaf must be at least 1, got {}", self.texels_per_leaf));
+        }
+        None
+    }
+}
+
+/// A goniometric point light ready to shoot.
+#[derive(Clone, Debug)]
+pub struct PointLight {
+    /// The normalised distribution.
+    pub ldt: photometry::Ldt,
+    /// Position, mesh frame, m.
+    pub position: [f64; 3],
+    /// Nadir direction (unit).
+    pub nadir: [f64; 3],
+    /// Multiplier on the file's intensities.
+    pub scale: f64,
+}
+
+impl PointLight {
+    /// Radiant intensity at the distribution's maximum, W/sr:
+    /// `scale x I_max / 683` (004 Eq. 2.12).
+    pub fn i_max_w_per_sr(&self) -> f64 {
+        self.scale * self.ldt.i_max / photometry::K_M
+    }
+
+    /// The light's frame `(r0, u0, n0)`: `n0` the nadir; `r0`, the C0
+    /// direction, is the mesh-frame x axis made perpendicular to the nadir
+    /// (the z axis when the nadir is nearly along x): the manifest gives
+    /// no C0 direction, so this fixed choice keeps a scene reproducible.
+    pub fn frame(&self) -> [DVec3; 3] {
+        frame_with_normal(DVec3::from(self.nadir).normalize())
+    }
+
+    /// Radiant flux, W (the same in R, G, B).
+    pub fn flux(&self) -> f64 {
+        self.scale * self.ldt.flux() / photometry::K_M
+    }
+
+    /// The LDT as the shader reads it: `[nc, ng, C angles, gamma angles, values]`.
+    pub fn table(&self) -> Vec<f32> {
+        let l = &self.ldt;
+        let mut t = vec![l.c_angles.len() as f32, l.gamma_angles.len() as f32];
+        t.extend(l.c_angles.iter().map(|&x| x as f32));
+        t.extend(l.gamma_angles.iter().map(|&x| x as f32));
+        t.extend(l.values.iter().map(|&x| x as f32));
+        t
+    }
+}
+
+/// A frame `(t, b, n)` with `n` given: `t` is the x axis (or z when `n` is
+/// nearly along x) made perpendicular to `n`, `b = n x t`.
+pub fn frame_with_normal(n: DVec3) -> [DVec3; 3] {
+    let seed = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Z };
+    let t = (seed - n * seed.dot(n)).normalize();
+    [t, n.cross(t), n]
+}
+
+/// The work a solve did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Work {
+    /// Shots fired (lights included).
+    pub shots: usize,
+    /// Shooting samples over all shots.
+    pub samples: u64,
+    /// Visibility map layers rendered.
+    pub layers: u64,
+    /// Texel-sample pairs evaluated by the receiver pass.
+    pub receiver_evaluations: u64,
+    /// Seconds spent before the first shot.
+    pub setup_seconds: f64,
+    /// Seconds spent shooting.
+    pub shoot_seconds: f64,
+}
+
+/// The result of a solve.
+#[derive(Clone, Debug)]
+pub struct Solved {
+    /// The atlas layout.
+    pub atlas: Atlas,
+    /// Radiosity per covered texel (order of `atlas.texels`), W/m².
+    pub radiosity: Vec<[f32; 3]>,
+    /// Residual per covered texel, W/m².
+    pub residual: Vec<[f32; 3]>,
+    /// Ambient term at the end (004 Eq. 2.4), W/m², RGB.
+    pub ambient: [f64; 3],
+    /// Total emitted power (surfaces and lights), W, RGB.
+    pub emitted_power: [f64; 3],
+    /// Unshot fraction before the first shot.
+    pub initial_unshot: f64,
+    /// Every shot.
+    pub shots: Vec<Shot>,
+    /// Work counters.
+    pub work: Work,
+}
+
+fn sum3(v: [f64; 3]) -> f64 {
+    v[0] + v[1] + v[2]
+}
+
+/// Runs the progressive solver on `device` / `queue`. `on_shot` sees every
+/// shot as it completes (for a progress bar).
+pub fn solve(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mesh: &Mesh,
+    manifest: &Manifest,
+    lights: &[PointLight],
+    params: &Params,
+    on_shot: &mut dyn FnMut(&Shot),
+) -> Result<Solved, String> {
+    let started = Instant::now();
+    if mesh.triangles.is_empty() {
+        return Err("the mesh has no triangles".into());
+    }
+    let atlas = atlas::bake(mesh, manifest, params.texels, params.min_size, params.max_size, params.shoot_level);
+    let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
+    let f4 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+    let texels: Vec<GpuTexel> = atlas
+        .texels
+        .iter()
+        .map(|x| {
+            let tri = &mesh.triangles[x.triangle as usize];
+            GpuTexel {
+                position_area: [x.position[0], x.position[1], x.position[2], x.area],
+                normal_triangle: [tri.normal[0], tri.normal[1], tri.normal[2], f32::from_bits(x.triangle)],
+                rho: f4(material(x.triangle as usize).diffuse),
+            }
+        })
+        .collect();
+    let emission: Vec<[f32; 4]> = atlas.texels.iter().map(|x| f4(material(x.triangle as usize).emission)).collect();
+    let tris: Vec<GpuTri> = atlas
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(t, r)| GpuTri {
+            first: r.first,
+            count: r.count,
+            group_first: r.group_first,
+            group_count: r.group_count,
+            area: atlas.texels[r.first as usize..(r.first + r.count) as usize].iter().map(|x| x.area).sum(),
+            _pad: [0.0; 3],
+            rho: f4(material(t).diffuse),
+        })
+        .collect();
+    let groups: Vec<GpuGroup> = atlas.groups.iter().map(|g| GpuGroup { first: g.first, count: g.count, _pad: [0; 2] }).collect();
+    let vertices: Vec<[f32; 4]> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| t.vertices.map(|v| {
+            let p = mesh.positions[v as usize];
+            [p[0], p[1], p[2], 1.0]
+        }))
+        .collect();
+    // Scene size: near plane, far distance, and the sample offset.
+    let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+    for p in &mesh.positions {
+        let p = DVec3::from(p.map(f64::from));
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    for l in lights {
+        lo = lo.min(DVec3::from(l.position));
+        hi = hi.max(DVec3::from(l.position));
+    }
+    let diagonal = (hi - lo).length().max(1e-6);
+    let hemicube = params.visibility == Visibility::Hemicube;
+    let layers_per_sample = if hemicube { 6 } else { 1 };
+    let max_groups = atlas.triangles.iter().map(|t| t.group_count).max().unwrap_or(1).max(1);
+    // Visibility layers per batch: at most 256 (WebGPU's default array
+    // limit) and 256 MiB of maps.
+    let per_layer = 4 * (params.resolution as u64).pow(2);
+    let layer_budget = (256u64).min((256u64 << 20) / per_layer).max(6) as u32;
+    let batch = (layer_budget / 6).max(1);
+    let layers = if hemicube { batch * 6 } else { (layer_budget / 6 * 6).max(6) };
+    let batch_area = if hemicube { batch } else { layers };
+    let ldt_capacity = lights.iter().map(|l| l.table().len()).max().unwrap_or(4);
+    let gpu = Gpu::new(
+        device,
+        &Setup {
+            texels: &texels,
+            tris: &tris,
+            groups: &groups,
+            emission: &emission,
+            vertices: &vertices,
+            res: params.resolution,
+            layers,
+            sample_capacity: max_groups.max(1),
+            ldt_capacity,
+        },
+    );
+    let total_area: f64 = tris.iter().map(|t| t.area as f64).sum();
+    let mut interreflection = [0.0f32; 4];
+    for c in 0..3 {
+        let mean_rho: f64 = tris.iter().map(|t| t.rho[c] as f64 * t.area as f64).sum::<f64>() / total_area;
+        interreflection[c] = (1.0 / (1.0 - mean_rho).max(1e-6)) as f32;
+    }
+    let mut emitted = [0.0f64; 3];
+    for (t, tri) in tris.iter().enumerate() {
+        for (c, e) in emitted.iter_mut().enumerate() {
+            *e += material(t).emission[c] * tri.area as f64;
+        }
+    }
+    let light_flux: Vec<f64> = lights.iter().map(PointLight::flux).collect();
+    for f in &light_flux {
+        for e in emitted.iter_mut() {
+            *e += f;
+        }
+    }
+    let emitted_total = sum3(emitted).max(f64::MIN_POSITIVE);
+    let base = GpuParams {
+        n_texels: texels.len() as u32,
+        n_tris: tris.len() as u32,
+        shooter: u32::MAX,
+        res: params.resolution,
+        mode: if hemicube { 0 } else { 1 },
+        overshoot: params.overshoot as u32,
+        tolerance: params.tolerance as f32,
+        near: (1e-5 * diagonal) as f32,
+        far: (4.0 * diagonal) as f32,
+        total_area: total_area as f32,
+        interreflection,
+        ..Default::default()
+    };
+    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), ..Default::default() };
+    let shooting = Instant::now();
+    let mut shots = Vec::new();
+    let mut unshot_lights: f64 = light_flux.iter().map(|f| 3.0 * f).sum();
+    let unshot_of = |sel: &gpu::GpuSelection, lights: f64| {
+        (sel.unshot[0] as f64 + sel.unshot[1] as f64 + sel.unshot[2] as f64 + lights).abs() / emitted_total
+    };
+    let magnitude_of = |sel: &gpu::GpuSelection, lights: f64| {
+        (sel.unshot_abs[0] as f64 + sel.unshot_abs[1] as f64 + sel.unshot_abs[2] as f64 + lights) / emitted_total
+    };
+    let mut selection = gpu.select(device, queue, &base);
+    let initial_unshot = unshot_of(&selection, unshot_lights);
+    let offset = 1e-6 * diagonal;
+    // Lights first: all their power is unshot, and a point source shoots
+    // once (6 full cube faces; the stereographic map covers a hemisphere
+    // only, so lights always use the cube).
+    for (k, light) in lights.iter().enumerate() {
+        if shots.len() >= params.max_shots {
+            break;
+        }
+        let [r0, u0, n0] = light.frame();
+        let i = light.i_max_w_per_sr() as f32;
+        let p = light.position;
+        let sample = GpuSample {
+            position_area: [p[0] as f32, p[1] as f32, p[2] as f32, 0.0],
+            t: f4(r0.to_array()),
+            b: f4(u0.to_array()),
+            n: f4(n0.to_array()),
+            power: [i, i, i, 1.0],
+        };
+        gpu.upload_samples(queue, &[sample], Some(&light.table()));
+        let p = GpuParams { shooter: u32::MAX, sample_first: 0, sample_count: 1, layers_per_sample: 6, mode: 0, ..base };
+        gpu.shoot_batch(device, queue, &p, false);
+        work.layers += 6;
+        work.samples += 1;
+        work.receiver_evaluations += texels.len() as u64;
+        unshot_lights -= 3.0 * light_flux[k];
+        selection = gpu.select(device, queue, &base);
+        let shot = Shot { shooter: format!("light {k}"), samples: 1, unshot_fraction: unshot_of(&selection, unshot_lights), unshot_magnitude_fraction: magnitude_of(&selection, unshot_lights), seconds: shooting.elapsed().as_secs_f64() };
+        on_shot(&shot);
+        shots.push(shot);
+    }
+    while shots.len() < params.max_shots && unshot_of(&selection, unshot_lights) > 1.0 - params.convergence {
+        let shooter = selection.shooter[0];
+        if shooter as usize >= tris.len() || selection.score[0] <= 0.0 {
+            break;
+        }
+        let range = atlas.triangles[shooter as usize];
+        let normal = DVec3::from(mesh.triangles[shooter as usize].normal.map(f64::from));
+        let [t, b, n] = frame_with_normal(normal);
+        let samples: Vec<GpuSample> = atlas.groups[range.group_first as usize..(range.group_first + range.group_count) as usize]
+            .iter()
+            .map(|g| {
+                let c = DVec3::from(g.centroid.map(f64::from)) + n * offset;
+                GpuSample {
+                    position_area: [c.x as f32, c.y as f32, c.z as f32, g.area],
+                    t: f4(t.to_array()),
+                    b: f4(b.to_array()),
+                    n: f4(n.to_array()),
+                    power: [0.0; 4],
+                }
+            })
+            .collect();
+        gpu.upload_samples(queue, &samples, None);
+        let shot_params = GpuParams { shooter, group_count: range.group_count, layers_per_sample, ..base };
+        gpu.prepare(device, queue, &shot_params);
+        let mut first = 0;
+        while first < range.group_count {
+            let count = (range.group_count - first).min(batch_area);
+            let p = GpuParams { sample_first: first, sample_count: count, ..shot_params };
+            gpu.shoot_batch(device, queue, &p, hemicube);
+            work.layers += count as u64 * if hemicube { 5 } else { 1 };
+            first += count;
+        }
+        gpu.finish(device, queue, &shot_params, range.count);
+        work.samples += range.group_count as u64;
+        work.receiver_evaluations += texels.len() as u64 * range.group_count as u64;
+        selection = gpu.select(device, queue, &base);
+        let shot = Shot {
+            shooter: format!("triangle {shooter}"),
+            samples: range.group_count,
+            unshot_fraction: unshot_of(&selection, unshot_lights),
+            unshot_magnitude_fraction: magnitude_of(&selection, unshot_lights),
+            seconds: shooting.elapsed().as_secs_f64(),
+        };
+        on_shot(&shot);
+        shots.push(shot);
+    }
+    work.shots = shots.len();
+    work.shoot_seconds = shooting.elapsed().as_secs_f64();
+    let n = texels.len();
+    let radiosity = gpu.read_vec4(device, queue, &gpu.radiosity, n).into_iter().map(|v| [v[0], v[1], v[2]]).collect();
+    let residual = gpu.read_vec4(device, queue, &gpu.residual, n).into_iter().map(|v| [v[0], v[1], v[2]]).collect();
+    let ambient = [0, 1, 2].map(|c| selection.ambient[c] as f64);
+    Ok(Solved { atlas, radiosity, residual, ambient, emitted_power: emitted, initial_unshot, shots, work })
+}

@@ -1,0 +1,248 @@
+//! `gpu-shoot`: see the library's documentation and `--help`.
+
+use clap::Parser;
+use gpu_shoot::{gpu, output, photometry, solve, Params, PointLight, Visibility};
+use schemas::header::Schema;
+use schemas::lightmap::{Convergence, Lightmap};
+use schemas::mesh::{Effects, Manifest, Mesh};
+use schemas::ron_io::{read_bytes, read_ron, write_ron};
+use schemas::solution::Solution;
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, Outputs, Run};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Progressive radiosity on the GPU (paper 004): per-triangle float
+/// lightmaps, shooter selection by GPU reduction, hemicube or stereographic
+/// visibility, disc-approximation form factors, ambient overshooting,
+/// goniometric lights (.ldt/.ies). Writes the lightmap atlas (EXR), a
+/// solution.exr that grid-gather previews, and a convergence record.
+/// Runs on any Vulkan adapter, Mesa's lavapipe included.
+#[derive(Parser, Debug)]
+#[command(name = "gpu-shoot", version)]
+struct Args {
+    /// Input: mesh.exr from mesh-prep.
+    #[arg(long, required_unless_present = "print_params")]
+    mesh: Option<PathBuf>,
+    /// Input: manifest.ron from mesh-prep.
+    #[arg(long, required_unless_present = "print_params")]
+    manifest: Option<PathBuf>,
+    /// Output: the solution (elements averaging the atlas; no links).
+    #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
+    output: Option<PathBuf>,
+    /// Output: the lightmap atlas and its region table (EXR).
+    #[arg(long)]
+    lightmap: Option<PathBuf>,
+    /// Output: shots, unshot fraction and time per shot (RON; timings are volatile).
+    #[arg(long)]
+    convergence: Option<PathBuf>,
+    /// Output: a plot of the unshot fraction against time (SVG).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Output: a report of the run (RON: work done, wall time).
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Read parameters from this RON file; flags below override it.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Print the effective parameters as RON and exit.
+    #[arg(long)]
+    print_params: bool,
+    /// Covered texels to aim for over the scene.
+    #[arg(long)]
+    texels: Option<f64>,
+    /// Substructuring: shoot from groups of 2^level x 2^level texels.
+    #[arg(long)]
+    shoot_level: Option<u32>,
+    /// Visibility: hemicube or stereographic.
+    #[arg(long, value_enum)]
+    visibility: Option<Visibility>,
+    /// Visibility map side, pixels.
+    #[arg(long)]
+    resolution: Option<u32>,
+    /// Relative depth tolerance of the visibility test.
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// Ambient overshooting (004 Eq. 4.9).
+    #[arg(long, overrides_with = "no_overshoot")]
+    overshoot: bool,
+    /// No ambient overshooting.
+    #[arg(long)]
+    no_overshoot: bool,
+    /// Stop when this fraction of the emitted power has been shot.
+    #[arg(long)]
+    convergence_target: Option<f64>,
+    /// Stop after this many shots.
+    #[arg(long)]
+    max_shots: Option<usize>,
+    /// Add rho x ambient to the solution (display).
+    #[arg(long, overrides_with = "no_ambient")]
+    ambient: bool,
+    /// Leave the ambient term out of the solution.
+    #[arg(long)]
+    no_ambient: bool,
+    /// Texels per solution leaf, about.
+    #[arg(long)]
+    texels_per_leaf: Option<f64>,
+}
+
+fn params_of(args: &Args) -> schemas::Result<Params> {
+    let mut p: Params = load_params(args.params.as_deref())?;
+    p.texels = args.texels.unwrap_or(p.texels);
+    p.shoot_level = args.shoot_level.unwrap_or(p.shoot_level);
+    p.visibility = args.visibility.unwrap_or(p.visibility);
+    p.resolution = args.resolution.unwrap_or(p.resolution);
+    p.tolerance = args.tolerance.unwrap_or(p.tolerance);
+    if args.overshoot {
+        p.overshoot = true;
+    }
+    if args.no_overshoot {
+        p.overshoot = false;
+    }
+    p.convergence = args.convergence_target.unwrap_or(p.convergence);
+    p.max_shots = args.max_shots.unwrap_or(p.max_shots);
+    if args.ambient {
+        p.ambient = true;
+    }
+    if args.no_ambient {
+        p.ambient = false;
+    }
+    p.texels_per_leaf = args.texels_per_leaf.unwrap_or(p.texels_per_leaf);
+    match p.problem() {
+        Some(problem) => Err(bad_parameter(problem)),
+        None => Ok(p),
+    }
+}
+
+fn skipped(effects: &Effects) -> Vec<String> {
+    let mut skipped = Vec::new();
+    let mut note = |present: bool, what: &str| {
+        if present {
+            skipped.push(what.to_string());
+        }
+    };
+    note(effects.diffuse_transmission, "diffuse transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.1, a later issue)");
+    note(effects.specular_reflection, "specular reflection: not simulated by gpu-shoot yet (004 Sec. 4.3.2); mirrors keep their diffuse part");
+    note(effects.specular_transmission, "specular transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.3)");
+    note(effects.alpha_masks, "alpha masks: surfaces are treated as opaque (004 Sec. 4.3.4, a later issue)");
+    note(effects.normal_maps, "normal maps: texels use the geometric normal (004 Sec. 2.3.3, a later issue)");
+    note(effects.textures, "textures: radiosity uses each material's mean diffuse reflectance");
+    note(effects.fine_clustered_geometry, "adaptive subdivision: not done; region sizes are fixed per object");
+    skipped
+}
+
+/// An SVG plot of the unshot fraction (log scale) against time.
+fn plot_svg(convergence: &Convergence) -> String {
+    let (w, h, m) = (640.0, 400.0, 50.0);
+    let t_max = convergence.shots.last().map(|s| s.seconds).unwrap_or(1.0).max(1e-9);
+    let floor = convergence.shots.iter().map(|s| s.unshot_fraction).fold(1.0f64, f64::min).max(1e-6);
+    let decades = (-floor.log10()).ceil().max(1.0);
+    let x = |t: f64| m + (w - 2.0 * m) * t / t_max;
+    let y = |f: f64| m + (h - 2.0 * m) * (-f.max(1e-12).log10() / decades).min(1.0);
+    let mut points = format!("{:.1},{:.1}", x(0.0), y(convergence.initial_unshot_fraction));
+    for s in &convergence.shots {
+        points += &format!(" {:.1},{:.1}", x(s.seconds), y(s.unshot_fraction));
+    }
+    let mut svg = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n");
+    svg += &format!("<rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>\n");
+    svg += &format!("<polyline fill=\"none\" stroke=\"black\" points=\"{m},{m} {m},{} {},{}\"/>\n", h - m, w - m, h - m);
+    for d in 0..=decades as i32 {
+        let yy = y(10f64.powi(-d));
+        svg += &format!("<text x=\"4\" y=\"{:.1}\">1e-{d}</text><line x1=\"{m}\" x2=\"{}\" y1=\"{yy:.1}\" y2=\"{yy:.1}\" stroke=\"#ddd\"/>\n", yy + 4.0, w - m);
+    }
+    svg += &format!("<text x=\"{}\" y=\"{}\">{t_max:.3} s</text>\n", w - m - 30.0, h - m + 16.0);
+    svg += &format!("<text x=\"{m}\" y=\"20\">unshot fraction vs time, {} shots ({})</text>\n", convergence.shots.len(), convergence.adapter);
+    svg += &format!("<polyline fill=\"none\" stroke=\"#c33\" stroke-width=\"1.5\" points=\"{points}\"/>\n</svg>\n");
+    svg
+}
+
+fn run(args: Args) -> schemas::Result<ExitCode> {
+    let params = params_of(&args)?;
+    if args.print_params {
+        print_params(&params);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
+        unreachable!("clap requires the inputs and output without --print-params")
+    };
+    for path in [Some(output), args.lightmap.as_ref(), args.convergence.as_ref(), args.plot.as_ref(), args.report.as_ref()].into_iter().flatten() {
+        check_writable(path)?;
+    }
+    let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
+    let (mesh, mesh_input) = Mesh::read(mesh_path)?;
+    let manifest = read_ron::<Manifest>(manifest_path)?;
+    manifest.value.check_mesh(mesh_path, &mesh)?;
+    run.input(mesh_input);
+    run.input(manifest.input);
+    let mut lights = Vec::new();
+    for light in &manifest.value.goniometric_lights {
+        let path = Path::new(&light.file);
+        let bytes = read_bytes(path)?;
+        let text = String::from_utf8_lossy(&bytes);
+        let distribution = photometry::parse(path, &text)?;
+        run.input(schemas::header::Input::new(path, &bytes, None));
+        lights.push(PointLight { ldt: photometry::Ldt::new(&distribution), position: light.position, nadir: light.nadir, scale: light.scale });
+    }
+    let (device, queue, info) = gpu::acquire().map_err(|m| schemas::Error::invalid(Path::new("gpu"), None, m))?;
+    let adapter = gpu::describe(&info);
+    let bar = progress(1000, "converged");
+    let solved = solve(&device, &queue, &mesh, &manifest.value, &lights, &params, &mut |shot| {
+        bar.set_position(((1.0 - shot.unshot_fraction).clamp(0.0, 1.0) * 1000.0) as u64);
+        bar.set_message(format!("{} shots", 0));
+    })
+    .map_err(|m| schemas::Error::invalid(mesh_path, None, m))?;
+    bar.finish_and_clear();
+    let final_unshot = solved.shots.last().map(|s| s.unshot_fraction).unwrap_or(solved.initial_unshot);
+    eprintln!(
+        "gpu-shoot: {} shots, {} texels, unshot {:.4}, {:.3} s shooting on {adapter}",
+        solved.work.shots,
+        solved.atlas.texels.len(),
+        final_unshot,
+        solved.work.shoot_seconds
+    );
+    let provenance = run.provenance(&params);
+    let lightmap = output::lightmap(&solved, &mesh, Lightmap::header(provenance.clone()));
+    let ambient = params.ambient.then_some(solved.ambient);
+    let solution = output::solution(&lightmap, &mesh, &manifest.value, ambient, params.texels_per_leaf, Solution::header(provenance.clone()));
+    let convergence = Convergence {
+        header: Convergence::header(provenance),
+        adapter: adapter.clone(),
+        initial_unshot_fraction: solved.initial_unshot,
+        setup_seconds: solved.work.setup_seconds,
+        shots: solved.shots.clone(),
+    };
+    let mut outputs = Outputs::new();
+    outputs.write(output, |p| solution.write(p))?;
+    if let Some(path) = &args.lightmap {
+        outputs.write(path, |p| lightmap.write(p))?;
+    }
+    if let Some(path) = &args.convergence {
+        outputs.write(path, |p| write_ron(p, &convergence))?;
+    }
+    if let Some(path) = &args.plot {
+        let svg = plot_svg(&convergence);
+        outputs.write(path, |p| schemas::atomic::write_atomically(p, |w| std::io::Write::write_all(w, svg.as_bytes()).map_err(|e| schemas::Error::io(p, e))))?;
+    }
+    if let Some(report) = &args.report {
+        let w = &solved.work;
+        let counters = BTreeMap::from([
+            ("shots".to_string(), w.shots as f64),
+            ("samples".to_string(), w.samples as f64),
+            ("visibility_layers".to_string(), w.layers as f64),
+            ("receiver_evaluations".to_string(), w.receiver_evaluations as f64),
+            ("texels".to_string(), solved.atlas.texels.len() as f64),
+            ("unshot_fraction".to_string(), final_unshot),
+            ("setup_seconds".to_string(), w.setup_seconds),
+            ("shoot_seconds".to_string(), w.shoot_seconds),
+            ("seconds_per_shot".to_string(), w.shoot_seconds / (w.shots.max(1) as f64)),
+        ]);
+        let notes = vec![format!("adapter: {adapter}")];
+        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.value.effects), notes))?;
+    }
+    outputs.keep();
+    Ok(ExitCode::SUCCESS)
+}
+
+fn main() -> ExitCode {
+    exit_code("gpu-shoot", run(Args::parse()))
+}

@@ -1,0 +1,213 @@
+//! From the solved texels to the artifacts: the atlas image with seams
+//! filled (004 Sec. 2.3.1), bilinear lookup, and a `solution.exr` whose
+//! leaves average the atlas, so the preview gather renders it like a
+//! hierarchical solution.
+
+use crate::Solved;
+use glam::DVec3;
+use radiometry::geometry::TriangleGeometry;
+use radiometry::subdivision::{children, Corners, ROOT};
+use schemas::header::Header;
+use schemas::lightmap::{Lightmap, COVERED, FILLED};
+use schemas::mesh::{Manifest, Mesh};
+use schemas::solution::{Element, Solution, NONE};
+
+/// Fills the texels of every region that are not covered but that a
+/// bilinear lookup inside the triangle reads: two passes (004 Sec. 2.3.1
+/// does the same, "ping-pong", twice), each giving a texel with at least
+/// one covered or already filled 8-neighbour in its region the mean of
+/// those neighbours. Two passes reach every texel a lookup inside the
+/// triangle touches: the one-texel gutter and the two texel diagonals
+/// beyond the covered staircase. Filled texels are for display only; they
+/// take no part in the solution (as in the paper).
+pub fn fill_seams(lightmap: &mut Lightmap) {
+    let w = lightmap.width;
+    for region in lightmap.regions.clone() {
+        let (x0, y0, side) = (region.x as usize, region.y as usize, region.size as usize + 2);
+        for _ in 0..2 {
+            let mut updates = Vec::new();
+            for y in y0..y0 + side {
+                for x in x0..x0 + side {
+                    if lightmap.coverage[y * w + x] != 0.0 {
+                        continue;
+                    }
+                    let (mut sum_b, mut sum_r, mut count) = ([0.0f64; 3], [0.0f64; 3], 0usize);
+                    for ny in y.saturating_sub(1).max(y0)..(y + 2).min(y0 + side) {
+                        for nx in x.saturating_sub(1).max(x0)..(x + 2).min(x0 + side) {
+                            let k = ny * w + nx;
+                            if lightmap.coverage[k] != 0.0 {
+                                for c in 0..3 {
+                                    sum_b[c] += lightmap.radiosity[k][c] as f64;
+                                    sum_r[c] += lightmap.residual[k][c] as f64;
+                                }
+                                count += 1;
+                            }
+                        }
+                    }
+                    if count > 0 {
+                        let n = count as f64;
+                        updates.push((y * w + x, sum_b.map(|v| (v / n) as f32), sum_r.map(|v| (v / n) as f32)));
+                    }
+                }
+            }
+            for (k, b, r) in updates {
+                lightmap.radiosity[k] = b;
+                lightmap.residual[k] = r;
+                lightmap.coverage[k] = FILLED;
+            }
+        }
+    }
+}
+
+/// The lightmap artifact of a solve, seams filled.
+pub fn lightmap(solved: &Solved, mesh: &Mesh, header: Header) -> Lightmap {
+    let a = &solved.atlas;
+    let (w, h) = (a.width as usize, a.height as usize);
+    let mut lm = Lightmap {
+        header,
+        width: w,
+        height: h,
+        radiosity: vec![[0.0; 3]; w * h],
+        residual: vec![[0.0; 3]; w * h],
+        coverage: vec![0.0; w * h],
+        texel_area: vec![0.0; w * h],
+        position: vec![[0.0; 3]; w * h],
+        normal: vec![[0.0; 3]; w * h],
+        regions: a.regions.clone(),
+    };
+    for (k, t) in a.texels.iter().enumerate() {
+        let i = t.y as usize * w + t.x as usize;
+        lm.radiosity[i] = solved.radiosity[k];
+        lm.residual[i] = solved.residual[k];
+        lm.coverage[i] = COVERED;
+        lm.texel_area[i] = t.area;
+    }
+    // Positions and normals of every texel of a region, gutter included
+    // (the point of the triangle's plane its centre maps to).
+    for (t, r) in a.regions.iter().enumerate() {
+        let tri = &mesh.triangles[t];
+        let g = TriangleGeometry::new(tri.vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from))));
+        let n = r.size as f64;
+        for j in 0..r.size + 2 {
+            for i in 0..r.size + 2 {
+                let uv = [(i as f64 - 0.5) / n, (j as f64 - 0.5) / n];
+                let k = (r.y + j) as usize * w + (r.x + i) as usize;
+                lm.position[k] = g.point(uv).as_vec3().to_array();
+                lm.normal[k] = tri.normal;
+            }
+        }
+    }
+    fill_seams(&mut lm);
+    lm
+}
+
+/// Bilinear lookup of radiosity at barycentric `uv` of triangle `t`: the
+/// four texels around the point, in the region's texel grid (centres at
+/// `(i + 1/2) / size`).
+pub fn bilinear(lm: &Lightmap, t: usize, uv: [f64; 2]) -> [f64; 3] {
+    let r = lm.regions[t];
+    let n = r.size as f64;
+    // Texel coordinates, gutter included: interior texel i has centre at
+    // i + 1 + 1/2 in region pixels.
+    let fx = (uv[0] * n + 0.5).clamp(0.5, n + 1.5) - 0.5;
+    let fy = (uv[1] * n + 0.5).clamp(0.5, n + 1.5) - 0.5;
+    let (ix, iy) = (fx.floor().min(n), fy.floor().min(n));
+    let (tx, ty) = (fx - ix, fy - iy);
+    let at = |dx: f64, dy: f64| {
+        let k = (r.y as usize + (iy + dy) as usize) * lm.width + r.x as usize + (ix + dx) as usize;
+        lm.radiosity[k].map(f64::from)
+    };
+    let (a, b, c, d) = (at(0.0, 0.0), at(1.0, 0.0), at(0.0, 1.0), at(1.0, 1.0));
+    [0, 1, 2].map(|k| (a[k] * (1.0 - tx) + b[k] * tx) * (1.0 - ty) + (c[k] * (1.0 - tx) + d[k] * tx) * ty)
+}
+
+/// The solution: each triangle subdivided uniformly (1:4, the order of
+/// `radiometry::subdivision`) to the level whose leaves hold about
+/// `texels_per_leaf` covered texels; a leaf's radiosity is the mean of the
+/// bilinear lookups at its centroid and at the three points `(2/3, 1/6,
+/// 1/6)` of its corners (Dunavant's degree-2 rule plus the centroid), plus
+/// `rho x ambient` when asked (004 Eq. 2.4, for display). Inner elements
+/// hold the area-weighted mean of their children. No links, no clusters.
+pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, ambient: Option<[f64; 3]>, texels_per_leaf: f64, header: Header) -> Solution {
+    let mut elements: Vec<Element> = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| Element {
+            triangle: t as u32,
+            parent: NONE,
+            first_child: NONE,
+            level: 0,
+            corners: ROOT.map(|c| c.map(|x| x as f32)),
+            area: tri.area,
+            radiosity: [0.0; 3],
+        })
+        .collect();
+    let mut corners_of: Vec<Corners> = vec![ROOT; elements.len()];
+    for t in 0..mesh.triangles.len() {
+        let covered = lm.regions[t].covered as f64;
+        let depth = ((covered / texels_per_leaf).max(1.0).ln() / 4f64.ln()).floor().clamp(0.0, 8.0) as u32;
+        let mut frontier = vec![t];
+        for level in 1..=depth {
+            let mut next = Vec::new();
+            for parent in frontier {
+                let first = elements.len() as u32;
+                elements[parent].first_child = first;
+                for child in children(&corners_of[parent]) {
+                    next.push(elements.len());
+                    elements.push(Element {
+                        triangle: t as u32,
+                        parent: parent as u32,
+                        first_child: NONE,
+                        level,
+                        corners: child.map(|c| c.map(|x| x as f32)),
+                        area: (mesh.triangles[t].area as f64 / 4f64.powi(level as i32)) as f32,
+                        radiosity: [0.0; 3],
+                    });
+                    corners_of.push(child);
+                }
+            }
+            frontier = next;
+        }
+    }
+    let rho_ambient = |t: usize| -> [f64; 3] {
+        let rho = manifest.materials[mesh.triangles[t].material as usize].diffuse;
+        ambient.map(|a| [0, 1, 2].map(|c| rho[c] * a[c])).unwrap_or([0.0; 3])
+    };
+    for e in 0..elements.len() {
+        if !elements[e].is_leaf() {
+            continue;
+        }
+        let t = elements[e].triangle as usize;
+        let c = corners_of[e];
+        let point = |l: [f64; 3]| [l[0] * c[0][0] + l[1] * c[1][0] + l[2] * c[2][0], l[0] * c[0][1] + l[1] * c[1][1] + l[2] * c[2][1]];
+        let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
+        let points = [[1.0 / 3.0; 3], [a, b, b], [b, a, b], [b, b, a]];
+        let mut sum = [0.0; 3];
+        for l in points {
+            let v = bilinear(lm, t, point(l));
+            for k in 0..3 {
+                sum[k] += v[k] / 4.0;
+            }
+        }
+        let extra = rho_ambient(t);
+        elements[e].radiosity = [0, 1, 2].map(|k| (sum[k] + extra[k]) as f32);
+    }
+    // Inner elements: area-weighted mean of the children, deepest first.
+    for e in (0..elements.len()).rev() {
+        if elements[e].is_leaf() {
+            continue;
+        }
+        let first = elements[e].first_child as usize;
+        let mut sum = [0.0f64; 3];
+        let mut area = 0.0f64;
+        for child in &elements[first..first + 4] {
+            for k in 0..3 {
+                sum[k] += child.radiosity[k] as f64 * child.area as f64;
+            }
+            area += child.area as f64;
+        }
+        elements[e].radiosity = sum.map(|s| (s / area) as f32);
+    }
+    Solution { header, elements, clusters: Vec::new(), links: Vec::new() }
+}

@@ -1,0 +1,321 @@
+// Progressive radiosity kernels over the compact list of covered texels
+// (004 Sec. 2.2-2.3, 4.2, 4.3.5). One thread per texel or per triangle's
+// workgroup; every sum runs in a fixed order (per-thread strided loops,
+// then a fixed tree), so a rerun on the same device gives the same bits.
+
+struct Texel {
+    position: vec4<f32>, // xyz: centre, m; w: area it stands for, m^2
+    normal: vec4<f32>,   // xyz: unit normal; w: triangle index (bitcast)
+    rho: vec4<f32>,      // rgb: diffuse reflectance of its material
+};
+
+struct Tri {
+    first: u32,
+    count: u32,
+    group_first: u32,
+    group_count: u32,
+    area: f32,
+    _p0: f32,
+    _p1: f32,
+    _p2: f32,
+    rho: vec4<f32>,
+};
+
+struct Group {
+    first: u32,
+    count: u32,
+    _p0: u32,
+    _p1: u32,
+};
+
+struct Selection {
+    shooter: vec4<u32>,     // x: triangle with the largest score
+    overshoot: vec4<f32>,   // rgb: dB' of the shooter (004 Eq. 4.9), 0 without overshooting
+    ambient: vec4<f32>,     // rgb: ambient term (004 Eq. 2.4-2.6), W/m^2
+    unshot: vec4<f32>,      // rgb: sum dB A over covered texels, W
+    unshot_abs: vec4<f32>,  // rgb: sum |dB| A, W
+    score: vec4<f32>,       // x: the shooter's (dB + dB') A summed over channels, W
+};
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read_write> texels: array<Texel>;
+@group(0) @binding(2) var<storage, read_write> radiosity: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> residual: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read_write> tris: array<Tri>;
+@group(0) @binding(5) var<storage, read_write> groups: array<Group>;
+@group(0) @binding(6) var<storage, read_write> tri_power: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read_write> selection: Selection;
+@group(0) @binding(8) var<storage, read_write> samples: array<Sample>;
+@group(0) @binding(9) var<storage, read_write> ldt: array<f32>;
+@group(0) @binding(10) var visibility: texture_2d_array<f32>;
+
+const WG: u32 = 256u;
+const PI: f32 = 3.14159265358979;
+
+var<workgroup> sum_a: array<vec4<f32>, 256>;
+var<workgroup> sum_b: array<vec4<f32>, 256>;
+var<workgroup> best_score: array<f32, 256>;
+var<workgroup> best_index: array<u32, 256>;
+
+fn group_index(wg: vec3<u32>) -> u32 {
+    return wg.x + wg.y * 32768u;
+}
+
+// Residual power of each triangle: sum over its covered texels of dB A
+// (signed) and |dB| A, in tri_power[2t], tri_power[2t+1] (004 Sec. 2.3:
+// only covered texels count).
+@compute @workgroup_size(256)
+fn reduce(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let t = group_index(wg);
+    if (t >= params.n_tris) { return; }
+    let tri = tris[t];
+    var s = vec4<f32>(0.0);
+    var a = vec4<f32>(0.0);
+    for (var k = li; k < tri.count; k += WG) {
+        let i = tri.first + k;
+        let area = texels[i].position.w;
+        let r = residual[i];
+        s += vec4<f32>(r.xyz * area, area);
+        a += vec4<f32>(abs(r.xyz) * area, 0.0);
+    }
+    sum_a[li] = s;
+    sum_b[li] = a;
+    workgroupBarrier();
+    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
+        if (li < stride) {
+            sum_a[li] += sum_a[li + stride];
+            sum_b[li] += sum_b[li + stride];
+        }
+        workgroupBarrier();
+    }
+    if (li == 0u) {
+        tri_power[2u * t] = sum_a[0];
+        tri_power[2u * t + 1u] = sum_b[0];
+    }
+}
+
+fn overshoot_of(t: u32, total: vec3<f32>, ambient: vec3<f32>) -> vec3<f32> {
+    if (params.overshoot == 0u) { return vec3<f32>(0.0); }
+    let tri = tris[t];
+    let own = tri_power[2u * t].xyz;
+    // 004 Eq. 4.9: dB'_i = min(rho_i ambient, sum_j dB_j A_j / A_i - dB_i),
+    // never negative (a negative ambient would not converge).
+    let rest = (total - own) / tri.area;
+    return max(min(tri.rho.xyz * ambient, rest), vec3<f32>(0.0));
+}
+
+// Shooter selection (one workgroup): the triangle with the largest
+// |dB + dB'| A (channels summed), lowest index on ties, and the ambient term
+// A = R sum_j dB_j A_j / sum_k A_k (004 Eq. 2.4-2.6) in the same pass.
+@compute @workgroup_size(256)
+fn select_shooter(@builtin(local_invocation_index) li: u32) {
+    var s = vec4<f32>(0.0);
+    var a = vec4<f32>(0.0);
+    for (var t = li; t < params.n_tris; t += WG) {
+        s += tri_power[2u * t];
+        a += tri_power[2u * t + 1u];
+    }
+    sum_a[li] = s;
+    sum_b[li] = a;
+    workgroupBarrier();
+    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
+        if (li < stride) {
+            sum_a[li] += sum_a[li + stride];
+            sum_b[li] += sum_b[li + stride];
+        }
+        workgroupBarrier();
+    }
+    let total = sum_a[0].xyz;
+    let ambient = params.interreflection.xyz * total / params.total_area;
+    var score = -3.4e38;
+    var index = 0xffffffffu;
+    for (var t = li; t < params.n_tris; t += WG) {
+        let own = tri_power[2u * t].xyz;
+        let shot = own + overshoot_of(t, total, ambient) * tris[t].area;
+        // Magnitude: a negative residual (left by overshooting) must be
+        // shot back too, or it would never converge (Feda and Purgathofer).
+        let value = abs(shot.x) + abs(shot.y) + abs(shot.z);
+        if (value > score) { score = value; index = t; }
+    }
+    best_score[li] = score;
+    best_index[li] = index;
+    workgroupBarrier();
+    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
+        if (li < stride) {
+            let other = best_score[li + stride];
+            let oi = best_index[li + stride];
+            if (other > best_score[li] || (other == best_score[li] && oi < best_index[li])) {
+                best_score[li] = other;
+                best_index[li] = oi;
+            }
+        }
+        workgroupBarrier();
+    }
+    if (li == 0u) {
+        let shooter = best_index[0];
+        selection.shooter = vec4<u32>(shooter, 0u, 0u, 0u);
+        var o = vec3<f32>(0.0);
+        if (shooter != 0xffffffffu) { o = overshoot_of(shooter, total, ambient); }
+        selection.overshoot = vec4<f32>(o, 0.0);
+        selection.ambient = vec4<f32>(ambient, 0.0);
+        selection.unshot = vec4<f32>(total, 0.0);
+        selection.unshot_abs = sum_b[0];
+        selection.score = vec4<f32>(best_score[0], 0.0, 0.0, 0.0);
+    }
+}
+
+// The shooter's samples (substructuring, 004 Sec. 2.3): each group shoots
+// its texels' mean residual plus the overshoot dB'.
+@compute @workgroup_size(64)
+fn prepare_samples(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= params.group_count) { return; }
+    let g = groups[tris[params.shooter].group_first + id.x];
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < g.count; k += 1u) {
+        sum += residual[g.first + k].xyz;
+    }
+    samples[id.x].power = vec4<f32>(sum / f32(g.count) + selection.overshoot.xyz, 0.0);
+}
+
+// After the shot the shooter keeps -dB' (0 without overshooting).
+@compute @workgroup_size(64)
+fn finish_shooter(@builtin(global_invocation_id) id: vec3<u32>) {
+    let tri = tris[params.shooter];
+    if (id.x >= tri.count) { return; }
+    residual[tri.first + id.x] = vec4<f32>(-selection.overshoot.xyz, 0.0);
+}
+
+fn depth(x: i32, y: i32, layer: u32) -> f32 {
+    let r = i32(params.res);
+    return textureLoad(visibility, vec2<i32>(clamp(x, 0, r - 1), clamp(y, 0, r - 1)), i32(layer), 0).x;
+}
+
+// Whether the point at distance d that projects to (px, py) of `layer` is
+// visible: the centre pixel holds nothing nearer than d (within the
+// tolerance), or one of its 8 neighbours holds a surface at d (the
+// neighbour test of 004 Fig. 2.3, against silhouette artefacts).
+fn visible(px: f32, py: f32, layer: u32, d: f32) -> bool {
+    let x = i32(floor(px));
+    let y = i32(floor(py));
+    let tol = params.tolerance * d;
+    if (depth(x, y, layer) >= d - tol) { return true; }
+    for (var dy = -1; dy <= 1; dy += 1) {
+        for (var dx = -1; dx <= 1; dx += 1) {
+            if (abs(depth(x + dx, y + dy, layer) - d) <= tol) { return true; }
+        }
+    }
+    return false;
+}
+
+fn catmull_rom(p0: f32, p1: f32, p2: f32, p3: f32, t: f32) -> f32 {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    return 0.5 * (2.0 * p1 + (p2 - p0) * t + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2 + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t3);
+}
+
+// ldt layout: [nc, ng, c angles (nc), gamma angles (ng), values (nc x ng)].
+fn interval(first: u32, n: u32, x: f32, periodic: bool) -> vec2<f32> {
+    // Returns (index, fraction) of x in the angles at ldt[first..first+n].
+    if (n == 1u) { return vec2<f32>(0.0, 0.0); }
+    var k = 0u;
+    for (var i = 1u; i < n; i += 1u) {
+        if (ldt[first + i] <= x) { k = i; }
+    }
+    var lo = ldt[first + k];
+    var hi = 0.0;
+    if (k + 1u < n) {
+        hi = ldt[first + k + 1u];
+    } else if (periodic) {
+        hi = ldt[first] + 360.0;
+    } else {
+        return vec2<f32>(f32(n - 2u), 1.0);
+    }
+    if (x < lo) { return vec2<f32>(0.0, 0.0); }
+    return vec2<f32>(f32(k), clamp((x - lo) / (hi - lo), 0.0, 1.0));
+}
+
+fn ldt_row(c: u32, g: i32, gt: f32, ng: u32, nc: u32) -> f32 {
+    let base = 2u + nc + ng + c * ng;
+    let last = i32(ng) - 1;
+    let p0 = ldt[base + u32(clamp(g - 1, 0, last))];
+    let p1 = ldt[base + u32(clamp(g, 0, last))];
+    let p2 = ldt[base + u32(clamp(g + 1, 0, last))];
+    let p3 = ldt[base + u32(clamp(g + 2, 0, last))];
+    return catmull_rom(p0, p1, p2, p3, gt);
+}
+
+// Normalised intensity at (C, gamma) degrees: bicubic Catmull-Rom, clamped
+// along gamma, periodic along C (004 Sec. 3.4.1); mirrors Ldt::lookup.
+fn ldt_lookup(c_deg: f32, gamma: f32) -> f32 {
+    let nc = u32(ldt[0]);
+    let ng = u32(ldt[1]);
+    let gi = interval(2u + nc, ng, gamma, false);
+    let g = i32(gi.x);
+    if (nc == 1u) { return max(ldt_row(0u, g, gi.y, ng, nc), 0.0); }
+    var c = c_deg - 360.0 * floor(c_deg / 360.0);
+    if (c < ldt[2]) { c += 360.0; }
+    let ci = interval(2u, nc, c, true);
+    let k = i32(ci.x);
+    let n = i32(nc);
+    let r0 = ldt_row(u32((k - 1 + n) % n), g, gi.y, ng, nc);
+    let r1 = ldt_row(u32(k % n), g, gi.y, ng, nc);
+    let r2 = ldt_row(u32((k + 1) % n), g, gi.y, ng, nc);
+    let r3 = ldt_row(u32((k + 2) % n), g, gi.y, ng, nc);
+    return max(catmull_rom(r0, r1, r2, r3, ci.y), 0.0);
+}
+
+// The receiver pass (004 Sec. 2.3, Eq. 2.2 / 4.1-4.3): every covered texel
+// tests its depth against each sample's visibility map and gathers
+//   area sample:  H += dB_s A_s cos_s cos_r / (pi d^2 + A_s)
+//   point light:  H += I_max LDT(C, gamma) cos_r / d^2      (Eq. 3.4)
+// then adds rho H to both its radiosity and its residual.
+@compute @workgroup_size(64)
+fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
+    let k = id.x + id.y * nw.x * 64u;
+    if (k >= params.n_texels) { return; }
+    let texel = texels[k];
+    let tri = bitcast<u32>(texel.normal.w);
+    if (tri == params.shooter) { return; }
+    let p = texel.position.xyz;
+    let nr = texel.normal.xyz;
+    var h = vec3<f32>(0.0);
+    for (var i = 0u; i < params.sample_count; i += 1u) {
+        let s = samples[params.sample_first + i];
+        let v = p - s.position.xyz;
+        let d2 = dot(v, v);
+        let d = sqrt(d2);
+        if (d <= 0.0) { continue; }
+        let cos_r = -dot(nr, v) / d;
+        if (cos_r <= 0.0) { continue; }
+        let local = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
+        let light = s.power.w != 0.0;
+        let cos_s = local.z / d;
+        if (!light && cos_s <= 0.0) { continue; }
+        let base = i * params.layers_per_sample;
+        var seen = false;
+        if (params.mode == 1u && !light) {
+            let uv = stereographic(local / d);
+            let px = (uv.x * 0.5 + 0.5) * f32(params.res);
+            let py = (0.5 - uv.y * 0.5) * f32(params.res);
+            seen = visible(px, py, base, d);
+        } else {
+            let face = face_of(local);
+            let f = face_coords(face, local);
+            let px = (f.x / f.z * 0.5 + 0.5) * f32(params.res);
+            let py = (0.5 - f.y / f.z * 0.5) * f32(params.res);
+            seen = visible(px, py, base + face, d);
+        }
+        if (!seen) { continue; }
+        if (light) {
+            let gamma = degrees(acos(clamp(cos_s, -1.0, 1.0)));
+            let c = degrees(atan2(local.y, local.x));
+            h += s.power.xyz * ldt_lookup(c, gamma) * cos_r / d2;
+        } else {
+            let area = s.position.w;
+            h += s.power.xyz * (area * cos_s * cos_r / (PI * d2 + area));
+        }
+    }
+    let db = texel.rho.xyz * h;
+    radiosity[k] += vec4<f32>(db, 0.0);
+    residual[k] += vec4<f32>(db, 0.0);
+}

@@ -1,0 +1,37 @@
+// Visibility maps: the scene rendered from a shooting sample into one layer
+// per cube face (hemicube: 5 faces, light: 6) or one stereographic layer;
+// each pixel keeps the distance to the nearest surface, m (004 Sec. 2.3:
+// depth values instead of polygon ids, so the test can have a tolerance).
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> samples: array<Sample>;
+@group(0) @binding(2) var<storage, read> vertices: array<vec4<f32>>;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) local: vec3<f32>,
+};
+
+@vertex
+fn vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) layer: u32) -> VertexOut {
+    let s = samples[params.sample_first + layer / params.layers_per_sample];
+    let face = layer % params.layers_per_sample;
+    let v = vertices[vi].xyz - s.position.xyz;
+    let local = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
+    var out: VertexOut;
+    out.local = local;
+    if (params.mode == 1u && s.power.w == 0.0) {
+        let d = length(local);
+        out.clip = vec4<f32>(stereographic(local / max(d, 1e-20)), d / params.far, 1.0);
+    } else {
+        let f = face_coords(face, local);
+        let z = (f.z - params.near) * params.far / (params.far - params.near);
+        out.clip = vec4<f32>(f.x, f.y, z, f.z);
+    }
+    return out;
+}
+
+@fragment
+fn fs(in: VertexOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(length(in.local), 0.0, 0.0, 0.0);
+}
