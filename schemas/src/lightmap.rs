@@ -53,8 +53,9 @@ pub struct Region {
     pub size: u32,
     /// Number of covered texels: `size (size + 1) / 2`.
     pub covered: u32,
-    /// Area each covered texel stands for, m²: the triangle's area over
-    /// `covered` (004 Sec. 2.3).
+    /// Area an interior covered texel stands for, m²: `2 A / size²`; a
+    /// texel on the hypotenuse (`i + j + 1 = size`, half its square inside
+    /// the triangle) stands for half that, so the areas sum to `A`.
     pub texel_area: f32,
 }
 
@@ -137,7 +138,7 @@ impl Lightmap {
                 Channel::u32("y", "atlas row of the region's top-left gutter texel", r.iter().map(|r| r.y).collect()),
                 Channel::u32("size", "interior texels per side", r.iter().map(|r| r.size).collect()),
                 Channel::u32("covered", "covered texels", r.iter().map(|r| r.covered).collect()),
-                Channel::f32("texel_area", "area per covered texel, m^2", r.iter().map(|r| r.texel_area).collect()),
+                Channel::f32("texel_area", "area per interior covered texel (half on the hypotenuse), m^2", r.iter().map(|r| r.texel_area).collect()),
             ],
         );
         write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![atlas, region] })

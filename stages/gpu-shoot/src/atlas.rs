@@ -137,7 +137,8 @@ pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_si
         }
         let size = size_of(t);
         let covered = covered_count(size);
-        regions[t] = Region { x, y, size, covered, texel_area: (mesh.triangles[t].area as f64 / covered as f64) as f32 };
+        let texel_area = 2.0 * mesh.triangles[t].area as f64 / (size as f64 * size as f64);
+        regions[t] = Region { x, y, size, covered, texel_area: texel_area as f32 };
         x += side;
         row_height = row_height.max(side);
     }
@@ -156,21 +157,28 @@ pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_si
             for gi in 0..blocks {
                 let start = all_texels.len() as u32;
                 let mut sum = DVec3::ZERO;
+                let mut area = 0.0f64;
                 for j in gj * g..((gj + 1) * g).min(n) {
                     for i in gi * g..((gi + 1) * g).min(n) {
                         if !region.is_covered(i, j) {
                             continue;
                         }
                         let p = geometry.point(region.uv(i, j));
-                        sum += p;
+                        let w = if i + j + 1 == n { 0.5 } else { 1.0 };
+                        sum += p * w;
+                        area += w;
                         let (x, y) = region.texel(i, j);
-                        all_texels.push(Texel { x, y, triangle: t as u32, position: p.as_vec3().to_array(), area: region.texel_area });
+                        // Texels on the hypotenuse have half their square inside the
+                        // triangle: interior texels stand for 2 A / n^2, those
+                        // A / n^2, and the areas sum to A exactly.
+                        let area = if i + j + 1 == n { region.texel_area * 0.5 } else { region.texel_area };
+                        all_texels.push(Texel { x, y, triangle: t as u32, position: p.as_vec3().to_array(), area });
                     }
                 }
                 let count = all_texels.len() as u32 - start;
                 if count > 0 {
-                    let centroid = (sum / count as f64).as_vec3().to_array();
-                    groups.push(Group { first: start, count, centroid, area: region.texel_area * count as f32 });
+                    let centroid = (sum / area).as_vec3().to_array();
+                    groups.push(Group { first: start, count, centroid, area: (region.texel_area as f64 * area) as f32 });
                 }
             }
         }

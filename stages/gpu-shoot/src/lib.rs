@@ -226,6 +226,9 @@ pub struct Solved {
     pub shots: Vec<Shot>,
     /// Work counters.
     pub work: Work,
+    /// Per triangle, the GPU reduction at the end: `sum dB A` (rgb, w: area)
+    /// and `sum |dB| A`, for tests against [`reference::triangle_power`].
+    pub triangle_power: Vec<[f32; 4]>,
 }
 
 fn sum3(v: [f64; 3]) -> f64 {
@@ -450,5 +453,6 @@ pub fn solve(
     let radiosity = gpu.read_vec4(device, queue, &gpu.radiosity, n).into_iter().map(|v| [v[0], v[1], v[2]]).collect();
     let residual = gpu.read_vec4(device, queue, &gpu.residual, n).into_iter().map(|v| [v[0], v[1], v[2]]).collect();
     let ambient = [0, 1, 2].map(|c| selection.ambient[c] as f64);
-    Ok(Solved { atlas, radiosity, residual, ambient, emitted_power: emitted, initial_unshot, shots, work })
+    let triangle_power = gpu.read_vec4(device, queue, &gpu.tri_power, 2 * tris.len());
+    Ok(Solved { atlas, radiosity, residual, ambient, emitted_power: emitted, initial_unshot, shots, work, triangle_power })
 }

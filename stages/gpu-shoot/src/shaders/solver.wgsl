@@ -171,10 +171,13 @@ fn prepare_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= params.group_count) { return; }
     let g = groups[tris[params.shooter].group_first + id.x];
     var sum = vec3<f32>(0.0);
+    var area = 0.0;
     for (var k = 0u; k < g.count; k += 1u) {
-        sum += residual[g.first + k].xyz;
+        let a = texels[g.first + k].position.w;
+        sum += residual[g.first + k].xyz * a;
+        area += a;
     }
-    samples[id.x].power = vec4<f32>(sum / f32(g.count) + selection.overshoot.xyz, 0.0);
+    samples[id.x].power = vec4<f32>(sum / area + selection.overshoot.xyz, 0.0);
 }
 
 // After the shot the shooter keeps -dB' (0 without overshooting).
