@@ -42,13 +42,10 @@
 use clap::Parser;
 use glam::DVec3;
 use hierarchical_solve::{solve, Params, Work};
-use mesh_prep::builtin::Builtin;
-use mesh_prep::{prepare, read_scene};
 use radiometry::geometry::{mesh_triangles, TriangleGeometry};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
 use rayon::prelude::*;
-use schemas::header::{Provenance, Schema};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::stage::{bad_parameter, check_writable, exit_code};
 use serde::Serialize;
@@ -79,6 +76,9 @@ pub const MIN_AREA: f64 = 3e-5;
 pub const POOL: usize = 1 << 20;
 /// Seed of the raw measurement's segments.
 const RAW_SEED: u64 = 0x5eed;
+
+/// The built-in scene the bench solves.
+const CORNELL: &str = "cornell-box";
 
 /// Times hierarchical-solve on the built-in Cornell box at about 10k leaf
 /// elements and compares its visibility ray rate with obvhs's raw traversal
@@ -189,23 +189,7 @@ struct Segment {
 
 /// The Cornell box as mesh-prep would write it, in memory.
 fn cornell_box() -> schemas::Result<(Mesh, Manifest)> {
-    let source = Builtin::CornellBox;
-    let path = source.scene_path();
-    let scene = read_scene(&source, &path)?;
-    let prepared = prepare(&scene, &path, &source, &Default::default())?;
-    let provenance = Provenance::in_memory("bench");
-    let mesh = Mesh { header: Mesh::header(provenance.clone()), positions: prepared.positions, triangles: prepared.triangles };
-    let manifest = Manifest {
-        header: Manifest::header(provenance),
-        world_from_mesh_translation: prepared.world_from_mesh_translation,
-        camera: prepared.camera,
-        materials: prepared.materials,
-        objects: prepared.objects,
-        goniometric_lights: prepared.goniometric_lights,
-        effects: prepared.effects,
-        statistics: prepared.statistics,
-    };
-    Ok((mesh, manifest))
+    mesh_prep::prepare_builtin(CORNELL, "bench")
 }
 
 /// `count` segments between uniform random points of two distinct
@@ -337,7 +321,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     }
     let (mesh, manifest) = cornell_box()?;
     let triangles = mesh_triangles(&mesh);
-    let scene_name = Builtin::CornellBox.scene_path().display().to_string();
+    let scene_name = format!("builtin:{CORNELL}");
     let threads = rayon::current_num_threads();
     eprintln!("bench-solve: {} triangles, {threads} threads, {} runs", triangles.len(), args.runs);
 

@@ -17,6 +17,7 @@
 //! | `min_area` | smallest element area, as a fraction of the scene's total area | 1e-4 |
 //! | `visibility_rays` | rays per link between two elements | 16 |
 //! | `cluster_samples` | point pairs (and rays) per link with a cluster end | 16 |
+//! | `quadrature_depth` | deepest split of the adaptive receiver quadrature near touching elements | 3 |
 //! | `tolerance` | convergence: largest relative change of a leaf's radiosity | 1e-5 |
 //! | `max_iterations` | Jacobi iterations per solve, at most | 2000 |
 //! | `max_passes` | refine-and-solve passes, at most | 8 |
@@ -52,6 +53,8 @@ pub struct Params {
     pub visibility_rays: usize,
     /// Point pairs per link with a cluster end.
     pub cluster_samples: usize,
+    /// Deepest split of the adaptive receiver quadrature.
+    pub quadrature_depth: u32,
     /// Relative change at which gathering stops.
     pub tolerance: f64,
     /// Jacobi iterations per solve, at most.
@@ -69,6 +72,7 @@ impl Default for Params {
             min_area: 1e-4,
             visibility_rays: 16,
             cluster_samples: 16,
+            quadrature_depth: 3,
             tolerance: 1e-5,
             max_iterations: 2000,
             max_passes: 8,
@@ -92,6 +96,9 @@ impl Params {
         }
         if self.cluster_samples == 0 || self.cluster_samples > 4096 {
             return Some(format!("cluster_samples must be in 1..=4096, not {}", self.cluster_samples));
+        }
+        if self.quadrature_depth > 8 {
+            return Some(format!("quadrature_depth must be at most 8, not {}", self.quadrature_depth));
         }
         if !positive(self.tolerance) || self.max_iterations == 0 || self.max_passes == 0 {
             return Some("tolerance must be positive, max_iterations and max_passes at least 1".into());
@@ -175,7 +182,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
     let min_area = params.min_area * total_area;
     let largest_emission = h.emission.iter().flatten().copied().fold(0.0, f64::max);
     let threshold = params.eps * largest_emission;
-    let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed };
+    let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed, quadrature_depth: params.quadrature_depth };
     let scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
     let mut work = Work::default();
     let mut b: Vec<[f64; 3]> = vec![[0.0; 3]; h.cluster_count()];

@@ -56,12 +56,14 @@ pub struct Linking {
     pub cluster_samples: usize,
     /// Seed of their random streams.
     pub seed: u64,
+    /// Deepest split of the adaptive receiver quadrature between elements.
+    pub quadrature_depth: u32,
 }
 
 /// The link `receiver <- sender`, or `None` where no light can pass.
 pub fn link(h: &Hierarchy, receiver: Node, sender: Node, linking: Linking) -> Option<Link> {
     match (receiver, sender) {
-        (Node::Element(r), Node::Element(s)) => element_link(h, r, s),
+        (Node::Element(r), Node::Element(s)) => element_link(h, r, s, linking.quadrature_depth),
         _ => {
             if behind(h, receiver, sender) || behind(h, sender, receiver) {
                 return None;
@@ -100,7 +102,7 @@ fn box_distance(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> f64 {
 /// sender lies wholly behind the receiver's plane or the receiver wholly
 /// behind the sender's (both are one-sided), which includes coplanar
 /// elements and an element with itself.
-fn element_link(h: &Hierarchy, receiver: u32, sender: u32) -> Option<Link> {
+fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32) -> Option<Link> {
     let (r, s) = (&h.elements[receiver as usize], &h.elements[sender as usize]);
     let (nr, ns) = (h.normal(receiver), h.normal(sender));
     // Heights above the other's plane, against a tolerance scaled to the
@@ -113,7 +115,7 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32) -> Option<Link> {
     if receiver == sender || !in_front(&s.points, r.points[0], nr) || !in_front(&r.points, s.points[0], ns) {
         return None;
     }
-    let f = triangle_to_polygon(&r.points, nr, &s.points);
+    let f = triangle_to_polygon(&r.points, nr, &s.points, quadrature_depth);
     (f.mean > 0.0).then_some(Link {
         receiver: Node::Element(receiver),
         sender: Node::Element(sender),

@@ -55,6 +55,9 @@ struct Args {
     /// Point pairs (and rays) per link with a cluster at an end.
     #[arg(long)]
     cluster_samples: Option<usize>,
+    /// Deepest split of the adaptive receiver quadrature between touching elements.
+    #[arg(long)]
+    quadrature_depth: Option<u32>,
     /// Stop gathering when no leaf changes by more than this fraction of the largest radiosity.
     #[arg(long)]
     tolerance: Option<f64>,
@@ -75,6 +78,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.min_area = args.min_area.unwrap_or(p.min_area);
     p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
     p.cluster_samples = args.cluster_samples.unwrap_or(p.cluster_samples);
+    p.quadrature_depth = args.quadrature_depth.unwrap_or(p.quadrature_depth);
     p.tolerance = args.tolerance.unwrap_or(p.tolerance);
     p.max_iterations = args.max_iterations.unwrap_or(p.max_iterations);
     p.max_passes = args.max_passes.unwrap_or(p.max_passes);

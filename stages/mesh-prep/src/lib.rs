@@ -11,6 +11,7 @@ pub mod builtin;
 pub mod material;
 pub mod obj;
 pub mod prepare;
+pub mod procedural;
 pub mod scene;
 
 pub use prepare::{prepare, Params, Prepared};
@@ -20,6 +21,16 @@ use schemas::header::Input;
 use schemas::Error;
 use std::cell::RefCell;
 use std::path::Path;
+
+/// Prepares the built-in scene `name` (see [`builtin`]) in memory with
+/// default parameters, as `mesh-prep --builtin name` would write it.
+pub fn prepare_builtin(name: &str, made_by: &str) -> Result<(schemas::mesh::Mesh, schemas::mesh::Manifest), Error> {
+    let source: builtin::Builtin = name.parse().map_err(|e: String| Error::invalid(Path::new(name), None, e))?;
+    let path = source.scene_path();
+    let scene = read_scene(&source, &path)?;
+    let prepared = prepare(&scene, &path, &source, &Params::default())?;
+    Ok(prepared.into_artifacts(schemas::header::Provenance::in_memory(made_by)))
+}
 
 /// Reads and parses the scene file at `path` through `source`.
 pub fn read_scene(source: &dyn TextSource, path: &Path) -> Result<scene::Scene, Error> {

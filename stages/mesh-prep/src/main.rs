@@ -4,8 +4,6 @@ use clap::Parser;
 use mesh_prep::builtin::Builtin;
 use mesh_prep::obj::Files;
 use mesh_prep::{prepare, read_scene, Params, Recording};
-use schemas::header::Schema;
-use schemas::mesh::{Manifest, Mesh};
 use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -21,8 +19,10 @@ struct Args {
     /// Scene file (scene.ron); omit it and give --builtin for a built-in scene.
     #[arg(required_unless_present_any = ["builtin", "print_params"])]
     scene: Option<PathBuf>,
-    /// Use a built-in scene instead of a file.
-    #[arg(long, value_enum, conflicts_with = "scene")]
+    /// Use a built-in scene instead of a file: cornell-box, or sized
+    /// (n like 10k, 100k, 1m): cornell-box-<n> (tessellated), plants-<n>,
+    /// sphere-<n> (integrating sphere), box-<n> (closed box, rho 0.8).
+    #[arg(long, conflicts_with = "scene")]
     builtin: Option<Builtin>,
     /// Output: the mesh (EXR tables of vertices and triangles).
     #[arg(long, required_unless_present = "print_params")]
@@ -66,12 +66,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         check_writable(path)?;
     }
     let mut run = Run::start("mesh-prep", env!("CARGO_PKG_VERSION"));
-    let builtin;
-    let (source, scene_path): (&dyn mesh_prep::obj::TextSource, PathBuf) = match (args.builtin, &args.scene) {
-        (Some(b), _) => {
-            builtin = b;
-            (&builtin, b.scene_path())
-        }
+    let (source, scene_path): (&dyn mesh_prep::obj::TextSource, PathBuf) = match (&args.builtin, &args.scene) {
+        (Some(b), _) => (b, b.scene_path()),
         (None, Some(path)) => (&Files, path.clone()),
         (None, None) => unreachable!("clap requires a scene or --builtin"),
     };
@@ -81,19 +77,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     for input in recording.into_inputs() {
         run.input(input);
     }
-    let provenance = run.provenance(&params);
-    let mesh = Mesh { header: Mesh::header(provenance.clone()), positions: prepared.positions, triangles: prepared.triangles };
-    let statistics = prepared.statistics;
-    let manifest = Manifest {
-        header: Manifest::header(provenance),
-        world_from_mesh_translation: prepared.world_from_mesh_translation,
-        camera: prepared.camera,
-        materials: prepared.materials,
-        objects: prepared.objects,
-        goniometric_lights: prepared.goniometric_lights,
-        effects: prepared.effects,
-        statistics: statistics.clone(),
-    };
+    let statistics = prepared.statistics.clone();
+    let (mesh, manifest) = prepared.into_artifacts(run.provenance(&params));
     eprintln!(
         "mesh-prep: {} triangles, {} vertices ({} degenerate and {} duplicate triangles dropped, {} vertices welded)",
         statistics.triangles, statistics.vertices, statistics.degenerate_dropped, statistics.duplicates_dropped, statistics.vertices_welded

@@ -62,6 +62,25 @@ pub struct Prepared {
     pub statistics: MeshStatistics,
 }
 
+impl Prepared {
+    /// The two artifacts, stamped with `provenance`.
+    pub fn into_artifacts(self, provenance: schemas::header::Provenance) -> (schemas::mesh::Mesh, schemas::mesh::Manifest) {
+        use schemas::header::Schema;
+        let mesh = schemas::mesh::Mesh { header: schemas::mesh::Mesh::header(provenance.clone()), positions: self.positions, triangles: self.triangles };
+        let manifest = schemas::mesh::Manifest {
+            header: schemas::mesh::Manifest::header(provenance),
+            world_from_mesh_translation: self.world_from_mesh_translation,
+            camera: self.camera,
+            materials: self.materials,
+            objects: self.objects,
+            goniometric_lights: self.goniometric_lights,
+            effects: self.effects,
+            statistics: self.statistics,
+        };
+        (mesh, manifest)
+    }
+}
+
 /// A triangle before welding: world corners, material, object.
 struct RawTriangle {
     corners: [DVec3; 3],

@@ -131,9 +131,6 @@ fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3]) -> AreaFactor {
 /// Relative accuracy the adaptive receiver quadrature aims for.
 pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
 
-/// Deepest 1:4 split of the receiver the adaptive quadrature makes.
-pub const QUADRATURE_DEPTH: u32 = 5;
-
 /// Area-averaged form factor from a receiver triangle to a sender polygon:
 ///
 /// ```text
@@ -148,11 +145,13 @@ pub const QUADRATURE_DEPTH: u32 = 5;
 /// integrand varies fast, and near a shared edge it has a logarithmic
 /// singularity, so the rule is applied adaptively: a triangle whose estimate
 /// differs from the sum over its four midpoint children by more than
-/// [`QUADRATURE_TOLERANCE`] is split, down to [`QUADRATURE_DEPTH`] levels.
+/// [`QUADRATURE_TOLERANCE`] is split, down to `depth` levels. Each level
+/// roughly halves the error of a receiver touching the sender (the
+/// singular strip halves in width), at twice the cost.
 /// This matters for energy balance: in a closed room with reflectance rho,
 /// a relative error d in the sum of a receiver's form factors becomes an
 /// error of about rho d / (1 - rho) in the mean radiosity.
-pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3]) -> AreaFactor {
+pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3], depth: u32) -> AreaFactor {
     let centroid = |p: &[DVec3]| p.iter().copied().sum::<DVec3>() / p.len() as f64;
     let size = |p: &[DVec3], c: DVec3| p.iter().map(|v| v.distance(c)).fold(0.0, f64::max);
     let (cr, cs) = (centroid(receiver), centroid(sender));
@@ -161,7 +160,7 @@ pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender
     if far {
         coarse
     } else {
-        adaptive(receiver, receiver_normal, sender, coarse, QUADRATURE_DEPTH)
+        adaptive(receiver, receiver_normal, sender, coarse, depth)
     }
 }
 
@@ -263,7 +262,7 @@ mod tests {
         let floor = [dvec3(0.0, 0.0, 0.0), dvec3(w, 0.0, 0.0), dvec3(w, l, 0.0), dvec3(0.0, l, 0.0)];
         let wall = [dvec3(0.0, 0.0, 0.0), dvec3(0.0, l, 0.0), dvec3(0.0, l, h), dvec3(0.0, 0.0, h)];
         let halves = [[floor[0], floor[1], floor[2]], [floor[0], floor[2], floor[3]]];
-        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall).mean).sum();
+        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall, 5).mean).sum();
         let exact = perpendicular_shared_edge(w, h, l);
         assert!(((f - exact) / exact).abs() < 1e-4, "{f} vs {exact}");
         let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &wall).mean).sum();
