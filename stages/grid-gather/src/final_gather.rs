@@ -145,7 +145,9 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                 .map(|x| {
                     let pixel = u64::from(y) * u64::from(width) + u64::from(x);
                     let mut stream = Stream::new(params.seed, pixel, 0);
-                    let mut gather_stream = Stream::new(params.seed, pixel, 1);
+                    // Keyed by the brute sample count too, so a high-sample reference
+                    // shares the camera jitter of a cheaper run but not its gather noise.
+                    let mut gather_stream = Stream::new(params.seed, pixel, 1 + u64::from(params.brute_samples));
                     let (mut sum, mut covered, mut work) = ([0.0f64; 3], 0u32, Work::default());
                     for k in 0..spp {
                         let (jx, jy) = pixel_offset(k, spp, &mut stream);
