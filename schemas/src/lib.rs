@@ -16,6 +16,7 @@
 //! | [`lightmap::Lightmap`] | `lightmap.exr` | `lightmap` 1 | gpu-shoot |
 //! | [`lightmap::Convergence`] | `convergence.ron` | `convergence` 1 | gpu-shoot |
 //! | [`image::HdrImage`] | `*.exr` | `image` 1 | grid-gather |
+//! | [`threshold::ThresholdImage`] | `threshold.exr` | `threshold` 1 | mask |
 //! | [`report::Report`] | `*.report.ron` | `report` 1 | every stage |
 //!
 //! ```
@@ -35,5 +36,6 @@ pub mod report;
 pub mod ron_io;
 pub mod solution;
 pub mod stage;
+pub mod threshold;
 
 pub use error::{Error, Result};

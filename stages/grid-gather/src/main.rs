@@ -5,28 +5,19 @@ use clap::Parser;
 use grid_gather::final_gather::{ContrastImage, Diagnostics, CLASS_NAMES_PIXEL};
 use grid_gather::{gather_with, image_size, Extras, GridKind, Mode, Params, Scene};
 use schemas::cluster::Clusters;
-use schemas::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer, LayerKind};
+use schemas::exr_io::{write_exr, Channel, ExrArtifact, Layer, LayerKind};
 use schemas::header::{Header, Schema};
 use schemas::image::HdrImage;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
+use schemas::threshold::ThresholdImage;
 use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, Outputs, Run};
-use schemas::{Error, Result};
+use schemas::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 const STAGE: &str = "grid-gather";
-
-/// The mask stage's `threshold` artifact, as this stage reads it (the
-/// contract's writer is `mask::ThresholdImage`; both declare this name and
-/// version until the contract moves into `schemas`).
-struct ThresholdImage;
-
-impl Schema for ThresholdImage {
-    const NAME: &'static str = "threshold";
-    const VERSION: u32 = 1;
-}
 
 /// The diagnostics artifact of a full or brute-force gather: image layer
 /// `pixel` (work and classes per camera sample), table layer `vertex`
@@ -38,17 +29,10 @@ impl Schema for GatherDiagnostics {
     const VERSION: u32 = 1;
 }
 
+/// The mask's contrast channel (schema `threshold`), as the gather uses it.
 fn read_threshold(path: &std::path::Path) -> Result<(ContrastImage, schemas::header::Input)> {
-    let (artifact, input) = read_exr::<ThresholdImage>(path)?;
-    let layer = artifact.layer(path, "")?;
-    let LayerKind::Image { width, height } = layer.kind else {
-        return Err(Error::invalid(path, None, "threshold layer is a table"));
-    };
-    let contrast = layer.f32s(path, "contrast")?.to_vec();
-    if width == 0 || height == 0 {
-        return Err(Error::invalid(path, None, "threshold image is empty"));
-    }
-    Ok((ContrastImage { width, height, contrast }, input))
+    let (t, input) = ThresholdImage::read(path)?;
+    Ok((ContrastImage { width: t.width, height: t.height, contrast: t.contrast }, input))
 }
 
 fn write_diagnostics(path: &std::path::Path, header: Header, d: &Diagnostics) -> Result<()> {

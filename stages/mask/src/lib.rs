@@ -43,13 +43,12 @@
 pub mod model;
 
 use model::{band_frequency_cpd, contrast_sensitivity, elevation_image, luminance_pyramid, tvi};
-use schemas::error::{Error, Result};
-use schemas::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer, LayerKind};
-use schemas::header::{Header, Input, Schema};
+use schemas::error::Result;
+use schemas::header::Header;
 use schemas::stage::bad_parameter;
+use schemas::threshold::ThresholdImage;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
 
 pub use model::elevation;
 
@@ -181,46 +180,20 @@ pub fn thresholds(params: &Params, width: usize, height: usize, luminance: &[f64
     Ok(out)
 }
 
-/// The `threshold` artifact (`threshold.exr`): one image layer with the
-/// channels `L` (display luminance, cd/m²), `La` (adaptation luminance,
-/// cd/m²), `elevation` (masking threshold elevation, >= 1), `threshold`
-/// (TVI x elevation, cd/m²) and `contrast` (threshold / luminance).
-///
-/// The contract belongs in `schemas` (it is read by grid-gather, which
-/// declares the same name and version for its reader); it lives here until
-/// it moves there.
-pub struct ThresholdImage;
-
-impl Schema for ThresholdImage {
-    const NAME: &'static str = "threshold";
-    const VERSION: u32 = 1;
-}
-
-impl ThresholdImage {
-    /// Writes `thresholds` with `header` atomically.
-    pub fn write(path: &Path, header: Header, t: &Thresholds) -> Result<()> {
-        let layer = Layer {
-            name: String::new(),
-            kind: LayerKind::Image { width: t.width, height: t.height },
-            channels: vec![
-                Channel::f32("L", "display luminance, cd/m^2", t.luminance.clone()),
-                Channel::f32("La", "adaptation luminance (about 1 degree), cd/m^2", t.adaptation.clone()),
-                Channel::f32("elevation", "masking threshold elevation (Ramasubramanian et al. 1999), >= 1", t.elevation.clone()),
-                Channel::f32("threshold", "TVI(La) x elevation, cd/m^2", t.threshold.clone()),
-                Channel::f32("contrast", "threshold / max(L, display black): smallest visible contrast", t.contrast.clone()),
-            ],
-        };
-        write_exr(path, &ExrArtifact { header, layers: vec![layer] })
-    }
-
-    /// Reads a threshold image: `(width, height, contrast)`.
-    pub fn read_contrast(path: &Path) -> Result<((usize, usize, Vec<f32>), Input)> {
-        let (artifact, input) = read_exr::<ThresholdImage>(path)?;
-        let layer = artifact.layer(path, "")?;
-        let LayerKind::Image { width, height } = layer.kind else {
-            return Err(Error::invalid(path, None, "threshold layer is a table"));
-        };
-        Ok(((width, height, layer.f32s(path, "contrast")?.to_vec()), input))
+impl Thresholds {
+    /// The `threshold` artifact ([`schemas::threshold::ThresholdImage`])
+    /// of these thresholds, with `header`.
+    pub fn into_artifact(self, header: Header) -> ThresholdImage {
+        ThresholdImage {
+            header,
+            width: self.width,
+            height: self.height,
+            luminance: self.luminance,
+            adaptation: self.adaptation,
+            elevation: self.elevation,
+            threshold: self.threshold,
+            contrast: self.contrast,
+        }
     }
 }
 

@@ -2,10 +2,11 @@
 //! a tone-mapped preview (TVI x masking elevation). See the library docs.
 
 use clap::Parser;
-use mask::{display_luminance, thresholds, Params, ThresholdImage};
+use mask::{display_luminance, thresholds, Params};
 use schemas::header::{Input, Schema};
 use schemas::ron_io::read_bytes;
-use schemas::stage::{check_writable, exit_code, load_params, print_params, Run};
+use schemas::threshold::ThresholdImage;
+use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run};
 use schemas::{Error, Result};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -83,6 +84,9 @@ fn run(args: &Args) -> Result<ExitCode> {
         return Err(schemas::stage::bad_parameter("IMAGE and -o are required"));
     };
     check_writable(output)?;
+    if let Some(report) = &args.report {
+        check_writable(report)?;
+    }
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
     let bytes = read_bytes(input)?;
     run.input(Input::new(input, &bytes, None));
@@ -93,13 +97,14 @@ fn run(args: &Args) -> Result<ExitCode> {
     let pixels: Vec<[u8; 3]> = decoded.pixels().map(|p| p.0).collect();
     let luminance = display_luminance(&pixels, params.display_max_cd_m2);
     let t = thresholds(&params, width, height, &luminance).map_err(|e| Error::invalid(input, None, e.to_string()))?;
-    ThresholdImage::write(output, ThresholdImage::header(run.provenance(&params)), &t)?;
+    let counters = t.counters.clone();
+    let artifact = t.into_artifact(ThresholdImage::header(run.provenance(&params)));
+    let mut outputs = Outputs::new();
+    outputs.write(output, |p| artifact.write(p))?;
     if let Some(report) = &args.report {
-        if let Err(e) = run.write_report(report, &params, t.counters.clone(), Vec::new(), Vec::new()) {
-            let _ = std::fs::remove_file(output);
-            return Err(e);
-        }
+        outputs.write(report, |p| run.write_report(p, &params, counters, Vec::new(), Vec::new()))?;
     }
+    outputs.keep();
     Ok(ExitCode::SUCCESS)
 }
 
