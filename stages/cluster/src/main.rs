@@ -12,8 +12,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Build the cluster hierarchy over a prepared mesh (a surface-area-heuristic
-/// BVH from obvhs), with per-cluster bounds, area, reflectance-weighted
+/// Build the cluster hierarchy over a prepared mesh (median splits along
+/// the longest axis), with per-cluster bounds, area, reflectance-weighted
 /// area and normal cone. Writes clusters.exr for hierarchical-solve
 /// --clusters and the final gather.
 #[derive(Parser, Debug)]

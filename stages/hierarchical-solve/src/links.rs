@@ -79,17 +79,41 @@ pub fn self_link(cluster: Node) -> Link {
     Link { receiver: cluster, sender: cluster, form_factor: 0.0, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY }
 }
 
-/// Whether `other` lies wholly behind element `node`'s plane (its bounding
-/// box's corners all on the back side); false for a cluster `node`.
+/// Whether `other` lies wholly behind the plane of `node`'s surfaces (the
+/// corners of its bounding box all on the back side), when `node` is flat:
+/// an element, or a cluster whose triangles all lie in one plane (a normal
+/// cone of zero width and a box without thickness along its axis, as the
+/// clusters of a tessellated wall have). Such pairs exchange no light, and
+/// their boxes touch, so the conservative bound alone would refine them all
+/// the way down to element pairs.
 fn behind(h: &Hierarchy, node: Node, other: Node) -> bool {
-    let Node::Element(e) = node else { return false };
-    let (origin, normal) = (h.elements[e as usize].points[0], h.normal(e));
+    let Some((origin, normal)) = plane(h, node) else { return false };
     let (lo, hi) = h.bounds(other);
-    let tolerance = 1e-9 * (hi - lo).length().max(h.elements[e as usize].area.sqrt());
+    let (nlo, nhi) = h.bounds(node);
+    let tolerance = 1e-9 * (hi - lo).length().max((nhi - nlo).length());
     (0..8).all(|i| {
         let corner = DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
         (corner - origin).dot(normal) <= tolerance
     })
+}
+
+/// A point and the front normal of the plane holding all of `node`'s
+/// surfaces, if there is one.
+fn plane(h: &Hierarchy, node: Node) -> Option<(DVec3, DVec3)> {
+    match node {
+        Node::Element(e) => Some((h.elements[e as usize].points[0], h.normal(e))),
+        Node::Cluster(c) => {
+            let cluster = &h.clusters.as_ref()?.clusters.nodes[c as usize];
+            let axis = DVec3::from(cluster.normal_axis.map(f64::from));
+            if cluster.normal_cos < 1.0 - 1e-6 || axis == DVec3::ZERO {
+                return None;
+            }
+            let (lo, hi) = h.bounds(node);
+            let half = 0.5 * (hi - lo);
+            let thickness = axis.abs().dot(half);
+            (thickness <= 1e-6 * half.length().max(f64::MIN_POSITIVE)).then_some((0.5 * (lo + hi), axis))
+        }
+    }
 }
 
 /// Distance between two axis-aligned boxes (0 where they overlap).
