@@ -197,3 +197,45 @@ fn a_row_of_pixels_crossing_cell_faces_shows_no_jump_above_the_brute_force_noise
     let level = b.iter().sum::<f64>() / b.len() as f64;
     assert!(worst <= noise + 1e-4 * level, "largest kink {worst} vs the brute-force floor {noise} (level {level})");
 }
+
+/// The closed box built into mesh-prep (`box-<n>`: a convex room, so no
+/// surface hides another) solved with clusters: links with cluster ends,
+/// among them the root's self-link refined, so some senders are clusters
+/// holding the grid vertices.
+pub(crate) fn clustered_box(triangles: usize, eps: f64) -> (Mesh, Manifest, Solution, schemas::cluster::Clusters) {
+    let (mesh, manifest) = mesh_prep::prepare_builtin(&format!("box-{triangles}"), "test").expect("built-in box");
+    let geometry = radiometry::geometry::mesh_triangles(&mesh);
+    let reflectances: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.materials[t.material as usize].diffuse).collect();
+    let h = cluster::build(&geometry, &reflectances, &cluster::Params::default());
+    let clusters = schemas::cluster::Clusters { header: schemas::cluster::Clusters::header(Provenance::in_memory("test")), nodes: h.nodes, order: h.order };
+    let params = hierarchical_solve::Params { eps, ..hierarchical_solve::Params::default() };
+    let solved = hierarchical_solve::solve(&mesh, &manifest, Some(clusters.clone()), &params, &|_| {}).expect("solve");
+    let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links };
+    (mesh, manifest, solution, clusters)
+}
+
+fn run_clustered(mesh: &Mesh, manifest: &Manifest, solution: &Solution, clusters: &schemas::cluster::Clusters, params: &Params) -> (Rendered, Diagnostics) {
+    let scene = Scene { mesh, manifest, manifest_path: Path::new("m.ron"), solution, solution_path: Path::new("s.exr") };
+    let extras = Extras { clusters: Some(clusters), threshold: None };
+    let (r, d) = gather_with(params, &scene, extras, &|_| {}).expect("gather");
+    (r, d.expect("diagnostics"))
+}
+
+#[test]
+fn a_clustered_solution_of_a_convex_room_interpolates_visibility_and_matches_brute_force() {
+    let (mesh, manifest, solution, clusters) = clustered_box(300, 1e-2);
+    let cluster_senders = solution.links.iter().filter(|l| matches!(l.sender, Node::Cluster(_))).count();
+    assert!(cluster_senders > 0, "the solve made cluster links");
+    let size = Params { width: Some(32), height: Some(32), spp: 2, ..Params::default() };
+    let full = Params { mode: Mode::Full, grid_pixels: 8, grid_depth: 6, ..size.clone() };
+    let (image, diagnostics) = run_clustered(&mesh, &manifest, &solution, &clusters, &full);
+    assert!(!diagnostics.vertices.is_empty());
+    for v in &diagnostics.vertices {
+        assert_eq!(v.classes[0] + v.classes[1], 0, "vertex {:?} resamples visibility: {:?}", v.ijk, v.classes);
+    }
+    assert_eq!(image.counters["visibility_rays"], 0.0, "no shadow ray at render time");
+    let brute = Params { mode: Mode::Brute, brute_samples: 4, ..size };
+    let (reference, _) = run_clustered(&mesh, &manifest, &solution, &clusters, &brute);
+    let e = relative_rmse(&floor_values(&image), &floor_values(&reference));
+    assert!(e < 0.01, "relative RMSE {e}");
+}
