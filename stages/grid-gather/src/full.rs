@@ -65,9 +65,12 @@
 //! Where the solver refined the surface finer than the grid (the leaf's
 //! longest edge is shorter than the cell size at `p`), the element mesh
 //! already follows the lighting: every link of the chain gets the exact
-//! point form factor, and visibility is resampled only for links the solver
-//! found partly occluded (`0 < V < 1`), with the view-dependent count;
-//! fully visible links use `V = 1`, fully occluded ones are skipped. The
+//! point form factor; fully visible links use `V = 1`, fully occluded ones
+//! are skipped, and of the links the solver found partly occluded (`0 < V <
+//! 1`) those whose visibility error `rho B_s F max(V, 1 - V)` (Eq. 3 with
+//! the link's `V` as the interpolated value) fits in the threshold budget
+//! ([`budget`]) keep the link's `V`; the rest resample visibility with the
+//! view-dependent count. The
 //! threshold there is the grid's vertex threshold interpolated at `p`.
 //!
 //! # Brute force
@@ -459,6 +462,19 @@ impl<'a> FullGather<'a> {
                 })
                 .sum();
             let tau = contrast * b_local;
+            // Eq. 3 per partly occluded link, with the link's own visibility
+            // as the interpolated value: the point's visibility differs from
+            // the leaf's mean V by at most max(V, 1 - V).
+            let partial: Vec<usize> = links.iter().copied().filter(|&l| (0.0..1.0).contains(&self.senders.solution.links[l].visibility) && self.senders.solution.links[l].visibility > 0.0).collect();
+            let d_vis: Vec<f64> = partial
+                .iter()
+                .map(|&l| {
+                    let link = &self.senders.solution.links[l];
+                    let v = f64::from(link.visibility);
+                    rho * luminance(link.unoccluded_irradiance.map(f64::from)) * v.max(1.0 - v)
+                })
+                .collect();
+            let resample = budget(&d_vis, tau);
             for &l in links {
                 let link = &self.senders.solution.links[l];
                 if link.visibility <= 0.0 {
@@ -466,9 +482,10 @@ impl<'a> FullGather<'a> {
                 }
                 let (f, evals) = self.senders.form_factor(link.sender, p, normal);
                 work.form_factors += evals;
-                let v = if link.visibility >= 1.0 {
+                let resampled = partial.binary_search(&l).is_ok_and(|k| resample[k]);
+                let v = if !resampled {
                     work.classes[2] += 1;
-                    1.0
+                    f64::from(link.visibility).min(1.0)
                 } else {
                     work.classes[0] += 1;
                     let rbf = rho * luminance(self.senders.radiosity(link.sender)) * f;
