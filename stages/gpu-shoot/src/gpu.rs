@@ -92,6 +92,8 @@ pub struct GpuTri {
     pub area: f32,
     pub _pad: [f32; 3],
     pub rho: [f32; 4],
+    pub half_u: [f32; 4],
+    pub half_v: [f32; 4],
 }
 
 /// Host mirror of `Group` in solver.wgsl.

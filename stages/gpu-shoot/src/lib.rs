@@ -261,11 +261,22 @@ pub fn solve(
             GpuTexel {
                 position_area: [x.position[0], x.position[1], x.position[2], x.area],
                 normal_triangle: [tri.normal[0], tri.normal[1], tri.normal[2], f32::from_bits(x.triangle)],
-                rho: f4(material(x.triangle as usize).diffuse),
+                rho: {
+                    let region = atlas.regions[x.triangle as usize];
+                    let mut rho = f4(material(x.triangle as usize).diffuse);
+                    // w: 1 on the hypotenuse (half a texel), read by the near-field form factor.
+                    rho[3] = if x.area < 0.75 * region.texel_area { 1.0 } else { 0.0 };
+                    rho
+                },
             }
         })
         .collect();
     let emission: Vec<[f32; 4]> = atlas.texels.iter().map(|x| f4(material(x.triangle as usize).emission)).collect();
+    let half_edges = |t: usize| {
+        let p = mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)));
+        let n = 2.0 * atlas.regions[t].size as f64;
+        [f4(((p[1] - p[0]) / n).to_array()), f4(((p[2] - p[0]) / n).to_array())]
+    };
     let tris: Vec<GpuTri> = atlas
         .triangles
         .iter()
@@ -278,6 +289,8 @@ pub fn solve(
             area: atlas.texels[r.first as usize..(r.first + r.count) as usize].iter().map(|x| x.area).sum(),
             _pad: [0.0; 3],
             rho: f4(material(t).diffuse),
+            half_u: half_edges(t)[0],
+            half_v: half_edges(t)[1],
         })
         .collect();
     let groups: Vec<GpuGroup> = atlas.groups.iter().map(|g| GpuGroup { first: g.first, count: g.count, _pad: [0; 2] }).collect();

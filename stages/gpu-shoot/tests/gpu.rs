@@ -64,7 +64,8 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert_and_the_cpu_kernel() 
             let r = solved.atlas.triangles[tri];
             for g in &solved.atlas.groups[r.group_first as usize..(r.group_first + r.group_count) as usize] {
                 let c = DVec3::from(g.centroid.map(f64::from));
-                h_cpu += e * reference::disc_form_factor(p, DVec3::Y, c, -DVec3::Y, g.area as f64);
+                let (count, patch) = reference::patch_of(&solved.atlas, &mesh, k);
+                h_cpu += e * reference::area_transfer(p, DVec3::Y, t.area as f64, &patch[..count], c, -DVec3::Y, g.area as f64);
             }
         }
         worst_cpu = worst_cpu.max((b - rho * h_cpu).abs() / (rho * h_cpu));
@@ -83,14 +84,13 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert_and_the_cpu_kernel() 
 }
 
 #[test]
-#[ignore = "open: the closed box loses 2.2% of its energy at rho 0.5 (disc approximation next to the box's edges and grazing visibility), over the issue's 1%"]
 fn closed_box_balances_energy_with_and_without_overshooting() {
     let mesh = closed_box(1.0, 0.3);
     let area: f64 = mesh.triangles.iter().map(|t| t.area as f64).sum();
     for rho in [0.5, 0.9] {
         for overshoot in [false, true] {
             let m = manifest(2, vec![material([rho; 3], [0.0; 3]), material([rho; 3], [10.0; 3])]);
-            let params = Params { texels: 3000.0, shoot_level: 0, convergence: 0.999, overshoot, ..Params::default() };
+            let params = Params { texels: 2000.0, shoot_level: 1, convergence: 0.999, overshoot, ..Params::default() };
             let Some(solved) = run(&mesh, &m, &[], &params) else { return };
             let power = solved.emitted_power[0];
             let expected = power / ((1.0 - rho) * area);
@@ -168,5 +168,40 @@ fn asymmetric_ldt_light_matches_the_cpu_lookup_on_the_gpu() {
         }
     }
     eprintln!("asymmetric LDT on the GPU vs CPU: worst relative difference {worst:.2e}");
+    assert!(worst < 1e-3, "{worst}");
+}
+
+/// Every triangle of a closed box, shooting once, delivers all its power:
+/// the sum over receivers of (received power) / (shot power) is 1 within
+/// 0.1% (the near-field point-to-patch factor and the receiver-plane depth
+/// test; the disc approximation alone lost up to 31% for a sample next to
+/// a crease, and the plain depth test 1-2.5% of every wall's shot).
+#[test]
+fn every_shot_in_a_closed_box_delivers_its_power() {
+    let base = closed_box(1.0, 0.3);
+    let Some((device, queue)) = device() else { return };
+    let mut worst = 0.0f64;
+    for shooter in 0..base.triangles.len() {
+        let mut mesh = base.clone();
+        for (t, tri) in mesh.triangles.iter_mut().enumerate() {
+            tri.material = u32::from(t == shooter);
+        }
+        // Receivers reflect everything (rho 1), so radiosity x area is received power.
+        let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
+        let params = Params { texels: 1500.0, shoot_level: 0, max_shots: 1, convergence: 1.0, overshoot: false, ..Params::default() };
+        let solved = solve(&device, &queue, &mesh, &m, &[], &params, &mut |_| {}).unwrap();
+        assert_eq!(solved.shots[0].shooter, format!("triangle {shooter}"));
+        let received: f64 = solved
+            .atlas
+            .texels
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.triangle as usize != shooter)
+            .map(|(k, t)| solved.radiosity[k][0] as f64 * t.area as f64)
+            .sum();
+        let ratio = received / solved.emitted_power[0];
+        worst = worst.max((ratio - 1.0).abs());
+    }
+    eprintln!("closed box, one shot per triangle: worst |received / shot - 1| = {worst:.2e}");
     assert!(worst < 1e-3, "{worst}");
 }

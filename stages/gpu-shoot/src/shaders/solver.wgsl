@@ -6,7 +6,7 @@
 struct Texel {
     position: vec4<f32>, // xyz: centre, m; w: area it stands for, m^2
     normal: vec4<f32>,   // xyz: unit normal; w: triangle index (bitcast)
-    rho: vec4<f32>,      // rgb: diffuse reflectance of its material
+    rho: vec4<f32>,      // rgb: diffuse reflectance of its material; w: 1 on the hypotenuse
 };
 
 struct Tri {
@@ -19,6 +19,8 @@ struct Tri {
     _p1: f32,
     _p2: f32,
     rho: vec4<f32>,
+    half_u: vec4<f32>,   // xyz: (P1 - P0) / (2 size), half a texel's first edge, m
+    half_v: vec4<f32>,   // xyz: (P2 - P0) / (2 size), half its second edge, m
 };
 
 struct Group {
@@ -210,6 +212,43 @@ fn visible(px: f32, py: f32, layer: u32, d: f32) -> bool {
     return false;
 }
 
+// Whether a receiver at face coordinates q (normal m, same coordinates)
+// is visible in cube face `layer` (004 Sec. 2.3 with the neighbour test of
+// Fig. 2.3). Each pixel stores the distance to the nearest surface along
+// its centre's ray; the receiver is compared not with its own distance
+// but with the distance at which that same ray meets the receiver's plane,
+// t |dir| with t = (m . q) / (m . dir). A plane seen at a grazing angle
+// changes its distance by far more than any fixed tolerance from one pixel
+// to the next, so comparing with the receiver's own distance hid the
+// texels of a neighbouring wall from a shooter next to it (the closed box
+// lost 1-2% of each wall shot that way). Visible when the centre pixel
+// holds nothing nearer than the receiver's plane (within the tolerance),
+// or one of its 8 neighbours holds the receiver's plane.
+fn visible_face(layer: u32, q: vec3<f32>, m: vec3<f32>) -> bool {
+    let res = f32(params.res);
+    let px = (q.x / q.z * 0.5 + 0.5) * res;
+    let py = (0.5 - q.y / q.z * 0.5) * res;
+    let x = i32(floor(px));
+    let y = i32(floor(py));
+    let mq = dot(m, q);
+    for (var dy = -1; dy <= 1; dy += 1) {
+        for (var dx = -1; dx <= 1; dx += 1) {
+            let cx = clamp(x + dx, 0, i32(params.res) - 1);
+            let cy = clamp(y + dy, 0, i32(params.res) - 1);
+            let dir = vec3<f32>((f32(cx) + 0.5) / res * 2.0 - 1.0, 1.0 - (f32(cy) + 0.5) / res * 2.0, 1.0);
+            let md = dot(m, dir);
+            // The ray must meet the front of the receiver's plane.
+            if (md >= 0.0 || mq >= 0.0) { continue; }
+            let plane = mq / md * length(dir);
+            let stored = textureLoad(visibility, vec2<i32>(cx, cy), i32(layer), 0).x;
+            let tol = params.tolerance * plane;
+            if (dx == 0 && dy == 0 && stored >= plane - tol) { return true; }
+            if (abs(stored - plane) <= tol) { return true; }
+        }
+    }
+    return false;
+}
+
 fn catmull_rom(p0: f32, p1: f32, p2: f32, p3: f32, t: f32) -> f32 {
     let t2 = t * t;
     let t3 = t2 * t;
@@ -267,6 +306,70 @@ fn ldt_lookup(c_deg: f32, gamma: f32) -> f32 {
     return max(catmull_rom(r0, r1, r2, r3, ci.y), 0.0);
 }
 
+// Near field: a receiver nearer than sqrt(NEAR_FIELD (A_r + A_s)) gets the
+// exact point-to-patch form factor; farther, the disc approximation, whose
+// energy loss A_s / (pi d^2 + A_s) is then below 1 / (pi NEAR_FIELD).
+const NEAR_FIELD: f32 = 100.0;
+
+// Form factor from a differential sender at the origin with normal n to
+// the polygon corners[0..count] (relative to the sender), clipped to the
+// sender's hemisphere: Lambert's contour formula, mirrors
+// reference::polygon_form_factor.
+fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 4>, count: u32) -> f32 {
+    var clipped: array<vec3<f32>, 5>;
+    var m = 0u;
+    for (var k = 0u; k < count; k += 1u) {
+        let a = corners[k];
+        let b = corners[(k + 1u) % count];
+        let za = dot(n, a);
+        let zb = dot(n, b);
+        if (za >= 0.0) { clipped[m] = a; m += 1u; }
+        if ((za >= 0.0) != (zb >= 0.0)) { clipped[m] = a + (b - a) * (za / (za - zb)); m += 1u; }
+    }
+    var sum = 0.0;
+    for (var k = 0u; k < m; k += 1u) {
+        let a = clipped[k];
+        let b = clipped[(k + 1u) % m];
+        let c = cross(a, b);
+        let s = length(c);
+        if (s > 0.0) { sum += atan2(s, dot(a, b)) * dot(n, c) / s; }
+    }
+    return abs(sum) / (2.0 * PI);
+}
+
+// Irradiance per unit radiosity of an area sample at `s` (normal n, area
+// a_s) on the receiving texel k at p (its patch: half edges of its
+// triangle, half a square on the hypotenuse), with the cosines at p.
+fn area_transfer(k: u32, p: vec3<f32>, s: vec3<f32>, n: vec3<f32>, a_s: f32, d2: f32, cos_s: f32, cos_r: f32) -> f32 {
+    let a_r = texels[k].position.w;
+    if (d2 >= NEAR_FIELD * (a_r + a_s)) {
+        // 004 Eq. 2.2 / 4.1 with one disc per sample.
+        return a_s * cos_s * cos_r / (PI * d2 + a_s);
+    }
+    let tri = tris[bitcast<u32>(texels[k].normal.w)];
+    let a = tri.half_u.xyz;
+    let b = tri.half_v.xyz;
+    var corners: array<vec3<f32>, 4>;
+    var count = 4u;
+    if (texels[k].rho.w != 0.0) {
+        // The hypotenuse texel stands for the half square whose centroid is p.
+        let c = p - s + (a + b) / 3.0;
+        corners[0] = c - a - b;
+        corners[1] = c + a - b;
+        corners[2] = c - a + b;
+        count = 3u;
+    } else {
+        let c = p - s;
+        corners[0] = c - a - b;
+        corners[1] = c + a - b;
+        corners[2] = c + a + b;
+        corners[3] = c - a + b;
+    }
+    // H_r = B_s A_s F_(s -> patch) / A_r: the power the patch receives
+    // spread over its area, so the shares of a closed room sum to 1.
+    return a_s * polygon_form_factor(n, corners, count) / a_r;
+}
+
 // The receiver pass (004 Sec. 2.3, Eq. 2.2 / 4.1-4.3): every covered texel
 // tests its depth against each sample's visibility map and gathers
 //   area sample:  H += dB_s A_s cos_s cos_r / (pi d^2 + A_s)
@@ -303,10 +406,8 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
             seen = visible(px, py, base, d);
         } else {
             let face = face_of(local);
-            let f = face_coords(face, local);
-            let px = (f.x / f.z * 0.5 + 0.5) * f32(params.res);
-            let py = (0.5 - f.y / f.z * 0.5) * f32(params.res);
-            seen = visible(px, py, base + face, d);
+            let normal = vec3<f32>(dot(nr, s.t.xyz), dot(nr, s.b.xyz), dot(nr, s.n.xyz));
+            seen = visible_face(base + face, face_coords(face, local), face_coords(face, normal));
         }
         if (!seen) { continue; }
         if (light) {
@@ -314,8 +415,7 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
             let c = degrees(atan2(local.y, local.x));
             h += s.power.xyz * ldt_lookup(c, gamma) * cos_r / d2;
         } else {
-            let area = s.position.w;
-            h += s.power.xyz * (area * cos_s * cos_r / (PI * d2 + area));
+            h += s.power.xyz * area_transfer(k, p, s.position.xyz, s.n.xyz, s.position.w, d2, cos_s, cos_r);
         }
     }
     let db = texel.rho.xyz * h;
