@@ -20,7 +20,12 @@
 //! It is *covered* (takes part in the solution) when `i + j + 1 <= size`,
 //! that is when its centre lies inside the triangle or on its edge (the
 //! paper renders each triangle filled and outlined for the same reason,
-//! 2.3.1). The texels a bilinear lookup inside the triangle reads but that
+//! 2.3.1). A texel on the hypotenuse (`i + j + 1 = size`) stands for the
+//! half of its square inside the triangle, and the solver samples it at
+//! that half's centroid `((i + 1/3) / size, (j + 1/3) / size)`, not at its
+//! centre on the edge (a point on a concave crease would shoot half its
+//! power through the neighbouring surface); the `P` channel keeps the
+//! centres, the lookup grid. The texels a bilinear lookup inside the triangle reads but that
 //! are not covered hold values filled from covered neighbours (seams,
 //! 2.3.1): `coverage` is 1 for covered texels, 0.5 for filled ones and 0
 //! elsewhere.
