@@ -286,11 +286,13 @@ impl Gpu {
             },
             count: None,
         });
+        entries.push(storage(11, c, true));
         let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("solver"), entries: &entries });
         let buffers = [&params, &texels, &radiosity, &residual, &tris, &groups, &tri_power, &selection, &samples, &ldt];
         let mut bind: Vec<wgpu::BindGroupEntry> =
             buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
         bind.push(wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&array_view) });
+        bind.push(wgpu::BindGroupEntry { binding: 11, resource: vertices.as_entire_binding() });
         let compute_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("solver"), layout: &compute_layout, entries: &bind });
         let compute_pipeline_layout =
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("solver"), bind_group_layouts: &[Some(&compute_layout)], immediate_size: 0 });

@@ -5,7 +5,7 @@
 use glam::DVec3;
 use gpu_shoot::photometry::{Distribution, Ldt};
 use gpu_shoot::testing::{closed_box, manifest, material, quads};
-use gpu_shoot::{gpu, reference, solve, Params, PointLight, Solved};
+use gpu_shoot::{gpu, reference, solve, Params, PointLight, Solved, Visibility};
 use schemas::mesh::{Manifest, Mesh};
 use std::f64::consts::PI;
 
@@ -48,7 +48,8 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert_and_the_cpu_kernel() 
         (DVec3::new(0.25, h, 0.25), DVec3::X * 0.5, DVec3::Z * 0.5, 1, 1),
     ]);
     let m = manifest(2, vec![material([rho; 3], [0.0; 3]), material([0.0; 3], [e; 3])]);
-    let params = Params { texels: 6000.0, shoot_level: 0, max_shots: 2, convergence: 1.0, resolution: 256, ..Params::default() };
+    for visibility in [Visibility::Hemicube, Visibility::Stereographic] {
+    let params = Params { texels: 6000.0, shoot_level: 0, max_shots: 2, convergence: 1.0, resolution: 256, visibility, ..Params::default() };
     let Some(solved) = run(&mesh, &m, &[], &params) else { return };
     assert_eq!(solved.shots.len(), 2);
     let (mut worst, mut worst_cpu, mut count) = (0.0f64, 0.0f64, 0);
@@ -80,17 +81,19 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert_and_the_cpu_kernel() 
     assert!(count > 1000, "{count} texels compared");
     assert!(worst_cpu < 1e-3, "GPU receiver pass vs CPU reference: worst relative difference {worst_cpu}");
     assert!(worst < 0.02, "floor radiosity vs Lambert: worst relative error {worst}");
-    eprintln!("Lambert floor: worst relative error {worst:.4} over {count} texels; GPU vs CPU {worst_cpu:.2e}");
+    eprintln!("Lambert floor ({visibility:?}): worst relative error {worst:.4} over {count} texels; GPU vs CPU {worst_cpu:.2e}");
+    }
 }
 
 #[test]
 fn closed_box_balances_energy_with_and_without_overshooting() {
     let mesh = closed_box(1.0, 0.3);
     let area: f64 = mesh.triangles.iter().map(|t| t.area as f64).sum();
-    for rho in [0.5, 0.9] {
-        for overshoot in [false, true] {
+    let cases = [(0.5, false, Visibility::Hemicube), (0.5, true, Visibility::Hemicube), (0.9, false, Visibility::Hemicube), (0.9, true, Visibility::Hemicube), (0.9, true, Visibility::Stereographic)];
+    for (rho, overshoot, visibility) in cases {
+        {
             let m = manifest(2, vec![material([rho; 3], [0.0; 3]), material([rho; 3], [10.0; 3])]);
-            let params = Params { texels: 2000.0, shoot_level: 1, convergence: 0.999, overshoot, ..Params::default() };
+            let params = Params { texels: 2000.0, shoot_level: 1, convergence: 0.999, overshoot, visibility, ..Params::default() };
             let Some(solved) = run(&mesh, &m, &[], &params) else { return };
             let power = solved.emitted_power[0];
             let expected = power / ((1.0 - rho) * area);
@@ -101,7 +104,7 @@ fn closed_box_balances_energy_with_and_without_overshooting() {
             }
             let mean = sum / area;
             let error = (mean - expected).abs() / expected;
-            eprintln!("closed box rho {rho} overshoot {overshoot}: {} shots, mean B {mean:.4} vs {expected:.4} ({error:.4})", solved.shots.len());
+            eprintln!("closed box rho {rho} overshoot {overshoot} {visibility:?}: {} shots, mean B {mean:.4} vs {expected:.4} ({error:.4})", solved.shots.len());
             assert!(solved.shots.last().unwrap().unshot_fraction <= 1e-3);
             assert!(error < 0.01, "rho {rho} overshoot {overshoot}: mean radiosity {mean} vs {expected}");
             // The GPU reduction against its CPU reference.
@@ -173,13 +176,15 @@ fn asymmetric_ldt_light_matches_the_cpu_lookup_on_the_gpu() {
 
 /// Every triangle of a closed box, shooting once, delivers all its power:
 /// the sum over receivers of (received power) / (shot power) is 1 within
-/// 0.1% (the near-field point-to-patch factor and the receiver-plane depth
+/// 0.1% with the hemicube, 0.5% with the stereographic map, whose
+/// piecewise-linear projection misplaces receivers near the horizon (the near-field point-to-patch factor and the receiver-plane depth
 /// test; the disc approximation alone lost up to 31% for a sample next to
 /// a crease, and the plain depth test 1-2.5% of every wall's shot).
 #[test]
 fn every_shot_in_a_closed_box_delivers_its_power() {
     let base = closed_box(1.0, 0.3);
     let Some((device, queue)) = device() else { return };
+    for (visibility, limit) in [(Visibility::Hemicube, 1e-3), (Visibility::Stereographic, 5e-3)] {
     let mut worst = 0.0f64;
     for shooter in 0..base.triangles.len() {
         let mut mesh = base.clone();
@@ -188,7 +193,7 @@ fn every_shot_in_a_closed_box_delivers_its_power() {
         }
         // Receivers reflect everything (rho 1), so radiosity x area is received power.
         let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
-        let params = Params { texels: 1500.0, shoot_level: 0, max_shots: 1, convergence: 1.0, overshoot: false, ..Params::default() };
+        let params = Params { texels: 1500.0, shoot_level: 0, max_shots: 1, convergence: 1.0, overshoot: false, visibility, ..Params::default() };
         let solved = solve(&device, &queue, &mesh, &m, &[], &params, &mut |_| {}).unwrap();
         assert_eq!(solved.shots[0].shooter, format!("triangle {shooter}"));
         let received: f64 = solved
@@ -202,6 +207,7 @@ fn every_shot_in_a_closed_box_delivers_its_power() {
         let ratio = received / solved.emitted_power[0];
         worst = worst.max((ratio - 1.0).abs());
     }
-    eprintln!("closed box, one shot per triangle: worst |received / shot - 1| = {worst:.2e}");
-    assert!(worst < 1e-3, "{worst}");
+    eprintln!("closed box, one shot per triangle ({visibility:?}): worst |received / shot - 1| = {worst:.2e}");
+    assert!(worst < limit, "{visibility:?}: {worst}");
+    }
 }

@@ -50,6 +50,7 @@ struct Selection {
 @group(0) @binding(8) var<storage, read_write> samples: array<Sample>;
 @group(0) @binding(9) var<storage, read_write> ldt: array<f32>;
 @group(0) @binding(10) var visibility: texture_2d_array<f32>;
+@group(0) @binding(11) var<storage, read> vertices: array<vec4<f32>>;
 
 const WG: u32 = 256u;
 const PI: f32 = 3.14159265358979;
@@ -190,28 +191,6 @@ fn finish_shooter(@builtin(global_invocation_id) id: vec3<u32>) {
     residual[tri.first + id.x] = vec4<f32>(-selection.overshoot.xyz, 0.0);
 }
 
-fn depth(x: i32, y: i32, layer: u32) -> f32 {
-    let r = i32(params.res);
-    return textureLoad(visibility, vec2<i32>(clamp(x, 0, r - 1), clamp(y, 0, r - 1)), i32(layer), 0).x;
-}
-
-// Whether the point at distance d that projects to (px, py) of `layer` is
-// visible: the centre pixel holds nothing nearer than d (within the
-// tolerance), or one of its 8 neighbours holds a surface at d (the
-// neighbour test of 004 Fig. 2.3, against silhouette artefacts).
-fn visible(px: f32, py: f32, layer: u32, d: f32) -> bool {
-    let x = i32(floor(px));
-    let y = i32(floor(py));
-    let tol = params.tolerance * d;
-    if (depth(x, y, layer) >= d - tol) { return true; }
-    for (var dy = -1; dy <= 1; dy += 1) {
-        for (var dx = -1; dx <= 1; dx += 1) {
-            if (abs(depth(x + dx, y + dy, layer) - d) <= tol) { return true; }
-        }
-    }
-    return false;
-}
-
 // Whether a receiver at face coordinates q (normal m, same coordinates)
 // is visible in cube face `layer` (004 Sec. 2.3 with the neighbour test of
 // Fig. 2.3). Each pixel stores the distance to the nearest surface along
@@ -244,6 +223,64 @@ fn visible_face(layer: u32, q: vec3<f32>, m: vec3<f32>) -> bool {
             let tol = params.tolerance * plane;
             if (dx == 0 && dy == 0 && stored >= plane - tol) { return true; }
             if (abs(stored - plane) <= tol) { return true; }
+        }
+    }
+    return false;
+}
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+// Whether the receiver at p on triangle t is visible in the stereographic
+// map `layer` of sample s. Only vertices are projected (004 Sec. 2.3), so
+// the rasterizer maps each triangle affinely between its projected
+// corners; the receiver is placed the same way (the paper's back
+// projection with "the same error", 004 Sec. 2.3): at its barycentric
+// combination of its triangle's projected corners. Each pixel stores the
+// length of the linearly interpolated local position, so the distance the
+// receiver's own triangle would leave at a pixel centre is that of the
+// point with the pixel's barycentrics in the projected triangle; the test
+// compares with it, as visible_face does with the receiver's plane.
+fn visible_stereographic(layer: u32, t: u32, p: vec3<f32>, s: Sample) -> bool {
+    var l: array<vec3<f32>, 3>;
+    var m: array<vec2<f32>, 3>;
+    for (var k = 0u; k < 3u; k += 1u) {
+        let v = vertices[3u * t + k].xyz - s.position.xyz;
+        l[k] = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
+        m[k] = stereographic(l[k] / max(length(l[k]), 1e-20));
+    }
+    // Barycentrics of p in its triangle.
+    let p0 = vertices[3u * t].xyz;
+    let e1 = vertices[3u * t + 1u].xyz - p0;
+    let e2 = vertices[3u * t + 2u].xyz - p0;
+    let w = p - p0;
+    let d11 = dot(e1, e1);
+    let d12 = dot(e1, e2);
+    let d22 = dot(e2, e2);
+    let det = d11 * d22 - d12 * d12;
+    let u = (d22 * dot(w, e1) - d12 * dot(w, e2)) / det;
+    let v = (d11 * dot(w, e2) - d12 * dot(w, e1)) / det;
+    let at = m[0] + u * (m[1] - m[0]) + v * (m[2] - m[0]);
+    let res = f32(params.res);
+    let x = i32(floor((at.x * 0.5 + 0.5) * res));
+    let y = i32(floor((0.5 - at.y * 0.5) * res));
+    let a = m[1] - m[0];
+    let b = m[2] - m[0];
+    let area = cross2(a, b);
+    if (abs(area) < 1e-12) { return false; }
+    for (var dy = -1; dy <= 1; dy += 1) {
+        for (var dx = -1; dx <= 1; dx += 1) {
+            let cx = clamp(x + dx, 0, i32(params.res) - 1);
+            let cy = clamp(y + dy, 0, i32(params.res) - 1);
+            let c = vec2<f32>((f32(cx) + 0.5) / res * 2.0 - 1.0, 1.0 - (f32(cy) + 0.5) / res * 2.0) - m[0];
+            let bu = cross2(c, b) / area;
+            let bv = cross2(a, c) / area;
+            let own = length(l[0] + bu * (l[1] - l[0]) + bv * (l[2] - l[0]));
+            let stored = textureLoad(visibility, vec2<i32>(cx, cy), i32(layer), 0).x;
+            let tol = params.tolerance * own;
+            if (dx == 0 && dy == 0 && stored >= own - tol) { return true; }
+            if (abs(stored - own) <= tol) { return true; }
         }
     }
     return false;
@@ -400,10 +437,7 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
         let base = i * params.layers_per_sample;
         var seen = false;
         if (params.mode == 1u && !light) {
-            let uv = stereographic(local / d);
-            let px = (uv.x * 0.5 + 0.5) * f32(params.res);
-            let py = (0.5 - uv.y * 0.5) * f32(params.res);
-            seen = visible(px, py, base, d);
+            seen = visible_stereographic(base, tri, p, s);
         } else {
             let face = face_of(local);
             let normal = vec3<f32>(dot(nr, s.t.xyz), dot(nr, s.b.xyz), dot(nr, s.n.xyz));

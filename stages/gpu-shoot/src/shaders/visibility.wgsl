@@ -23,6 +23,15 @@ fn vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) layer: u32) -> Ve
     if (params.mode == 1u && s.power.w == 0.0) {
         let d = length(local);
         out.clip = vec4<f32>(stereographic(local / max(d, 1e-20)), d / params.far, 1.0);
+        // Cull triangles on or behind the shooter's plane (004 Sec. 2.3):
+        // the shooter's own and coplanar triangles project onto the rim and,
+        // filled across the disc, hid every receiver.
+        let t = vi / 3u;
+        var above = false;
+        for (var k = 0u; k < 3u; k += 1u) {
+            if (dot(vertices[3u * t + k].xyz - s.position.xyz, s.n.xyz) > 0.0) { above = true; }
+        }
+        if (!above) { out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0); }
     } else {
         let f = face_coords(face, local);
         let z = (f.z - params.near) * params.far / (params.far - params.near);
