@@ -53,21 +53,37 @@ pub fn describe(info: &wgpu::AdapterInfo) -> String {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuParams {
+    /// Covered texels in the atlas.
     pub n_texels: u32,
+    /// Triangles.
     pub n_tris: u32,
+    /// Triangle that shoots; `u32::MAX` for a light.
     pub shooter: u32,
+    /// First sample of this batch.
     pub sample_first: u32,
+    /// Samples in this batch.
     pub sample_count: u32,
+    /// Visibility layers per sample: 6 (cube faces) or 1 (stereographic).
     pub layers_per_sample: u32,
+    /// Visibility map side, pixels.
     pub res: u32,
+    /// 0: cube faces; 1: stereographic.
     pub mode: u32,
+    /// 1: ambient overshooting (004 Eq. 4.9).
     pub overshoot: u32,
+    /// Groups (samples) of the shooter.
     pub group_count: u32,
+    /// Padding to the WGSL layout.
     pub _pad0: [u32; 2],
+    /// Relative depth tolerance of the visibility test.
     pub tolerance: f32,
+    /// Near plane of the cube faces, m.
     pub near: f32,
+    /// Far distance, m.
     pub far: f32,
+    /// Sum of triangle areas, m².
     pub total_area: f32,
+    /// rgb: the interreflection factor R of 004 Eq. 2.6, per channel.
     pub interreflection: [f32; 4],
 }
 
@@ -75,9 +91,11 @@ pub struct GpuParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuTexel {
+    /// xyz: the point the texel stands for, m; w: its area, m².
     pub position_area: [f32; 4],
     /// xyz: normal; w: the triangle index's bits.
     pub normal_triangle: [f32; 4],
+    /// rgb: diffuse reflectance of its material; w: 1 for a hypotenuse texel (half a square).
     pub rho: [f32; 4],
 }
 
@@ -85,14 +103,23 @@ pub struct GpuTexel {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuTri {
+    /// First covered texel of the triangle.
     pub first: u32,
+    /// Covered texels of the triangle.
     pub count: u32,
+    /// First group (sample) of the triangle.
     pub group_first: u32,
+    /// Groups (samples) of the shooter.
     pub group_count: u32,
+    /// Triangle area, m².
     pub area: f32,
+    /// Padding to the WGSL layout.
     pub _pad: [f32; 3],
+    /// rgb: diffuse reflectance of its material.
     pub rho: [f32; 4],
+    /// xyz: `(P1 - P0) / (2 size)`, half a texel edge, m (the near-field patch).
     pub half_u: [f32; 4],
+    /// xyz: `(P2 - P0) / (2 size)`, half a texel edge, m.
     pub half_v: [f32; 4],
 }
 
@@ -100,8 +127,11 @@ pub struct GpuTri {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuGroup {
+    /// First texel of the group.
     pub first: u32,
+    /// Texels in the group.
     pub count: u32,
+    /// Padding to the WGSL layout.
     pub _pad: [u32; 2],
 }
 
@@ -109,9 +139,13 @@ pub struct GpuGroup {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuSample {
+    /// xyz: sample position, m; w: area of the group, m² (0 for a light).
     pub position_area: [f32; 4],
+    /// Frame tangent (light: r0, the C0 direction).
     pub t: [f32; 4],
+    /// Frame bitangent (light: u0).
     pub b: [f32; 4],
+    /// Frame normal (light: n0, the nadir).
     pub n: [f32; 4],
     /// rgb: unshot radiosity (area sample) or I_max in W/sr (light); w: 0 area, 1 light.
     pub power: [f32; 4],
@@ -121,21 +155,32 @@ pub struct GpuSample {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuSelection {
+    /// x: the triangle with the largest score.
     pub shooter: [u32; 4],
+    /// rgb: dB' of the shooter (004 Eq. 4.9), 0 without overshooting.
     pub overshoot: [f32; 4],
+    /// rgb: ambient term (004 Eq. 2.4-2.6), W/m².
     pub ambient: [f32; 4],
+    /// rgb: sum dB A over covered texels, W.
     pub unshot: [f32; 4],
+    /// rgb: sum |dB| A, W.
     pub unshot_abs: [f32; 4],
+    /// x: the shooter's |dB + dB'| A summed over channels, W.
     pub score: [f32; 4],
 }
 
 /// Everything the solver keeps on the device.
 pub struct Gpu {
+    /// Covered texels.
     pub texel_count: u32,
+    /// Triangles.
     pub tri_count: u32,
     params: wgpu::Buffer,
+    /// Radiosity per covered texel (vec4, rgb), W/m².
     pub radiosity: wgpu::Buffer,
+    /// Residual per covered texel (vec4, rgb), W/m².
     pub residual: wgpu::Buffer,
+    /// Per triangle: `sum dB A` (rgb, w: area) and `sum |dB| A`.
     pub tri_power: wgpu::Buffer,
     selection: wgpu::Buffer,
     samples: wgpu::Buffer,
@@ -179,8 +224,11 @@ fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayou
 
 /// What the GPU solver is built from.
 pub struct Setup<'a> {
+    /// The covered texels.
     pub texels: &'a [GpuTexel],
+    /// The triangles.
     pub tris: &'a [GpuTri],
+    /// The shooting samples (texel groups).
     pub groups: &'a [GpuGroup],
     /// Initial radiosity = residual = emission, per texel (rgb, 0).
     pub emission: &'a [[f32; 4]],

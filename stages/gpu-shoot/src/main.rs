@@ -186,9 +186,11 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (device, queue, info) = gpu::acquire().map_err(|m| schemas::Error::invalid(Path::new("gpu"), None, m))?;
     let adapter = gpu::describe(&info);
     let bar = progress(1000, "converged");
+    let mut fired = 0usize;
     let solved = solve(&device, &queue, &mesh, &manifest.value, &lights, &params, &mut |shot| {
+        fired += 1;
         bar.set_position(((1.0 - shot.unshot_fraction).clamp(0.0, 1.0) * 1000.0) as u64);
-        bar.set_message(format!("{} shots", 0));
+        bar.set_message(format!("{fired} shots"));
     })
     .map_err(|m| schemas::Error::invalid(mesh_path, None, m))?;
     bar.finish_and_clear();
