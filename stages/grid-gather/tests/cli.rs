@@ -145,3 +145,52 @@ fn print_params_reads_back_through_params() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("typo.ron"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The diagnostics artifact's schema, as a reader declares it.
+struct GatherDiagnostics;
+
+impl Schema for GatherDiagnostics {
+    const NAME: &'static str = "gather-diagnostics";
+    const VERSION: u32 = 1;
+}
+
+#[test]
+fn a_clustered_solution_needs_its_hierarchy_and_full_mode_writes_diagnostics() {
+    let dir = workdir("clusters");
+    let (mesh, manifest) = mesh_prep::prepare_builtin("box-200", "test").unwrap();
+    let geometry = radiometry::geometry::mesh_triangles(&mesh);
+    let reflectances: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.materials[t.material as usize].diffuse).collect();
+    let h = cluster::build(&geometry, &reflectances, &cluster::Params::default());
+    let clusters = schemas::cluster::Clusters { header: schemas::cluster::Clusters::header(provenance()), nodes: h.nodes, order: h.order };
+    let params = hierarchical_solve::Params { eps: 1e-2, ..hierarchical_solve::Params::default() };
+    let solved = hierarchical_solve::solve(&mesh, &manifest, Some(clusters.clone()), &params, &|_| {}).unwrap();
+    let solution = Solution { header: Solution::header(provenance()), elements: solved.elements, clusters: solved.clusters, links: solved.links };
+    mesh.write(&dir.join("mesh.exr")).unwrap();
+    write_ron(&dir.join("manifest.ron"), &manifest).unwrap();
+    solution.write(&dir.join("solution.exr")).unwrap();
+    clusters.write(&dir.join("clusters.exr")).unwrap();
+    let size = ["--width", "16", "--height", "12", "--spp", "1"];
+
+    let out = gather(&dir, &[&["--mode", "full", "--diagnostics", "d.exr"][..], &size].concat());
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.lines().count() == 1 && stderr.contains("solution.exr") && stderr.contains("--clusters"), "{stderr}");
+    assert!(!dir.join("image.exr").exists() && !dir.join("d.exr").exists(), "no partial output");
+
+    let out = gather(&dir, &[&["--mode", "full", "--clusters", "clusters.exr", "--diagnostics", "d.exr", "--report", "r.ron"][..], &size].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (image, _) = HdrImage::read(&dir.join("image.exr")).unwrap();
+    assert!(image.header.provenance.inputs.iter().any(|i| i.path == "clusters.exr"));
+    let (d, _) = schemas::exr_io::read_exr::<GatherDiagnostics>(&dir.join("d.exr")).unwrap();
+    let pixel = d.layer(Path::new("d.exr"), "pixel").unwrap();
+    let classes: f32 = ["class.rv_rf", "class.rv_if", "class.iv_rf", "class.iv_if"].iter().map(|c| pixel.f32s(Path::new("d.exr"), c).unwrap().iter().sum::<f32>()).sum();
+    assert!(classes > 0.0, "senders counted per pixel");
+    let vertex = d.layer(Path::new("d.exr"), "vertex").unwrap();
+    let report = read_ron::<Report>(&dir.join("r.ron")).unwrap().value;
+    assert_eq!(vertex.len() as f64, report.counters["grid_vertices_built"]);
+    // Preview mode writes no diagnostics and says so.
+    let out = gather(&dir, &[&["--diagnostics", "d2.exr"][..], &size].concat());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!dir.join("d2.exr").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
