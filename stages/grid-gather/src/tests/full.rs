@@ -119,7 +119,7 @@ fn relative_rmse(a: &[f64], b: &[f64]) -> f64 {
 fn without_occluders_every_sender_interpolates_visibility_and_matches_brute_force() {
     let room = room();
     let full = Params { mode: Mode::Full, spp: 2, grid_pixels: 8, grid_depth: 6, ..Params::default() };
-    let (image, _) = run(&room, &full);
+    let (image, diagnostics) = run(&room, &full);
     assert!(!diagnostics.vertices.is_empty());
     for v in &diagnostics.vertices {
         assert_eq!(v.classes[0] + v.classes[1], 0, "vertex {:?} resamples visibility: {:?}", v.ijk, v.classes);
