@@ -56,23 +56,50 @@ full: $(OUT)/final.png
 
 # Tables 1-2 of paper 000 in shape: brute force and the full gather (with
 # and without masking) against a high-sample brute-force reference, on the
-# Cornell box at BENCH_SIZE^2 pixels. Figures: each run's report
-# (visibility_rays, form_factor_evaluations, wall_time_s) and compare's
-# relative RMSE, gathered in out/bench-gather/summary.txt.
+# Cornell box at BENCH_SIZE^2 pixels and on the clustered plant room
+# (mesh-prep's plants-10k, cluster, hierarchical-solve --clusters at eps
+# 1e-2) at BENCH_PLANT_SIZE^2. Figures: each run's report (visibility_rays,
+# form_factor_evaluations, wall_time_s) and compare's relative RMSE, in
+# out/bench-gather/summary.txt and out/bench-gather-plants/summary.txt;
+# `equal_error_brute_rays` is the brute-force ray count at the run's error,
+# interpolated on the brute runs' log(rays)-log(error) line.
 BENCH_SIZE ?= 128
+BENCH_PLANT_SIZE ?= 64
 BENCH_OUT := out/bench-gather
+BENCH_PLANTS := out/bench-gather-plants
 BG_ARGS = --mesh $(BENCH_OUT)/mesh.exr --manifest $(BENCH_OUT)/manifest.ron --solution $(BENCH_OUT)/solution.exr --width $(BENCH_SIZE) --height $(BENCH_SIZE)
+BP_ARGS = --mesh $(BENCH_PLANTS)/mesh.exr --manifest $(BENCH_PLANTS)/manifest.ron --solution $(BENCH_PLANTS)/solution.exr --clusters $(BENCH_PLANTS)/clusters.exr --width $(BENCH_PLANT_SIZE) --height $(BENCH_PLANT_SIZE)
+
+# bench_runs(dir, args, reference samples, brute sample counts): the
+# reference, the brute runs, full and masked, and the summary table.
+define bench_runs
+	$(BIN)/grid-gather $(2) --brute --brute-samples $(3) -o $(1)/reference.exr --report $(1)/reference.report.ron
+	for n in $(4); do $(BIN)/grid-gather $(2) --brute --brute-samples $$n -o $(1)/brute$$n.exr --report $(1)/brute$$n.report.ron; done
+	$(BIN)/grid-gather $(2) --mode full --diagnostics $(1)/full.diagnostics.exr -o $(1)/full.exr --report $(1)/full.report.ron
+	$(BIN)/grid-gather $(2) --mode full --threshold $(1)/threshold.exr --diagnostics $(1)/masked.diagnostics.exr -o $(1)/masked.exr --report $(1)/masked.report.ron
+	@for r in $(addprefix brute,$(4)) full masked; do \
+	  rays=$$(grep -oE '"visibility_rays": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
+	  ffs=$$(grep -oE '"form_factor_evaluations": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
+	  crays=$$(grep -oE '"classification_visibility_rays": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
+	  time=$$(grep -oE 'wall_time_s: [0-9.]+' $(1)/$$r.report.ron | grep -oE '[0-9.]+$$'); \
+	  err=$$($(BIN)/compare $(1)/$$r.exr $(1)/reference.exr -o $(1)/$$r.compare.ron 2>&1 | grep -oE 'relative_rmse [0-9.e-]+' | grep -oE '[0-9.e-]+$$'); \
+	  echo "$$r $$rays $$crays $$ffs $$time $$err"; \
+	done | awk 'BEGIN { printf "%-8s %14s %14s %14s %8s %12s %14s %8s\n", "run", "vis_rays", "class_rays", "ff_evals", "time_s", "rel_rmse", "brute_rays@err", "ratio" } \
+	  { name[NR] = $$1; rays[NR] = $$2 + $$3; line[NR] = sprintf("%-8s %14d %14d %14d %8.2f %12.3e", $$1, $$2, $$3, $$4, $$5, $$6); err[NR] = $$6; \
+	    if ($$1 ~ /^brute/) { nb++; lx[nb] = log($$2); ly[nb] = log($$6) } } \
+	  END { sx = sy = sxx = sxy = 0; for (i = 1; i <= nb; i++) { sx += lx[i]; sy += ly[i]; sxx += lx[i]^2; sxy += lx[i] * ly[i] } \
+	    b = (nb * sxy - sx * sy) / (nb * sxx - sx^2); a = (sy - b * sx) / nb; \
+	    for (i = 1; i <= NR; i++) { eq = exp((log(err[i]) - a) / b); printf "%s %14d %8.3f\n", line[i], eq, rays[i] / eq } }' | tee $(1)/summary.txt
+endef
+
 bench-gather: $(BINS) $(BIN)/mask
-	@mkdir -p $(BENCH_OUT)
+	@mkdir -p $(BENCH_OUT) $(BENCH_PLANTS)
 	$(MAKE) --no-print-directory OUT=$(BENCH_OUT) WIDTH=$(BENCH_SIZE) HEIGHT=$(BENCH_SIZE) $(BENCH_OUT)/threshold.exr
-	$(BIN)/grid-gather $(BG_ARGS) --brute --brute-samples 256 -o $(BENCH_OUT)/reference.exr --report $(BENCH_OUT)/reference.report.ron
-	$(BIN)/grid-gather $(BG_ARGS) --brute --brute-samples 16 -o $(BENCH_OUT)/brute16.exr --report $(BENCH_OUT)/brute16.report.ron
-	$(BIN)/grid-gather $(BG_ARGS) --brute --brute-samples 64 -o $(BENCH_OUT)/brute64.exr --report $(BENCH_OUT)/brute64.report.ron
-	$(BIN)/grid-gather $(BG_ARGS) --mode full -o $(BENCH_OUT)/full.exr --report $(BENCH_OUT)/full.report.ron
-	$(BIN)/grid-gather $(BG_ARGS) --mode full --threshold $(BENCH_OUT)/threshold.exr -o $(BENCH_OUT)/masked.exr --report $(BENCH_OUT)/masked.report.ron
-	@for r in brute16 brute64 full masked; do \
-	  printf '%-8s ' $$r; \
-	  grep -oE '"(visibility_rays|form_factor_evaluations|classification_visibility_rays)": [0-9.e+]+' $(BENCH_OUT)/$$r.report.ron | tr '\n' ' '; \
-	  grep -oE 'wall_time_s: [0-9.]+' $(BENCH_OUT)/$$r.report.ron | tr '\n' ' '; \
-	  $(BIN)/compare $(BENCH_OUT)/$$r.exr $(BENCH_OUT)/reference.exr -o $(BENCH_OUT)/$$r.compare.ron 2>&1 | grep -oE 'relative_rmse [0-9.e-]+'; \
-	done | tee $(BENCH_OUT)/summary.txt
+	$(call bench_runs,$(BENCH_OUT),$(BG_ARGS),256,4 8 16 64)
+	$(BIN)/mesh-prep --builtin plants-10k --mesh $(BENCH_PLANTS)/mesh.exr --manifest $(BENCH_PLANTS)/manifest.ron
+	$(BIN)/cluster --mesh $(BENCH_PLANTS)/mesh.exr --manifest $(BENCH_PLANTS)/manifest.ron -o $(BENCH_PLANTS)/clusters.exr
+	$(BIN)/hierarchical-solve --mesh $(BENCH_PLANTS)/mesh.exr --manifest $(BENCH_PLANTS)/manifest.ron --clusters $(BENCH_PLANTS)/clusters.exr --eps 1e-2 -o $(BENCH_PLANTS)/solution.exr --report $(BENCH_PLANTS)/solve.report.ron
+	$(BIN)/grid-gather $(BP_ARGS) --mode preview -o $(BENCH_PLANTS)/preview.exr
+	$(BIN)/tonemap --operator $(OPERATOR) $(BENCH_PLANTS)/preview.exr -o $(BENCH_PLANTS)/preview.png
+	$(BIN)/mask $(BENCH_PLANTS)/preview.png -o $(BENCH_PLANTS)/threshold.exr
+	$(call bench_runs,$(BENCH_PLANTS),$(BP_ARGS),128,4 8 16)
