@@ -49,10 +49,24 @@ pub fn s(path: &Path) -> &str {
 /// mesh-prep then hierarchical-solve on `scene` in `dir`, with extra
 /// solver arguments; returns the paths of mesh, manifest and solution.
 pub fn prepare_and_solve(dir: &Path, scene: &Path, solve_args: &[&str]) -> (PathBuf, PathBuf, PathBuf) {
-    let (mesh, manifest, solution) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("solution.exr"));
+    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
     run_ok("mesh-prep", &[s(scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let solution = solve_prepared(dir, solve_args, None);
+    (mesh, manifest, solution)
+}
+
+/// hierarchical-solve on the mesh and manifest already in `dir`, clustered
+/// with clusters of at most `leaf_size` triangles if given; returns the
+/// solution's path.
+pub fn solve_prepared(dir: &Path, solve_args: &[&str], leaf_size: Option<u32>) -> PathBuf {
+    let (mesh, manifest, clusters, solution) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("clusters.exr"), dir.join("solution.exr"));
     let mut args = vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution)];
+    let leaf = leaf_size.map(|l| l.to_string());
+    if let Some(leaf) = &leaf {
+        run_ok("cluster", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&clusters), "--leaf-size", leaf]);
+        args.extend_from_slice(&["--clusters", s(&clusters)]);
+    }
     args.extend_from_slice(solve_args);
     run_ok("hierarchical-solve", &args);
-    (mesh, manifest, solution)
+    solution
 }

@@ -1,10 +1,12 @@
 //! hierarchical-solve against closed forms: configuration factors of
 //! rectangles (Howell C-11, C-14), irradiance under a square emitter
-//! (Lambert), and energy balance of closed rooms.
+//! (Lambert), and energy balance of closed rooms; each without and with
+//! clustering (clusters of one triangle, so that cluster nodes really sit
+//! between the triangles and the root).
 
 use end_to_end::closed_form::{parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
 use end_to_end::scenes::{closed_box, rectangle, QuadScene};
-use end_to_end::{prepare_and_solve, scratch};
+use end_to_end::{run_ok, s, scratch, solve_prepared};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::{Node, Solution};
@@ -16,11 +18,15 @@ struct Solved {
     object_of_element: Vec<String>,
 }
 
-fn solve(test: &str, scene: &QuadScene, args: &[&str]) -> Solved {
-    let dir = scratch(test);
+/// Prepares and solves `scene` in a scratch directory; `clustered` adds a
+/// cluster hierarchy of one triangle per leaf.
+fn solve(test: &str, scene: &QuadScene, args: &[&str], clustered: bool) -> (Solved, std::path::PathBuf) {
+    let dir = scratch(&format!("{test}{}", if clustered { "_clustered" } else { "" }));
     let scene_path = scene.write(&dir);
-    let (mesh, manifest, solution) = prepare_and_solve(&dir, &scene_path, args);
-    load(&mesh, &manifest, &solution)
+    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
+    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let solution = solve_prepared(&dir, args, clustered.then_some(1));
+    (load(&mesh, &manifest, &solution), dir)
 }
 
 fn load(mesh: &Path, manifest: &Path, solution: &Path) -> Solved {
@@ -58,6 +64,18 @@ impl Solved {
         flux / area_of(r)
     }
 
+    /// Area-weighted mean radiosity (grey) of the leaves of `object`.
+    fn mean_radiosity(&self, object: &str) -> f64 {
+        let (mut weighted, mut area) = (0.0, 0.0);
+        for (o, a, b, _) in self.leaves() {
+            if o == object {
+                weighted += a * b;
+                area += a;
+            }
+        }
+        weighted / area
+    }
+
     /// Leaves with their object, area and radiosity (grey: channel 0).
     fn leaves(&self) -> impl Iterator<Item = (&str, f64, f64, usize)> {
         self.solution
@@ -77,6 +95,20 @@ fn assert_close(what: &str, got: f64, want: f64, relative: f64) {
     assert!(error <= relative, "{what}: {got} vs closed form {want} (relative error {error:.2e} > {relative:.0e})");
 }
 
+/// Rectangles R (reflectance 1/2) and S (emitting 1 W/m², black): the
+/// solver's R-S factor summed over its element links must be the closed
+/// form, and R's mean radiosity rho F_RS E with or without clusters (there
+/// links may join clusters holding parts of both R and S, so only the
+/// radiosity is compared).
+fn check_pair(test: &str, scene: &QuadScene, exact: f64, what: &str) {
+    let (solved, _) = solve(test, scene, &FINE, false);
+    assert_close(&format!("F_RS for {what}"), solved.form_factor("R", "S"), exact, 0.01);
+    for clustered in [false, true] {
+        let (solved, _) = solve(test, scene, &FINE, clustered);
+        assert_close(&format!("B_R for {what}, clustered {clustered}"), solved.mean_radiosity("R"), 0.5 * exact, 0.01);
+    }
+}
+
 #[test]
 fn parallel_rectangles_match_howell_c11() {
     for (k, (a, b, c)) in [(1.0, 1.0, 1.0), (2.0, 1.0, 0.5), (1.0, 3.0, 2.0)].into_iter().enumerate() {
@@ -84,9 +116,10 @@ fn parallel_rectangles_match_howell_c11() {
         scene.material("receiving", 0.5, 0.0).material("emitting", 0.0, 1.0);
         scene.quad("R", "receiving", rectangle(2, 0.0, [0.0, 0.0], [a, b]), [0.0, 0.0, 1.0]);
         scene.quad("S", "emitting", rectangle(2, c, [0.0, 0.0], [a, b]), [0.0, 0.0, -1.0]);
-        let solved = solve(&format!("c11_{k}"), &scene, &FINE);
-        assert_close(&format!("F_RS for {a} x {b} at {c}"), solved.form_factor("R", "S"), parallel_rectangles(a, b, c), 0.01);
-        assert_close(&format!("F_SR for {a} x {b} at {c}"), solved.form_factor("S", "R"), parallel_rectangles(a, b, c), 0.01);
+        let exact = parallel_rectangles(a, b, c);
+        check_pair(&format!("c11_{k}"), &scene, exact, &format!("{a} x {b} at {c}"));
+        let (solved, _) = solve(&format!("c11_{k}"), &scene, &FINE, false);
+        assert_close(&format!("F_SR for {a} x {b} at {c}"), solved.form_factor("S", "R"), exact, 0.01);
     }
 }
 
@@ -98,22 +131,28 @@ fn perpendicular_rectangles_sharing_an_edge_match_howell_c14() {
         scene.material("receiving", 0.5, 0.0).material("emitting", 0.0, 1.0);
         scene.quad("R", "receiving", rectangle(2, 0.0, [0.0, 0.0], [w, l]), [0.0, 0.0, 1.0]);
         scene.quad("S", "emitting", rectangle(0, 0.0, [0.0, 0.0], [l, h]), [1.0, 0.0, 0.0]);
-        let solved = solve(&format!("c14_{k}"), &scene, &FINE);
-        assert_close(&format!("F for w={w} h={h} l={l}"), solved.form_factor("R", "S"), perpendicular_rectangles(w, h, l), 0.01);
+        check_pair(&format!("c14_{k}"), &scene, perpendicular_rectangles(w, h, l), &format!("w={w} h={h} l={l}"));
     }
 }
 
 #[test]
 fn floor_irradiance_under_a_square_emitter_matches_lambert() {
+    lambert(false);
+}
+
+#[test]
+fn floor_irradiance_under_a_square_emitter_matches_lambert_with_clusters() {
+    lambert(true);
+}
+
+fn lambert(clustered: bool) {
     let (rho, height) = (0.5, 1.0);
     let mut scene = QuadScene { camera: ([0.0, -3.0, 2.0], [0.0, 0.0, 0.0]), ..Default::default() };
     scene.material("floor", rho, 0.0).material("lamp", 0.0, 1.0);
     scene.quad("floor", "floor", rectangle(2, 0.0, [-2.0, -2.0], [2.0, 2.0]), [0.0, 0.0, 1.0]);
     scene.quad("lamp", "lamp", rectangle(2, height, [-0.5, -0.5], [0.5, 0.5]), [0.0, 0.0, -1.0]);
-    let dir = scratch("lambert");
-    let scene_path = scene.write(&dir);
-    let (mesh_path, manifest_path, solution_path) = prepare_and_solve(&dir, &scene_path, &["--eps", "1e-4", "--min-area", "1e-5"]);
-    let solved = load(&mesh_path, &manifest_path, &solution_path);
+    let (solved, dir) = solve("lambert", &scene, &["--eps", "1e-4", "--min-area", "1e-5"], clustered);
+    let (mesh_path, manifest_path) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
     let (mesh, _) = Mesh::read(&mesh_path).unwrap();
     let manifest = read_ron::<Manifest>(&manifest_path).unwrap().value;
     let origin = manifest.world_from_mesh_translation;
@@ -139,9 +178,9 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert() {
     assert!(checked > 100, "only {checked} floor elements under the lamp");
 }
 
-fn energy_balance(test: &str, rho: f64) {
+fn energy_balance(test: &str, rho: f64, clustered: bool) {
     let (size, emission) = (1.0, 10.0);
-    let solved = solve(test, &closed_box(size, rho, emission), &["--eps", "1e-3", "--min-area", "1e-3", "--tolerance", "1e-7"]);
+    let (solved, _) = solve(test, &closed_box(size, rho, emission), &["--eps", "1e-3", "--min-area", "1e-3", "--tolerance", "1e-7"], clustered);
     let lamp_area = (size / 3.0) * (size / 3.0);
     let total_area = 6.0 * size * size;
     let expected = emission * lamp_area / ((1.0 - rho) * total_area);
@@ -158,10 +197,12 @@ fn energy_balance(test: &str, rho: f64) {
 
 #[test]
 fn closed_box_conserves_energy_rho_0_5() {
-    energy_balance("energy_0_5", 0.5);
+    energy_balance("energy_0_5", 0.5, false);
+    energy_balance("energy_0_5", 0.5, true);
 }
 
 #[test]
 fn closed_box_conserves_energy_rho_0_9() {
-    energy_balance("energy_0_9", 0.9);
+    energy_balance("energy_0_9", 0.9, false);
+    energy_balance("energy_0_9", 0.9, true);
 }

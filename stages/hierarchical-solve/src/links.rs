@@ -156,7 +156,13 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
 /// form factor larger than `A_s / (pi d_min^2)`, `d_min` the distance
 /// between the two bounding boxes, so the link may misplace at most
 /// `rho_r B_s A_s / (pi d_min^2)`; above `threshold` the larger node (by
-/// bounding box) is split, or the other where the larger cannot be.
+/// bounding box) is split, or the other where the larger cannot be. And,
+/// as between elements, the link spreads the sender's mean radiosity over
+/// the sender: where its children's radiosities differ from that mean by
+/// more than `threshold / (rho_r F_rs)` the sender is split. Without this
+/// term a cluster holding a lamp and the dim ceiling around it sends the
+/// mean of the two to the floor, which the lamp sees better than the
+/// ceiling does: a closed box lost 2.7% of its energy at eps 5e-2.
 /// Between elements, see [`decide_elements`].
 pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64, min_area: f64) -> Split {
     let (r, s) = (link.receiver, link.sender);
@@ -171,10 +177,18 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64
             let reflected = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);
             let distance = box_distance(h.bounds(r), h.bounds(s));
             let bound = if distance > 0.0 { h.area(s) / (PI * distance * distance) } else { f64::INFINITY };
-            if reflected * bound <= threshold {
-                Split::Keep
-            } else {
+            let sender_variation = h
+                .children_if_any(s)
+                .iter()
+                .flat_map(|&child| (0..3).map(move |c| (child, c)))
+                .map(|(child, c)| rho[c] * (radiosity[h.flat(child)][c] - b[c]).abs())
+                .fold(0.0, f64::max);
+            if sender_variation * link.form_factor > threshold && sender_variation * link.form_factor >= reflected * bound {
+                Split::Sender
+            } else if reflected * bound > threshold {
                 Split::Larger
+            } else {
+                Split::Keep
             }
         }
     };

@@ -178,6 +178,15 @@ impl Hierarchy {
         }
     }
 
+    /// The children of a node, if they exist (an element not yet
+    /// subdivided has none).
+    pub fn children_if_any(&self, node: Node) -> Vec<Node> {
+        match node {
+            Node::Element(e) if self.elements[e as usize].is_leaf() => Vec::new(),
+            _ => self.children(node),
+        }
+    }
+
     /// The parent of a node in the whole hierarchy: an input triangle's is
     /// its leaf cluster.
     pub fn parent(&self, node: Node) -> Option<Node> {
