@@ -152,8 +152,9 @@ fn constant_intensity_light_gives_i_cos_over_d_squared() {
 }
 
 #[test]
-fn asymmetric_ldt_light_matches_the_cpu_lookup_on_the_gpu() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/lidrs_example_prolicht_E30-0019.ldt");
+fn asymmetric_ldt_and_ies_lights_match_the_cpu_lookup_on_the_gpu() {
+    for file in ["lidrs_example_prolicht_E30-0019.ldt", "lidrs_iesna2002_example_typec_tilt_include.ies"] {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);
     let d = gpu_shoot::photometry::parse(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
     let rho = 0.5;
     let mesh = quads(&[(DVec3::new(-1.0, 0.0, -1.0), DVec3::Z * 2.0, DVec3::X * 2.0, 0, 0)]);
@@ -170,8 +171,9 @@ fn asymmetric_ldt_light_matches_the_cpu_lookup_on_the_gpu() {
             worst = worst.max((solved.radiosity[k][0] as f64 - exact).abs() / exact);
         }
     }
-    eprintln!("asymmetric LDT on the GPU vs CPU: worst relative difference {worst:.2e}");
-    assert!(worst < 1e-3, "{worst}");
+    eprintln!("{file} on the GPU vs CPU: worst relative difference {worst:.2e}");
+    assert!(worst < 1e-3, "{file}: {worst}");
+    }
 }
 
 /// Every triangle of a closed box, shooting once, delivers all its power:
