@@ -8,20 +8,34 @@
 SHELL := bash
 
 # --- scene -------------------------------------------------------------
-# SCENE=cornell is built into mesh-prep; anything else is a scene.ron path.
+# SCENE=cornell (the default) and the sized procedural scenes (plants-100k,
+# sphere-5k, box-100k, cornell-box-2k, ...) are built into mesh-prep;
+# anything that names an existing file is a scene.ron path.
 SCENE ?= cornell
 ifeq ($(SCENE),cornell)
   SCENE_ARGS := --builtin cornell-box
   SCENE_FILES :=
   SCENE_NAME := cornell
-else
+else ifneq ($(wildcard $(SCENE)),)
   SCENE_ARGS := $(SCENE)
   SCENE_FILES := $(SCENE) $(wildcard $(dir $(SCENE))*.obj $(dir $(SCENE))*.mtl)
   SCENE_NAME := $(notdir $(patsubst %/,%,$(dir $(abspath $(SCENE)))))
+else
+  SCENE_ARGS := --builtin $(SCENE)
+  SCENE_FILES :=
+  SCENE_NAME := $(SCENE)
 endif
 OUT ?= out/$(SCENE_NAME)
 
 # --- knobs (defaults are the stages' own) -------------------------------
+# CLUSTERS=1 solves with the cluster hierarchy (the cluster stage), 0 links
+# every pair of input triangles. The large procedural scenes default to a
+# coarser refinement threshold: 2e-4 of the lamp's exitance is a Cornell-box
+# figure, far stricter than a 100k-triangle plant room needs.
+CLUSTERS ?= 1
+ifneq ($(filter plants-% box-% sphere-%,$(SCENE)),)
+  EPS ?= 1e-2
+endif
 EPS ?= 2e-4
 MIN_AREA ?= 1e-4
 VISIBILITY_RAYS ?= 16
@@ -33,7 +47,7 @@ SPP ?= 4
 OPERATOR ?= reinhard
 
 BIN := target/release
-STAGES := mesh-prep hierarchical-solve grid-gather tonemap compare
+STAGES := mesh-prep cluster hierarchical-solve grid-gather tonemap compare
 BINS := $(addprefix $(BIN)/,$(STAGES))
 
 .PHONY: all test bench clean FORCE
@@ -64,6 +78,11 @@ test: $(BINS)
 # obvhs's raw traversal rate measured in the same run (see README).
 bench: $(BINS) | out
 	$(BIN)/bench-solve -o out/bench-solve.ron
+
+# Clustering at scale: plant rooms of 10k, 100k and 1M triangles (see README).
+.PHONY: bench-scale
+bench-scale: $(BINS) | out
+	$(BIN)/bench-scale --sizes $(or $(SIZES),10k,100k,1m) -o out/bench-scale.ron
 
 out:
 	@mkdir -p $@

@@ -1,8 +1,11 @@
-# The hierarchical pipeline: mesh-prep -> hierarchical-solve -> grid-gather
-# (preview) -> tonemap. Every intermediate lands in $(OUT); every stage also
-# writes its report (work done, wall time) beside its output.
+# The hierarchical pipeline: mesh-prep -> [cluster] -> hierarchical-solve ->
+# grid-gather (preview) -> tonemap. Every intermediate lands in $(OUT);
+# every stage also writes its report (work done, wall time) beside its
+# output. CLUSTERS=0 leaves the cluster stage out.
+CLUSTERS_EXR := $(if $(filter 1,$(CLUSTERS)),$(OUT)/clusters.exr)
 
 $(eval $(call params_file,mesh-prep,))
+$(eval $(call params_file,cluster,))
 $(eval $(call params_file,hierarchical-solve,--eps $(EPS) --min-area $(MIN_AREA) --visibility-rays $(VISIBILITY_RAYS) --tolerance $(TOLERANCE) --seed $(SEED)))
 $(eval $(call params_file,grid-gather,--spp $(SPP) $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT))))
 $(eval $(call params_file,tonemap,--operator $(OPERATOR)))
@@ -11,9 +14,17 @@ $(OUT)/mesh.exr $(OUT)/manifest.ron &: $(BIN)/mesh-prep $(OUT)/params/mesh-prep.
 	$(BIN)/mesh-prep $(SCENE_ARGS) --params $(OUT)/params/mesh-prep.ron \
 	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --report $(OUT)/mesh-prep.report.ron
 
-$(OUT)/solution.exr: $(BIN)/hierarchical-solve $(OUT)/params/hierarchical-solve.ron $(OUT)/mesh.exr $(OUT)/manifest.ron
+$(OUT)/clusters.exr: $(BIN)/cluster $(OUT)/params/cluster.ron $(OUT)/mesh.exr $(OUT)/manifest.ron
+	$(BIN)/cluster --params $(OUT)/params/cluster.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron -o $@ --report $(OUT)/cluster.report.ron
+
+# The clustering choice, rewritten only when it changes, so that switching
+# CLUSTERS reruns the solve.
+$(OUT)/params/clusters: FORCE | $(OUT)/params
+	@echo "$(CLUSTERS)" > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
+
+$(OUT)/solution.exr: $(BIN)/hierarchical-solve $(OUT)/params/hierarchical-solve.ron $(OUT)/params/clusters $(OUT)/mesh.exr $(OUT)/manifest.ron $(CLUSTERS_EXR)
 	$(BIN)/hierarchical-solve --params $(OUT)/params/hierarchical-solve.ron \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron -o $@ --report $(OUT)/solve.report.ron
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) -o $@ --report $(OUT)/solve.report.ron
 
 $(OUT)/preview.exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/solution.exr
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview \
@@ -43,9 +54,9 @@ $(OUT)/threshold.exr: $(BIN)/mask $(OUT)/params/mask.ron $(OUT)/image.png
 $(OUT)/params/grid-gather-full.ron: $(BIN)/grid-gather FORCE | $(OUT)/params
 	@$(BIN)/grid-gather --print-params --mode full --spp $(SPP) $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT)) $(GATHER_FLAGS) > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
 
-$(OUT)/final.exr $(OUT)/final.diagnostics.exr &: $(BIN)/grid-gather $(OUT)/params/grid-gather-full.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/solution.exr $(if $(MASK),$(OUT)/threshold.exr)
+$(OUT)/final.exr $(OUT)/final.diagnostics.exr &: $(BIN)/grid-gather $(OUT)/params/grid-gather-full.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/solution.exr $(if $(MASK),$(OUT)/threshold.exr) $(CLUSTERS_EXR)
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather-full.ron \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --solution $(OUT)/solution.exr $(if $(MASK),--threshold $(OUT)/threshold.exr) \
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --solution $(OUT)/solution.exr $(if $(MASK),--threshold $(OUT)/threshold.exr) $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) \
 	  -o $(OUT)/final.exr --diagnostics $(OUT)/final.diagnostics.exr --report $(OUT)/final.report.ron
 
 $(OUT)/final.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(OUT)/final.exr

@@ -39,6 +39,7 @@
 //! (the bench prints its exact command line). Timings are volatile; the work
 //! counters are not.
 
+use bench::{median, peak_memory_mib};
 use clap::Parser;
 use glam::DVec3;
 use hierarchical_solve::{solve, Params, Work};
@@ -247,23 +248,6 @@ fn raw_single(scene: &SceneRays, pool: &[Segment]) -> f64 {
     pool.len() as f64 / started.elapsed().as_secs_f64()
 }
 
-/// The process's peak resident memory (VmHWM), MiB; `None` off Linux.
-fn peak_memory_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.trim_start_matches("VmHWM:").trim().trim_end_matches("kB").trim().parse().ok()?;
-    Some(kib / 1024.0)
-}
-
-fn median(mut xs: Vec<f64>) -> f64 {
-    xs.sort_by(f64::total_cmp);
-    let m = xs.len() / 2;
-    if xs.len() % 2 == 1 {
-        xs[m]
-    } else {
-        0.5 * (xs[m - 1] + xs[m])
-    }
-}
 
 fn median_times(runs: &[RunTimes]) -> RunTimes {
     let m = |f: fn(&RunTimes) -> f64| median(runs.iter().map(f).collect());
