@@ -32,6 +32,7 @@ pub mod header;
 pub mod image;
 pub mod lightmap;
 pub mod mesh;
+pub mod png;
 pub mod report;
 pub mod ron_io;
 pub mod solution;

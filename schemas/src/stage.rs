@@ -118,6 +118,18 @@ pub fn bad_parameter(message: impl Into<String>) -> Error {
     Error::invalid(Path::new("parameters"), None, message)
 }
 
+/// Reads the prepared scene a stage starts from: `mesh.exr` and
+/// `manifest.ron`, checked against each other, both recorded as inputs of
+/// `run`.
+pub fn read_prepared(run: &mut Run, mesh: &Path, manifest: &Path) -> Result<(crate::mesh::Mesh, crate::mesh::Manifest)> {
+    let (mesh_value, mesh_input) = crate::mesh::Mesh::read(mesh)?;
+    let loaded = crate::ron_io::read_ron::<crate::mesh::Manifest>(manifest)?;
+    loaded.value.check_mesh(mesh, &mesh_value)?;
+    run.input(mesh_input);
+    run.input(loaded.input);
+    Ok((mesh_value, loaded.value))
+}
+
 /// Checks, before any work, that `path` can be written: its directory
 /// exists and accepts a new file. A stage that would fail only after
 /// minutes of computing fails at once instead.

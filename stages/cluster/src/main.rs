@@ -4,9 +4,7 @@ use clap::Parser;
 use cluster::{build, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
-use schemas::mesh::{Manifest, Mesh};
-use schemas::ron_io::read_ron;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, read_prepared, Outputs, Run};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -59,14 +57,10 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         check_writable(path)?;
     }
     let mut run = Run::start("cluster", env!("CARGO_PKG_VERSION"));
-    let (mesh, mesh_input) = Mesh::read(mesh_path)?;
-    let manifest = read_ron::<Manifest>(manifest_path)?;
-    manifest.value.check_mesh(mesh_path, &mesh)?;
-    run.input(mesh_input);
-    run.input(manifest.input);
+    let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let started = Instant::now();
     let triangles = radiometry::geometry::mesh_triangles(&mesh);
-    let reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.value.materials[t.material as usize].diffuse).collect();
+    let reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.materials[t.material as usize].diffuse).collect();
     let hierarchy = build(&triangles, &reflectance, &params);
     let seconds = started.elapsed().as_secs_f64();
     let leaves = hierarchy.nodes.iter().filter(|n| n.is_leaf()).count();
@@ -84,7 +78,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("build_seconds".to_string(), seconds),
         ]);
         let mut notes = Vec::new();
-        if !manifest.value.effects.fine_clustered_geometry {
+        if !manifest.effects.fine_clustered_geometry {
             notes.push("the manifest does not flag fine geometry: clustering may not pay on this scene".to_string());
         }
         outputs.write(report, |p| run.write_report(p, &params, counters, vec![], notes))?;

@@ -227,17 +227,6 @@ pub fn compare_solutions(a: &Solution, b: &Solution, params: &Params) -> Result<
     })
 }
 
-/// Encodes 8-bit RGB pixels as a PNG file's bytes (deterministic).
-pub fn encode_png(width: usize, height: usize, pixels: &[[u8; 3]]) -> Result<Vec<u8>, String> {
-    use image::ImageEncoder;
-    let (w, h) = (u32::try_from(width).map_err(|e| e.to_string())?, u32::try_from(height).map_err(|e| e.to_string())?);
-    let bytes: Vec<u8> = pixels.iter().flatten().copied().collect();
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(&bytes, w, h, image::ExtendedColorType::Rgb8)
-        .map_err(|e| format!("cannot encode PNG: {e}"))?;
-    Ok(out)
-}
 
 #[cfg(test)]
 mod tests;

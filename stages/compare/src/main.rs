@@ -100,7 +100,7 @@ fn compare_files(args: &Args, params: &Params, run: &mut Run, a: &Path, b: &Path
                 params.tau_max(),
             );
             Some(
-                compare::encode_png(image_b.width, image_b.height, &picture)
+                schemas::png::encode_png(image_b.width, image_b.height, &picture)
                     .map_err(|e| Error::invalid(path, None, e))?,
             )
         }

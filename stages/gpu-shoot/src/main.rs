@@ -4,10 +4,10 @@ use clap::Parser;
 use gpu_shoot::{gpu, output, photometry, solve, Params, PointLight, Visibility};
 use schemas::header::Schema;
 use schemas::lightmap::{Convergence, Lightmap};
-use schemas::mesh::{Effects, Manifest, Mesh};
-use schemas::ron_io::{read_bytes, read_ron, write_ron};
+use schemas::mesh::Effects;
+use schemas::ron_io::{read_bytes, write_ron};
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -169,13 +169,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         check_writable(path)?;
     }
     let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
-    let (mesh, mesh_input) = Mesh::read(mesh_path)?;
-    let manifest = read_ron::<Manifest>(manifest_path)?;
-    manifest.value.check_mesh(mesh_path, &mesh)?;
-    run.input(mesh_input);
-    run.input(manifest.input);
+    let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let mut lights = Vec::new();
-    for light in &manifest.value.goniometric_lights {
+    for light in &manifest.goniometric_lights {
         let path = Path::new(&light.file);
         let bytes = read_bytes(path)?;
         let text = String::from_utf8_lossy(&bytes);
@@ -187,7 +183,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let adapter = gpu::describe(&info);
     let bar = progress(1000, "converged");
     let mut fired = 0usize;
-    let solved = solve(&device, &queue, &mesh, &manifest.value, &lights, &params, &mut |shot| {
+    let solved = solve(&device, &queue, &mesh, &manifest, &lights, &params, &mut |shot| {
         fired += 1;
         bar.set_position(((1.0 - shot.unshot_fraction).clamp(0.0, 1.0) * 1000.0) as u64);
         bar.set_message(format!("{fired} shots"));
@@ -205,7 +201,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let provenance = run.provenance(&params);
     let lightmap = output::lightmap(&solved, &mesh, Lightmap::header(provenance.clone()));
     let ambient = params.ambient.then_some(solved.ambient);
-    let solution = output::solution(&lightmap, &mesh, &manifest.value, ambient, params.texels_per_leaf, Solution::header(provenance.clone()));
+    let solution = output::solution(&lightmap, &mesh, &manifest, ambient, params.texels_per_leaf, Solution::header(provenance.clone()));
     let convergence = Convergence {
         header: Convergence::header(provenance),
         adapter: adapter.clone(),
@@ -239,7 +235,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("seconds_per_shot".to_string(), w.shoot_seconds / (w.shots.max(1) as f64)),
         ]);
         let notes = vec![format!("adapter: {adapter}")];
-        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.value.effects), notes))?;
+        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects), notes))?;
     }
     outputs.keep();
     Ok(ExitCode::SUCCESS)

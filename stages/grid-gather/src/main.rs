@@ -8,11 +8,9 @@ use schemas::cluster::Clusters;
 use schemas::exr_io::{write_exr, Channel, ExrArtifact, Layer, LayerKind};
 use schemas::header::{Header, Schema};
 use schemas::image::HdrImage;
-use schemas::mesh::{Manifest, Mesh};
-use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run};
 use schemas::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -264,12 +262,7 @@ fn run(args: &Args) -> Result<ExitCode> {
         check_writable(d)?;
     }
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
-    let (mesh, input) = Mesh::read(mesh_path)?;
-    run.input(input);
-    let manifest = read_ron::<Manifest>(manifest_path)?;
-    run.input(manifest.input);
-    let manifest = manifest.value;
-    manifest.check_mesh(mesh_path, &mesh)?;
+    let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let (solution, input) = Solution::read(solution_path)?;
     run.input(input);
 

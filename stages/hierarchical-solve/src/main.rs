@@ -4,10 +4,9 @@ use clap::Parser;
 use hierarchical_solve::{solve, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
-use schemas::mesh::{Effects, Manifest, Mesh};
-use schemas::ron_io::read_ron;
+use schemas::mesh::Effects;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -121,11 +120,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         check_writable(path)?;
     }
     let mut run = Run::start("hierarchical-solve", env!("CARGO_PKG_VERSION"));
-    let (mesh, mesh_input) = Mesh::read(mesh_path)?;
-    let manifest = read_ron::<Manifest>(manifest_path)?;
-    manifest.value.check_mesh(mesh_path, &mesh)?;
-    run.input(mesh_input);
-    run.input(manifest.input);
+    let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let clusters = match &args.clusters {
         Some(path) => {
             let (clusters, input) = Clusters::read(path, mesh.triangles.len())?;
@@ -136,7 +131,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     };
     let clustered = clusters.is_some();
     let bar = progress(params.max_passes as u64, "passes");
-    let solved = solve(&mesh, &manifest.value, clusters, &params, &|p| {
+    let solved = solve(&mesh, &manifest, clusters, &params, &|p| {
         bar.set_position(p.pass as u64);
         bar.set_message(format!("{} links", p.links));
     })
@@ -171,8 +166,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("gather_seconds".to_string(), w.gather_seconds),
             ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
         ]);
-        let mut skipped = skipped(&manifest.value.effects);
-        if !clustered && manifest.value.effects.fine_clustered_geometry {
+        let mut skipped = skipped(&manifest.effects);
+        if !clustered && manifest.effects.fine_clustered_geometry {
             skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
         }
         outputs.write(report, |p| run.write_report(p, &params, counters, skipped, vec![]))?;

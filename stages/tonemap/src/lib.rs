@@ -339,18 +339,6 @@ pub fn tonemap(image: &HdrImage, params: &Params) -> Result<Tonemapped, InputErr
     Ok(Tonemapped { width: image.width, height: image.height, pixels, stats })
 }
 
-/// Encodes 8-bit RGB pixels as a PNG file's bytes (deterministic: same
-/// pixels, same bytes).
-pub fn encode_png(width: usize, height: usize, pixels: &[[u8; 3]]) -> Result<Vec<u8>, String> {
-    use image::ImageEncoder;
-    let (w, h) = (u32::try_from(width).map_err(|e| e.to_string())?, u32::try_from(height).map_err(|e| e.to_string())?);
-    let bytes: Vec<u8> = pixels.iter().flatten().copied().collect();
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(&bytes, w, h, image::ExtendedColorType::Rgb8)
-        .map_err(|e| format!("cannot encode PNG: {e}"))?;
-    Ok(out)
-}
 
 #[cfg(test)]
 mod tests {
@@ -471,8 +459,8 @@ mod tests {
     #[test]
     fn png_encoding_is_deterministic_and_sized() {
         let pixels = vec![[1, 2, 3], [4, 5, 6]];
-        let a = encode_png(2, 1, &pixels).unwrap();
-        assert_eq!(a, encode_png(2, 1, &pixels).unwrap());
+        let a = schemas::png::encode_png(2, 1, &pixels).unwrap();
+        assert_eq!(a, schemas::png::encode_png(2, 1, &pixels).unwrap());
         assert_eq!(&a[1..4], b"PNG");
         // IHDR width and height, big-endian, at bytes 16..24.
         assert_eq!(&a[16..24], &[0, 0, 0, 2, 0, 0, 0, 1]);

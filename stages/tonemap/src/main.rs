@@ -66,7 +66,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (image, record) = HdrImage::read(input)?;
     run.input(record);
     let mapped = tonemap::tonemap(&image, &params).map_err(|e| Error::invalid(input, None, e.to_string()))?;
-    let png = tonemap::encode_png(mapped.width, mapped.height, &mapped.pixels)
+    let png = schemas::png::encode_png(mapped.width, mapped.height, &mapped.pixels)
         .map_err(|e| Error::invalid(output, None, e))?;
     schemas::atomic::write_bytes_atomically(output, &png)?;
     if let Some(report) = args.report.as_deref() {
