@@ -14,6 +14,20 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// The options every stage binary has, flattened into its clap `Args`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct StageArgs {
+    /// Output: a report of the run (RON: work done, what was skipped, wall time).
+    #[arg(long, value_name = "REPORT.ron")]
+    pub report: Option<std::path::PathBuf>,
+    /// Read parameters from this RON file; flags override its values.
+    #[arg(long, value_name = "PARAMS.ron")]
+    pub params: Option<std::path::PathBuf>,
+    /// Print the effective parameters as RON on stdout and exit.
+    #[arg(long)]
+    pub print_params: bool,
+}
+
 /// Exit code of a run that failed.
 pub const EXIT_ERROR: u8 = 2;
 

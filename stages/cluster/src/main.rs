@@ -4,7 +4,7 @@ use clap::Parser;
 use cluster::{build, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, read_prepared, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -26,34 +26,27 @@ struct Args {
     /// Output: the cluster hierarchy.
     #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
     output: Option<PathBuf>,
-    /// Output: a report of the run (RON, with wall time).
-    #[arg(long)]
-    report: Option<PathBuf>,
-    /// Read parameters from this RON file; flags below override it.
-    #[arg(long)]
-    params: Option<PathBuf>,
-    /// Print the effective parameters as RON and exit.
-    #[arg(long)]
-    print_params: bool,
+    #[command(flatten)]
+    stage: StageArgs,
     /// Most triangles in a leaf cluster (1..=255).
     #[arg(long)]
     leaf_size: Option<u32>,
 }
 
 fn run(args: Args) -> schemas::Result<ExitCode> {
-    let mut params: Params = load_params(args.params.as_deref())?;
+    let mut params: Params = load_params(args.stage.params.as_deref())?;
     params.leaf_size = args.leaf_size.unwrap_or(params.leaf_size);
     if !(1..=255).contains(&params.leaf_size) {
         return Err(bad_parameter(format!("leaf_size must be in 1..=255, not {}", params.leaf_size)));
     }
-    if args.print_params {
+    if args.stage.print_params {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
     let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
         unreachable!("clap requires the inputs and output without --print-params")
     };
-    for path in [Some(output), args.report.as_ref()].into_iter().flatten() {
+    for path in [Some(output), args.stage.report.as_ref()].into_iter().flatten() {
         check_writable(path)?;
     }
     let mut run = Run::start("cluster", env!("CARGO_PKG_VERSION"));
@@ -69,7 +62,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let clusters = Clusters { header: Clusters::header(run.provenance(&params)), nodes: hierarchy.nodes, order: hierarchy.order };
     let mut outputs = Outputs::new();
     outputs.write(output, |p| clusters.write(p))?;
-    if let Some(report) = &args.report {
+    if let Some(report) = &args.stage.report {
         let counters = BTreeMap::from([
             ("clusters".to_string(), clusters.nodes.len() as f64),
             ("leaf_clusters".to_string(), leaves as f64),

@@ -7,7 +7,7 @@ use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
 use schemas::ron_io::{read_bytes, write_ron};
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -39,15 +39,8 @@ struct Args {
     /// Output: a plot of the unshot fraction against time (SVG).
     #[arg(long)]
     plot: Option<PathBuf>,
-    /// Output: a report of the run (RON: work done, wall time).
-    #[arg(long)]
-    report: Option<PathBuf>,
-    /// Read parameters from this RON file; flags below override it.
-    #[arg(long)]
-    params: Option<PathBuf>,
-    /// Print the effective parameters as RON and exit.
-    #[arg(long)]
-    print_params: bool,
+    #[command(flatten)]
+    stage: StageArgs,
     /// Covered texels to aim for over the scene.
     #[arg(long)]
     texels: Option<f64>,
@@ -87,7 +80,7 @@ struct Args {
 }
 
 fn params_of(args: &Args) -> schemas::Result<Params> {
-    let mut p: Params = load_params(args.params.as_deref())?;
+    let mut p: Params = load_params(args.stage.params.as_deref())?;
     p.texels = args.texels.unwrap_or(p.texels);
     p.shoot_level = args.shoot_level.unwrap_or(p.shoot_level);
     p.visibility = args.visibility.unwrap_or(p.visibility);
@@ -158,14 +151,14 @@ fn plot_svg(convergence: &Convergence) -> String {
 
 fn run(args: Args) -> schemas::Result<ExitCode> {
     let params = params_of(&args)?;
-    if args.print_params {
+    if args.stage.print_params {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
     let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
         unreachable!("clap requires the inputs and output without --print-params")
     };
-    for path in [Some(output), args.lightmap.as_ref(), args.convergence.as_ref(), args.plot.as_ref(), args.report.as_ref()].into_iter().flatten() {
+    for path in [Some(output), args.lightmap.as_ref(), args.convergence.as_ref(), args.plot.as_ref(), args.stage.report.as_ref()].into_iter().flatten() {
         check_writable(path)?;
     }
     let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
@@ -221,7 +214,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         let svg = plot_svg(&convergence);
         outputs.write(path, |p| schemas::atomic::write_atomically(p, |w| std::io::Write::write_all(w, svg.as_bytes()).map_err(|e| schemas::Error::io(p, e))))?;
     }
-    if let Some(report) = &args.report {
+    if let Some(report) = &args.stage.report {
         let w = &solved.work;
         let counters = BTreeMap::from([
             ("shots".to_string(), w.shots as f64),

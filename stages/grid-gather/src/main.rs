@@ -10,7 +10,7 @@ use schemas::header::{Header, Schema};
 use schemas::image::HdrImage;
 use schemas::solution::Solution;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use schemas::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -169,21 +169,14 @@ struct Args {
     /// separates them).
     #[arg(long, overrides_with = "material_seams")]
     no_material_seams: bool,
-    /// Parameters file (RON); flags override its values.
-    #[arg(long, value_name = "PARAMS.ron")]
-    params: Option<PathBuf>,
-    /// Print the effective parameters as RON on stdout and exit.
-    #[arg(long)]
-    print_params: bool,
-    /// Write a report (work counters, what was skipped, wall time).
-    #[arg(long, value_name = "REPORT.ron")]
-    report: Option<PathBuf>,
+    #[command(flatten)]
+    stage: StageArgs,
 }
 
 impl Args {
     /// Parameters from `--params` (or defaults), overridden by flags.
     fn params(&self) -> Result<Params> {
-        let mut p: Params = load_params(self.params.as_deref())?;
+        let mut p: Params = load_params(self.stage.params.as_deref())?;
         if let Some(mode) = self.mode {
             p.mode = mode;
         }
@@ -240,7 +233,7 @@ impl Args {
 
 fn run(args: &Args) -> Result<ExitCode> {
     let params = args.params()?;
-    if args.print_params {
+    if args.stage.print_params {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
@@ -302,7 +295,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     if let (Some(path), Some(d)) = (&args.diagnostics, &diagnostics) {
         outputs.write(path, |p| write_diagnostics(p, GatherDiagnostics::header(run.provenance(&params)), d))?;
     }
-    if let Some(report) = &args.report {
+    if let Some(report) = &args.stage.report {
         outputs.write(report, |p| run.write_report(p, &params, rendered.counters, rendered.skipped, Vec::new()))?;
     }
     outputs.keep();

@@ -6,7 +6,7 @@ use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::Effects;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run};
+use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,15 +33,8 @@ struct Args {
     /// Output: the solution (EXR tables of elements and links).
     #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
     output: Option<PathBuf>,
-    /// Output: a report of the run (RON: work done, wall time).
-    #[arg(long)]
-    report: Option<PathBuf>,
-    /// Read parameters from this RON file; flags below override it.
-    #[arg(long)]
-    params: Option<PathBuf>,
-    /// Print the effective parameters as RON and exit.
-    #[arg(long)]
-    print_params: bool,
+    #[command(flatten)]
+    stage: StageArgs,
     /// BF refinement threshold, as a fraction of the largest emitted radiosity.
     #[arg(long)]
     eps: Option<f64>,
@@ -72,7 +65,7 @@ struct Args {
 }
 
 fn params_of(args: &Args) -> schemas::Result<Params> {
-    let mut p: Params = load_params(args.params.as_deref())?;
+    let mut p: Params = load_params(args.stage.params.as_deref())?;
     p.eps = args.eps.unwrap_or(p.eps);
     p.min_area = args.min_area.unwrap_or(p.min_area);
     p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
@@ -109,14 +102,14 @@ fn skipped(effects: &Effects) -> Vec<String> {
 
 fn run(args: Args) -> schemas::Result<ExitCode> {
     let params = params_of(&args)?;
-    if args.print_params {
+    if args.stage.print_params {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
     let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
         unreachable!("clap requires the inputs and output without --print-params")
     };
-    for path in [Some(output), args.report.as_ref()].into_iter().flatten() {
+    for path in [Some(output), args.stage.report.as_ref()].into_iter().flatten() {
         check_writable(path)?;
     }
     let mut run = Run::start("hierarchical-solve", env!("CARGO_PKG_VERSION"));
@@ -150,7 +143,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     };
     let mut outputs = Outputs::new();
     outputs.write(output, |p| solution.write(p))?;
-    if let Some(report) = &args.report {
+    if let Some(report) = &args.stage.report {
         let counters = BTreeMap::from([
             ("passes".to_string(), w.passes as f64),
             ("links".to_string(), w.links as f64),

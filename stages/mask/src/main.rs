@@ -6,7 +6,7 @@ use mask::{display_luminance, thresholds, Params};
 use schemas::header::{Input, Schema};
 use schemas::ron_io::read_bytes;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run};
+use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run, StageArgs};
 use schemas::{Error, Result};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -40,20 +40,13 @@ struct Args {
     /// Exponent s of the masking function max(1, C^s) [default: 0.7].
     #[arg(long, value_name = "S")]
     masking_slope: Option<f64>,
-    /// Parameters file (RON); flags override its values.
-    #[arg(long, value_name = "PARAMS.ron")]
-    params: Option<PathBuf>,
-    /// Print the effective parameters as RON on stdout and exit.
-    #[arg(long)]
-    print_params: bool,
-    /// Write a report (work counters, wall time).
-    #[arg(long, value_name = "REPORT.ron")]
-    report: Option<PathBuf>,
+    #[command(flatten)]
+    stage: StageArgs,
 }
 
 impl Args {
     fn params(&self) -> Result<Params> {
-        let mut p: Params = load_params(self.params.as_deref())?;
+        let mut p: Params = load_params(self.stage.params.as_deref())?;
         if let Some(v) = self.display_max_cd_m2 {
             p.display_max_cd_m2 = v;
         }
@@ -76,7 +69,7 @@ impl Args {
 
 fn run(args: &Args) -> Result<ExitCode> {
     let params = args.params()?;
-    if args.print_params {
+    if args.stage.print_params {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
@@ -84,7 +77,7 @@ fn run(args: &Args) -> Result<ExitCode> {
         return Err(schemas::stage::bad_parameter("IMAGE and -o are required"));
     };
     check_writable(output)?;
-    if let Some(report) = &args.report {
+    if let Some(report) = &args.stage.report {
         check_writable(report)?;
     }
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
@@ -101,7 +94,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     let artifact = t.into_artifact(ThresholdImage::header(run.provenance(&params)));
     let mut outputs = Outputs::new();
     outputs.write(output, |p| artifact.write(p))?;
-    if let Some(report) = &args.report {
+    if let Some(report) = &args.stage.report {
         outputs.write(report, |p| run.write_report(p, &params, counters, Vec::new(), Vec::new()))?;
     }
     outputs.keep();

@@ -4,7 +4,7 @@ use clap::Parser;
 use mesh_prep::builtin::Builtin;
 use mesh_prep::obj::Files;
 use mesh_prep::{prepare, read_scene, Params, Recording};
-use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run};
+use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -30,15 +30,8 @@ struct Args {
     /// Output: the manifest (RON: camera, materials, effects, statistics).
     #[arg(long, required_unless_present = "print_params")]
     manifest: Option<PathBuf>,
-    /// Output: a report of the run (RON, with wall time).
-    #[arg(long)]
-    report: Option<PathBuf>,
-    /// Read parameters from this RON file; flags below override it.
-    #[arg(long)]
-    params: Option<PathBuf>,
-    /// Print the effective parameters as RON and exit.
-    #[arg(long)]
-    print_params: bool,
+    #[command(flatten)]
+    stage: StageArgs,
     /// Weld vertices closer than this times the scene's diagonal.
     #[arg(long)]
     weld_tolerance: Option<f64>,
@@ -51,18 +44,18 @@ struct Args {
 }
 
 fn run(args: Args) -> schemas::Result<ExitCode> {
-    let mut params: Params = load_params(args.params.as_deref())?;
+    let mut params: Params = load_params(args.stage.params.as_deref())?;
     params.weld_tolerance = args.weld_tolerance.unwrap_or(params.weld_tolerance);
     params.degenerate_area = args.degenerate_area.unwrap_or(params.degenerate_area);
     params.fine_geometry_triangles = args.fine_geometry_triangles.unwrap_or(params.fine_geometry_triangles);
-    if args.print_params {
+    if args.stage.print_params {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
     let (Some(mesh_path), Some(manifest_path)) = (args.mesh, args.manifest) else {
         unreachable!("clap requires --mesh and --manifest without --print-params")
     };
-    for path in [Some(&mesh_path), Some(&manifest_path), args.report.as_ref()].into_iter().flatten() {
+    for path in [Some(&mesh_path), Some(&manifest_path), args.stage.report.as_ref()].into_iter().flatten() {
         check_writable(path)?;
     }
     let mut run = Run::start("mesh-prep", env!("CARGO_PKG_VERSION"));
@@ -86,7 +79,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let mut outputs = Outputs::new();
     outputs.write(&mesh_path, |p| mesh.write(p))?;
     outputs.write(&manifest_path, |p| schemas::ron_io::write_ron(p, &manifest))?;
-    if let Some(report) = &args.report {
+    if let Some(report) = &args.stage.report {
         let counters = BTreeMap::from([
             ("input_triangles".to_string(), statistics.input_triangles as f64),
             ("triangles".to_string(), statistics.triangles as f64),

@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use schemas::image::HdrImage;
-use schemas::stage::{exit_code, load_params, print_params, Run};
+use schemas::stage::{exit_code, load_params, print_params, Run, StageArgs};
 use schemas::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -27,19 +27,12 @@ struct Args {
     /// Exposure k in 1/(W/(m^2 sr)) for the exposure operator, or 'auto' (1 / log-average luminance).
     #[arg(long)]
     exposure: Option<Setting>,
-    /// Parameters file (RON); flags given here override it.
-    #[arg(long)]
-    params: Option<PathBuf>,
-    /// Print the effective parameters as RON and exit.
-    #[arg(long)]
-    print_params: bool,
-    /// Write a run report (RON) here.
-    #[arg(long)]
-    report: Option<PathBuf>,
+    #[command(flatten)]
+    stage: StageArgs,
 }
 
 fn params(args: &Args) -> schemas::Result<Params> {
-    let mut params: Params = load_params(args.params.as_deref())?;
+    let mut params: Params = load_params(args.stage.params.as_deref())?;
     if let Some(operator) = args.operator {
         params.operator = operator;
     }
@@ -55,7 +48,7 @@ fn params(args: &Args) -> schemas::Result<Params> {
 
 fn run(args: Args) -> schemas::Result<ExitCode> {
     let params = params(&args)?;
-    if args.print_params {
+    if args.stage.print_params {
         print_params(&params);
         return Ok(ExitCode::SUCCESS);
     }
@@ -69,7 +62,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let png = schemas::png::encode_png(mapped.width, mapped.height, &mapped.pixels)
         .map_err(|e| Error::invalid(output, None, e))?;
     schemas::atomic::write_bytes_atomically(output, &png)?;
-    if let Some(report) = args.report.as_deref() {
+    if let Some(report) = args.stage.report.as_deref() {
         write_report(&run, report, &params, &mapped.stats)?;
     }
     Ok(ExitCode::SUCCESS)
