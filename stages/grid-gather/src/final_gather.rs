@@ -166,7 +166,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                             Mode::Brute => {
                                 brute_irradiance(&senders, &rays, p, tri.normal, hit.triangle, &links, params.brute_samples, &mut gather_stream, &mut sample)
                             }
-                            _ => gather.irradiance(p, tri.normal, hit.triangle, leaf, &links, &mut sample),
+                            _ => gather.irradiance(p, tri.normal, hit.triangle, leaf, &links, k, &mut sample),
                         };
                         work.add(&sample);
                         let s = scene.surfaces[hit.triangle as usize];

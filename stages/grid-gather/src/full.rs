@@ -425,14 +425,20 @@ impl<'a> FullGather<'a> {
         data
     }
 
-    /// Visible fraction of the first `n` fixed samples of `node` from `p`
-    /// on triangle `triangle`; adds the rays to `work`.
-    fn fixed_visibility(&self, p: DVec3, triangle: u32, node: Node, n: u32, work: &mut Work) -> f64 {
+    /// Visible fraction from `p` on triangle `triangle` of `n` fixed
+    /// samples of `node`: block `pass` of the sender's sequence, samples
+    /// `pass n .. (pass + 1) n`. Camera sample `pass` of every pixel uses
+    /// the same block, so each sub-image is continuous (fixed positions,
+    /// Sec. 4.4.1), while a pixel's `spp` camera samples together see the
+    /// first `spp n` points of the sequence rather than the same `n` again.
+    /// Adds the rays to `work`.
+    fn fixed_visibility(&self, p: DVec3, triangle: u32, node: Node, n: u32, pass: u32, work: &mut Work) -> f64 {
         if n == 0 {
             return 1.0;
         }
         let mut visible = 0;
-        for k in 0..n as usize {
+        let first = pass as usize * n as usize;
+        for k in first..first + n as usize {
             let y = self.senders.sample(node, k);
             work.visibility_rays += 1;
             visible += u32::from(self.rays.segment_clear(p, y.point, [triangle, y.triangle]));
@@ -442,8 +448,9 @@ impl<'a> FullGather<'a> {
 
     /// Irradiance H at `p` (W/m², RGB) on `triangle` (front normal
     /// `normal`) from the links in `links`, by the grid method or the
-    /// surface-based gather (module docs).
-    pub fn irradiance(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], work: &mut Work) -> [f64; 3] {
+    /// surface-based gather (module docs), for camera sample `pass` of its
+    /// pixel.
+    pub fn irradiance(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], pass: u32, work: &mut Work) -> [f64; 3] {
         let mut h = [0.0; 3];
         let Some(location) = self.grid.locate(p) else { return h };
         let mut w = location.weights.map(|x| x.max(0.0));
@@ -490,7 +497,7 @@ impl<'a> FullGather<'a> {
                     work.classes[0] += 1;
                     let rbf = rho * luminance(self.senders.radiosity(link.sender)) * f;
                     let n = self.shadow_samples(p, link.sender, f64::from(link.occluder_distance), rbf, tau, self.params.max_shadow_samples);
-                    self.fixed_visibility(p, triangle, link.sender, n, work)
+                    self.fixed_visibility(p, triangle, link.sender, n, pass, work)
                 };
                 let b = self.senders.radiosity(link.sender);
                 (0..3).for_each(|c| h[c] += b[c] * f * v);
@@ -525,7 +532,7 @@ impl<'a> FullGather<'a> {
             } else {
                 0.0
             };
-            let v_exact = if need_v { self.fixed_visibility(p, triangle, s, (n_vis.ceil() as u32).max(1), work) } else { 1.0 };
+            let v_exact = if need_v { self.fixed_visibility(p, triangle, s, (n_vis.ceil() as u32).max(1), pass, work) } else { 1.0 };
             let mut fv = 0.0;
             for i in 0..4 {
                 let (f, v) = match entries[i] {

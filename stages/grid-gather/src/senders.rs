@@ -9,9 +9,16 @@
 //! uniformly over their triangle; clusters over their triangles in
 //! proportion to area. Either way sample `k` of a sender is the same point
 //! for every pixel and every vertex (paper 000 Sec. 4.4.1: fixed positions
-//! trade noise for a small bias), from a Halton sequence (bases 2, 3, 5)
-//! shifted by a rotation keyed by the sender (Cranley-Patterson), so any
-//! prefix of the sequence is well stratified whatever the sample count.
+//! trade noise for a small bias), from the Sobol (0,2)-sequence (van der
+//! Corput in base 2, and Sobol's second dimension) under a digital shift
+//! keyed by the sender. Every block of `2^m` consecutive points starting at
+//! a multiple of `2^m` is a (0,m,2)-net, one point in each of the square's
+//! `2^m` elementary intervals of every shape, and the XOR shift keeps that:
+//! a block of 4 points has exactly one in each quarter of either axis.
+//! Halton points in bases 3 and 5 had no such balance for small blocks; a
+//! sender's 4 fixed points sat off its centre the same way for every pixel,
+//! which darkened the Cornell box by 0.2% against brute force. Clusters
+//! take a third coordinate, radical inverse in base 3, to pick the triangle.
 
 use glam::DVec3;
 use radiometry::form_factor::point_to_polygon;
@@ -64,6 +71,23 @@ fn radical_inverse(mut k: u64, b: u64) -> f64 {
         f /= b as f64;
     }
     inv
+}
+
+/// Point `k` of the Sobol (0,2)-sequence as 32-bit fractions, each
+/// XOR-shifted by `shift`: van der Corput in base 2 (the bits of `k`
+/// reversed), and Sobol's second dimension, whose generator matrix is
+/// Pascal's triangle mod 2 (the direction numbers `v <- v ^ (v >> 1)`).
+fn sobol_02(k: u32, shift: [u32; 2]) -> [f64; 2] {
+    let (mut i, mut v, mut second) = (k, 1u32 << 31, 0u32);
+    while i != 0 {
+        if i & 1 != 0 {
+            second ^= v;
+        }
+        i >>= 1;
+        v ^= v >> 1;
+    }
+    let scale = 1.0 / 4_294_967_296.0;
+    [f64::from(k.reverse_bits() ^ shift[0]) * scale, f64::from(second ^ shift[1]) * scale]
 }
 
 /// One fixed sample on a sender.
@@ -299,9 +323,9 @@ impl<'a> Senders<'a> {
             Node::Cluster(c) => u64::from(c) | 1 << 40,
         };
         let mut rotation = Stream::new(self.seed, key, 0x5e4d);
-        let shift = [rotation.next_f64(), rotation.next_f64(), rotation.next_f64()];
-        let h = |b: u64, s: f64| (radical_inverse(k as u64 + 1, b) + s).fract();
-        let (u, v) = (h(3, shift[1]), h(5, shift[2]));
+        let shift = [0, 1].map(|_| (rotation.next_f64() * 4_294_967_296.0) as u32);
+        let third = (radical_inverse(k as u64 + 1, 3) + rotation.next_f64()).fract();
+        let [u, v] = sobol_02(k as u32, shift);
         match node {
             Node::Element(e) => {
                 let corners = self.element_corners(e);
@@ -321,7 +345,7 @@ impl<'a> Senders<'a> {
                     }).collect()
                 });
                 let total = *cdf.last().unwrap_or(&0.0);
-                let x = h(2, shift[0]) * total;
+                let x = third * total;
                 let i = cdf.partition_point(|&a| a <= x).min(tris.len() - 1);
                 let t = &self.triangles[tris[i] as usize];
                 let b = square_to_triangle(u, v);
@@ -393,6 +417,35 @@ impl<'a> Senders<'a> {
                 }
             }
             (Node::Element(_), Node::Cluster(_)) => false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sobol_02;
+
+    /// Every aligned block of `2^m` points, under any digital shift, is a
+    /// (0,m,2)-net: each elementary interval `[i/2^a, (i+1)/2^a) x
+    /// [j/2^(m-a), (j+1)/2^(m-a))` of area `2^-m` holds exactly one point.
+    #[test]
+    fn aligned_blocks_of_the_shifted_sequence_are_0_m_2_nets() {
+        for shift in [[0, 0], [0x9e37_79b9, 0x7f4a_7c15], [u32::MAX, 1 << 31]] {
+            for m in 0..=6u32 {
+                let n = 1u32 << m;
+                for block in [0, 1, 5] {
+                    let points: Vec<[f64; 2]> = (block * n..(block + 1) * n).map(|k| sobol_02(k, shift)).collect();
+                    for a in 0..=m {
+                        let (cols, rows) = (1u32 << a, 1u32 << (m - a));
+                        let mut count = vec![0; n as usize];
+                        for p in &points {
+                            let (i, j) = ((p[0] * f64::from(cols)) as u32, (p[1] * f64::from(rows)) as u32);
+                            count[(j * cols + i) as usize] += 1;
+                        }
+                        assert!(count.iter().all(|&c| c == 1), "shift {shift:?}, block {block} of {n}, intervals {cols}x{rows}: {count:?}");
+                    }
+                }
+            }
         }
     }
 }
