@@ -222,6 +222,10 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
             factors: data.factors as u32,
         });
     }
+    for check in gather.checked_leaves() {
+        class_rays += check.rays;
+        class_factors += check.factors;
+    }
     let pixels = f64::from(width) * f64::from(height);
     let c = &mut image.counters;
     c.insert("pixels".into(), pixels);

@@ -38,6 +38,7 @@
 //! | `allowed_hits` | 1 or 2 | full: hits a classification ray may cross unblocked (1: double-sided sheets, 2: single-sided solids; Fig. 2) | 1 |
 //! | `interior_rays` | count | full: rays from a vertex inside a sender cluster | 100 |
 //! | `surface_gather` | bool | full: surface-based gather where leaves are finer than the grid (Sec. 4.5) | true |
+//! | `leaf_check_rays` | count | full: rays a leaf of the surface-based gather casts to check each link the solver called fully visible or occluded whose error would not fit the threshold; 0 trusts the solver | 8 |
 //! | `view_dependent` | bool | full: shadow samples bounded by penumbra size and contrast (Sec. 5.3) | true |
 //! | `brute_samples` | count | brute: visibility rays per link per camera sample | 64 |
 //!
@@ -182,6 +183,9 @@ pub struct Params {
     pub interior_rays: u32,
     /// Full: surface-based gather where leaves are finer than the grid.
     pub surface_gather: bool,
+    /// Full: rays per checked link and leaf in the surface-based gather (0:
+    /// trust the solver's fully visible and fully occluded links).
+    pub leaf_check_rays: u32,
     /// Full: view-dependent shadow sample counts (000 Sec. 5.3).
     pub view_dependent: bool,
     /// Brute: visibility rays per link per camera sample, at least 1.
@@ -209,6 +213,7 @@ impl Default for Params {
             allowed_hits: 1,
             interior_rays: 100,
             surface_gather: true,
+            leaf_check_rays: 8,
             view_dependent: true,
             brute_samples: 64,
         }

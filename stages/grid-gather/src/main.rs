@@ -126,6 +126,9 @@ struct Args {
     /// Full: surfaces a classification ray may cross unblocked, 1 or 2 [default: 1].
     #[arg(long, value_name = "N")]
     allowed_hits: Option<u32>,
+    /// Full: rays per leaf to check a fully visible or occluded link of the surface-based gather, 0 to trust the solver [default: 8].
+    #[arg(long, value_name = "N")]
+    leaf_check_rays: Option<u32>,
     /// Full: surface-based gather where leaves are finer than the grid [default: on].
     #[arg(long, overrides_with = "no_surface_gather")]
     surface_gather: bool,
@@ -213,7 +216,7 @@ impl Args {
         macro_rules! set {
             ($($f:ident),*) => { $(if let Some(v) = self.$f { p.$f = v; })* };
         }
-        set!(grid_pixels, grid_depth, samples, min_samples, max_shadow_samples, contrast, allowed_hits, brute_samples);
+        set!(grid_pixels, grid_depth, samples, min_samples, max_shadow_samples, contrast, allowed_hits, leaf_check_rays, brute_samples);
         if self.surface_gather {
             p.surface_gather = true;
         }

@@ -277,3 +277,42 @@ fn a_clustered_solution_of_a_convex_room_interpolates_visibility_and_matches_bru
     let e = relative_rmse(&floor_values(&image), &floor_values(&reference));
     assert!(e < 0.01, "relative RMSE {e}");
 }
+
+/// The room with a 0.6 m square sheet 0.75 m above the floor's centre (no
+/// elements of its own in the light's links), while the solution's links
+/// still call the emitter fully visible: a solver that missed the
+/// occluder.
+fn room_with_missed_occluder() -> Room {
+    let mut room = room();
+    let (a, b, c, d) = (dvec3(-0.3, 0.75, -0.3), dvec3(-0.3, 0.75, 0.3), dvec3(0.3, 0.75, 0.3), dvec3(0.3, 0.75, -0.3));
+    for t in [[a, b, c], [a, c, d]] {
+        let base = room.mesh.positions.len() as u32;
+        room.mesh.positions.extend(t.iter().map(|p| p.as_vec3().to_array()));
+        let g = TriangleGeometry::new(t);
+        room.mesh.triangles.push(Triangle { vertices: [base, base + 1, base + 2], material: 0, object: 0, area: g.area as f32, normal: g.normal.as_vec3().to_array() });
+        let mut element = room.solution.elements[0].clone();
+        element.triangle = room.solution.elements.len() as u32;
+        element.radiosity = [0.0; 3];
+        room.solution.elements.push(element);
+    }
+    room
+}
+
+#[test]
+fn the_surface_gather_checks_links_the_solver_called_fully_visible() {
+    let room = room_with_missed_occluder();
+    // One cell across the image: the floor's triangles are finer than the
+    // grid, so the surface-based gather shades them.
+    let full = |leaf_check_rays| Params { mode: Mode::Full, spp: 2, grid_pixels: 64, grid_depth: 2, leaf_check_rays, ..Params::default() };
+    let (checked, diagnostics) = run(&room, &full(8));
+    assert!(diagnostics.surface.iter().any(|&s| s > 0.0), "the surface-based gather ran");
+    let (trusted, _) = run(&room, &full(0));
+    let (reference, _) = run(&room, &Params { mode: Mode::Brute, spp: 2, brute_samples: 64, ..Params::default() });
+    // Relative to the image's energy (compare's relative RMSE), so the
+    // umbra's near-black pixels do not dominate.
+    let b = floor_values(&reference);
+    let error = |a: &Rendered| (floor_values(a).iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / b.iter().map(|y| y * y).sum::<f64>()).sqrt();
+    let (e_checked, e_trusted) = (error(&checked), error(&trusted));
+    assert!(e_checked < 0.05, "with leaf checks: relative RMSE {e_checked}");
+    assert!(e_trusted > 10.0 * e_checked, "trusting the stale links: {e_trusted} against {e_checked} with checks");
+}
