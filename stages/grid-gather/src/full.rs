@@ -73,12 +73,12 @@
 //! vertex threshold interpolated at `p`. The error terms use the point
 //! factor, not the link's `Eu`: a cluster link's `Eu` averages the
 //! receiver cluster's surfaces, and where it is near 0 while `F(p)` is
-//! not, links escaped resampling (3.4% error on the clustered plant room,
-//! 0.9% with the point factor).
+//! not, links escaped resampling (3.4% relative RMSE on the clustered
+//! plant room of `make bench-gather`, 0.75% with the point factor).
 //!
 //! The paper takes `V = 1` and `V = 0` on trust ("the risk of missing a
 //! sender which was wrongly classified as occluded"). With the solver's 16
-//! rays per link that cost a floor of error near 3e-4 relative RMSE on the
+//! rays per link that set an error floor near 4e-4 relative RMSE on the
 //! Cornell box, so each leaf checks the links it would trust, once, built
 //! on first use like a grid vertex ([`LeafCheck`]): the trusted links whose
 //! `rho B_s F` at the leaf's centre does not fit the budget cast
