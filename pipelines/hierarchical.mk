@@ -67,7 +67,8 @@ full: $(OUT)/final.png
 
 # Tables 1-2 of paper 000 in shape: brute force and the full gather (with
 # and without masking) against a high-sample brute-force reference, on the
-# Cornell box at BENCH_SIZE^2 pixels and on the clustered plant room
+# unclustered Cornell box at BENCH_SIZE^2 pixels (the surface-based
+# gather's case: walls refined finer than the grid) and on the clustered plant room
 # (mesh-prep's plants-10k, cluster, hierarchical-solve --clusters at eps
 # 1e-2) at BENCH_PLANT_SIZE^2. Figures: each run's report (visibility_rays,
 # form_factor_evaluations, wall_time_s) and compare's relative RMSE, in
@@ -75,6 +76,9 @@ full: $(OUT)/final.png
 # `equal_error_brute_rays` is the brute-force ray count at the run's error,
 # interpolated on the brute runs' log(rays)-log(error) line.
 BENCH_SIZE ?= 128
+# Contrast thresholds of the unmasked full runs (`full<c>`): the price of
+# accuracy.
+BENCH_CONTRASTS ?= 0.02 0.005
 BENCH_PLANT_SIZE ?= 64
 BENCH_OUT := out/bench-gather
 BENCH_PLANTS := out/bench-gather-plants
@@ -86,17 +90,17 @@ BP_ARGS = --mesh $(BENCH_PLANTS)/mesh.exr --manifest $(BENCH_PLANTS)/manifest.ro
 define bench_runs
 	$(BIN)/grid-gather $(2) --brute --brute-samples $(3) -o $(1)/reference.exr --report $(1)/reference.report.ron
 	for n in $(4); do $(BIN)/grid-gather $(2) --brute --brute-samples $$n -o $(1)/brute$$n.exr --report $(1)/brute$$n.report.ron; done
-	$(BIN)/grid-gather $(2) --mode full --diagnostics $(1)/full.diagnostics.exr -o $(1)/full.exr --report $(1)/full.report.ron
+	for c in $(BENCH_CONTRASTS); do $(BIN)/grid-gather $(2) --mode full --contrast $$c --diagnostics $(1)/full$$c.diagnostics.exr -o $(1)/full$$c.exr --report $(1)/full$$c.report.ron; done
 	$(BIN)/grid-gather $(2) --mode full --threshold $(1)/threshold.exr --diagnostics $(1)/masked.diagnostics.exr -o $(1)/masked.exr --report $(1)/masked.report.ron
-	@for r in $(addprefix brute,$(4)) full masked; do \
+	@for r in $(addprefix brute,$(4)) $(addprefix full,$(BENCH_CONTRASTS)) masked; do \
 	  rays=$$(grep -oE '"visibility_rays": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
 	  ffs=$$(grep -oE '"form_factor_evaluations": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
 	  crays=$$(grep -oE '"classification_visibility_rays": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
 	  time=$$(grep -oE 'wall_time_s: [0-9.]+' $(1)/$$r.report.ron | grep -oE '[0-9.]+$$'); \
 	  err=$$($(BIN)/compare $(1)/$$r.exr $(1)/reference.exr -o $(1)/$$r.compare.ron 2>&1 | grep -oE 'relative_rmse [0-9.e-]+' | grep -oE '[0-9.e-]+$$'); \
 	  echo "$$r $$rays $$crays $$ffs $$time $$err"; \
-	done | awk 'BEGIN { printf "%-8s %14s %14s %14s %8s %12s %14s %8s\n", "run", "vis_rays", "class_rays", "ff_evals", "time_s", "rel_rmse", "brute_rays@err", "ratio" } \
-	  { name[NR] = $$1; rays[NR] = $$2 + $$3; line[NR] = sprintf("%-8s %14d %14d %14d %8.2f %12.3e", $$1, $$2, $$3, $$4, $$5, $$6); err[NR] = $$6; \
+	done | awk 'BEGIN { printf "%-9s %14s %14s %14s %8s %12s %14s %8s\n", "run", "vis_rays", "class_rays", "ff_evals", "time_s", "rel_rmse", "brute_rays@err", "ratio" } \
+	  { name[NR] = $$1; rays[NR] = $$2 + $$3; line[NR] = sprintf("%-9s %14d %14d %14d %8.2f %12.3e", $$1, $$2, $$3, $$4, $$5, $$6); err[NR] = $$6; \
 	    if ($$1 ~ /^brute/) { nb++; lx[nb] = log($$2); ly[nb] = log($$6) } } \
 	  END { sx = sy = sxx = sxy = 0; for (i = 1; i <= nb; i++) { sx += lx[i]; sy += ly[i]; sxx += lx[i]^2; sxy += lx[i] * ly[i] } \
 	    b = (nb * sxy - sx * sy) / (nb * sxx - sx^2); a = (sy - b * sx) / nb; \
@@ -105,7 +109,7 @@ endef
 
 bench-gather: $(BINS) $(BIN)/mask
 	@mkdir -p $(BENCH_OUT) $(BENCH_PLANTS)
-	$(MAKE) --no-print-directory OUT=$(BENCH_OUT) WIDTH=$(BENCH_SIZE) HEIGHT=$(BENCH_SIZE) $(BENCH_OUT)/threshold.exr
+	$(MAKE) --no-print-directory OUT=$(BENCH_OUT) CLUSTERS=0 WIDTH=$(BENCH_SIZE) HEIGHT=$(BENCH_SIZE) $(BENCH_OUT)/threshold.exr
 	$(call bench_runs,$(BENCH_OUT),$(BG_ARGS),256,4 8 16 64)
 	$(BIN)/mesh-prep --builtin plants-10k --mesh $(BENCH_PLANTS)/mesh.exr --manifest $(BENCH_PLANTS)/manifest.ron
 	$(BIN)/cluster --mesh $(BENCH_PLANTS)/mesh.exr --manifest $(BENCH_PLANTS)/manifest.ron -o $(BENCH_PLANTS)/clusters.exr
