@@ -182,6 +182,15 @@ pub struct Effects {
     pub fine_clustered_geometry: bool,
 }
 
+impl Effects {
+    /// The report's `skipped` list: the note of every `(present, note)`
+    /// pair whose effect the scene has, in order. Each stage passes its own
+    /// notes for the effects it does not simulate.
+    pub fn skipped(notes: &[(bool, &str)]) -> Vec<String> {
+        notes.iter().filter(|(present, _)| *present).map(|(_, note)| note.to_string()).collect()
+    }
+}
+
 /// What `mesh-prep` did to the input geometry.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Default)]
 #[serde(deny_unknown_fields)]

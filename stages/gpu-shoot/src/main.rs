@@ -108,20 +108,15 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
 }
 
 fn skipped(effects: &Effects) -> Vec<String> {
-    let mut skipped = Vec::new();
-    let mut note = |present: bool, what: &str| {
-        if present {
-            skipped.push(what.to_string());
-        }
-    };
-    note(effects.diffuse_transmission, "diffuse transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.1, a later issue)");
-    note(effects.specular_reflection, "specular reflection: not simulated by gpu-shoot yet (004 Sec. 4.3.2); mirrors keep their diffuse part");
-    note(effects.specular_transmission, "specular transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.3)");
-    note(effects.alpha_masks, "alpha masks: surfaces are treated as opaque (004 Sec. 4.3.4, a later issue)");
-    note(effects.normal_maps, "normal maps: texels use the geometric normal (004 Sec. 2.3.3, a later issue)");
-    note(effects.textures, "textures: radiosity uses each material's mean diffuse reflectance");
-    note(effects.fine_clustered_geometry, "adaptive subdivision: not done; region sizes are fixed per object");
-    skipped
+    Effects::skipped(&[
+        (effects.diffuse_transmission, "diffuse transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.1, a later issue)"),
+        (effects.specular_reflection, "specular reflection: not simulated by gpu-shoot yet (004 Sec. 4.3.2); mirrors keep their diffuse part"),
+        (effects.specular_transmission, "specular transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.3)"),
+        (effects.alpha_masks, "alpha masks: surfaces are treated as opaque (004 Sec. 4.3.4, a later issue)"),
+        (effects.normal_maps, "normal maps: texels use the geometric normal (004 Sec. 2.3.3, a later issue)"),
+        (effects.textures, "textures: radiosity uses each material's mean diffuse reflectance"),
+        (effects.fine_clustered_geometry, "adaptive subdivision: not done; region sizes are fixed per object"),
+    ])
 }
 
 /// An SVG plot of the unshot fraction (log scale) against time.

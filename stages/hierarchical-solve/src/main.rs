@@ -83,21 +83,16 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
 
 /// What this stage does not simulate, for the effects the scene has.
 fn skipped(effects: &Effects) -> Vec<String> {
-    let mut skipped = Vec::new();
-    let mut note = |present: bool, what: &str| {
-        if present {
-            skipped.push(what.to_string());
-        }
-    };
-    note(!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only");
-    note(effects.specular_reflection, "specular reflection: not simulated by hierarchical-solve; mirrors keep their diffuse part only");
-    note(effects.specular_transmission, "specular transmission: not simulated by hierarchical-solve");
-    note(effects.diffuse_transmission, "diffuse transmission: not simulated by hierarchical-solve");
-    note(effects.goniometric_lights, "goniometric lights: not simulated by hierarchical-solve; only emitting surfaces light the scene");
-    note(effects.textures, "textures: radiosity uses each material's mean diffuse reflectance");
-    note(effects.alpha_masks, "alpha masks: surfaces are treated as opaque");
-    note(effects.normal_maps, "normal maps: radiosity uses geometric normals");
-    skipped
+    Effects::skipped(&[
+        (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
+        (effects.specular_reflection, "specular reflection: not simulated by hierarchical-solve; mirrors keep their diffuse part only"),
+        (effects.specular_transmission, "specular transmission: not simulated by hierarchical-solve"),
+        (effects.diffuse_transmission, "diffuse transmission: not simulated by hierarchical-solve"),
+        (effects.goniometric_lights, "goniometric lights: not simulated by hierarchical-solve; only emitting surfaces light the scene"),
+        (effects.textures, "textures: radiosity uses each material's mean diffuse reflectance"),
+        (effects.alpha_masks, "alpha masks: surfaces are treated as opaque"),
+        (effects.normal_maps, "normal maps: radiosity uses geometric normals"),
+    ])
 }
 
 fn run(args: Args) -> schemas::Result<ExitCode> {
