@@ -260,9 +260,36 @@ fn padded<T: Copy + Default>(values: &[T], len: usize) -> Vec<T> {
     out
 }
 
+/// What [`read_exr_or_foreign`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExrFile {
+    /// An artifact of this pipeline, of the schema asked for.
+    Artifact(ExrArtifact),
+    /// An EXR with no `pipeline` header, written by another program: its
+    /// image layers (parts), every channel converted to `f32` (half and
+    /// float) or kept as `u32`, no meanings and no provenance.
+    Foreign(Vec<Layer>),
+}
+
 /// Reads the EXR artifact at `path` and checks that it is of schema `S`.
 /// Returns it with the input record (hash, carried provenance).
 pub fn read_exr<S: Schema>(path: &Path) -> Result<(ExrArtifact, Input)> {
+    match read_exr_or_foreign::<S>(path)? {
+        (ExrFile::Artifact(artifact), input) => Ok((artifact, input)),
+        (ExrFile::Foreign(_), _) => Err(Error::schema(
+            path,
+            format!("EXR without a '{META_ATTRIBUTE}' header; expected a '{}' artifact of this pipeline", S::NAME),
+        )),
+    }
+}
+
+/// Reads the EXR at `path`: an artifact of schema `S` (checked as
+/// [`read_exr`] does), or any other readable EXR (scan lines or tiles, any
+/// compression, half, float or uint channels; the largest mip level), as
+/// [`ExrFile::Foreign`] whose input record carries no provenance. A file
+/// that claims to be this pipeline's (has the header) and is of another
+/// schema is refused, never read as foreign.
+pub fn read_exr_or_foreign<S: Schema>(path: &Path) -> Result<(ExrFile, Input)> {
     let bytes = read_bytes(path)?;
     let image = read()
         .no_deep_data()
@@ -279,12 +306,8 @@ pub fn read_exr<S: Schema>(path: &Path) -> Result<(ExrArtifact, Input)> {
         .find_map(|attributes| attributes.get(&key));
     let text = match found {
         Some(AttributeValue::Text(t)) => String::from_utf8_lossy(t.bytes()).into_owned(),
-        _ => {
-            return Err(Error::schema(
-                path,
-                format!("EXR without a '{META_ATTRIBUTE}' header; expected a '{}' artifact of this pipeline", S::NAME),
-            ))
-        }
+        Some(_) => return Err(Error::schema(path, format!("EXR attribute '{META_ATTRIBUTE}' is not text"))),
+        None => return Ok((ExrFile::Foreign(foreign_layers(&image)), Input::new(path, &bytes, None))),
     };
     let untyped: ron::Value = parse_ron(path, &text)?;
     let tag: Option<HeaderTag> = match &untyped {
@@ -298,7 +321,7 @@ pub fn read_exr<S: Schema>(path: &Path) -> Result<(ExrArtifact, Input)> {
         let stored = image
             .layer_data
             .iter()
-            .find(|l| l.attributes.layer_name.as_ref().map(|n| n.to_string()).unwrap_or_default() == described.name)
+            .find(|l| layer_name(l) == described.name)
             .ok_or_else(|| Error::invalid(path, None, format!("layer '{}' described but absent", described.name)))?;
         let layer_len = match described.kind {
             LayerKind::Image { width, height } => width * height,
@@ -315,17 +338,49 @@ pub fn read_exr<S: Schema>(path: &Path) -> Result<(ExrArtifact, Input)> {
             if data.sample_data.len() < layer_len {
                 return Err(Error::invalid(path, None, format!("channel '{name}' holds fewer samples than its layer's size")));
             }
-            let samples = match &data.sample_data {
-                FlatSamples::F32(v) => Samples::F32(v[..layer_len].to_vec()),
-                FlatSamples::U32(v) => Samples::U32(v[..layer_len].to_vec()),
-                FlatSamples::F16(v) => Samples::F32(v[..layer_len].iter().map(|h| h.to_f32()).collect()),
-            };
-            channels.push(Channel { name: name.clone(), meaning: meaning.clone(), samples });
+            channels.push(Channel { name: name.clone(), meaning: meaning.clone(), samples: samples(&data.sample_data, layer_len) });
         }
         layers.push(Layer { name: described.name.clone(), kind: described.kind, channels });
     }
     let input = Input::new(path, &bytes, Some(meta.header.provenance.clone()));
-    Ok((ExrArtifact { header: meta.header, layers }, input))
+    Ok((ExrFile::Artifact(ExrArtifact { header: meta.header, layers }), input))
+}
+
+/// A stored layer's name; the empty string for an unnamed one.
+fn layer_name(layer: &exr::image::Layer<AnyChannels<FlatSamples>>) -> String {
+    layer.attributes.layer_name.as_ref().map(|n| n.to_string()).unwrap_or_default()
+}
+
+/// The first `len` samples of a stored channel, half widened to `f32`.
+fn samples(data: &FlatSamples, len: usize) -> Samples {
+    match data {
+        FlatSamples::F32(v) => Samples::F32(v[..len].to_vec()),
+        FlatSamples::U32(v) => Samples::U32(v[..len].to_vec()),
+        FlatSamples::F16(v) => Samples::F32(v[..len].iter().map(|h| h.to_f32()).collect()),
+    }
+}
+
+/// Every layer of a foreign EXR as an image layer of its stored size, with
+/// its channels' full names (`R`, `albedo.R`) and no meanings.
+fn foreign_layers(image: &Image<Layers<AnyChannels<FlatSamples>>>) -> Vec<Layer> {
+    image
+        .layer_data
+        .iter()
+        .map(|stored| {
+            let (width, height) = (stored.size.width(), stored.size.height());
+            let channels = stored
+                .channel_data
+                .list
+                .iter()
+                .map(|c| Channel {
+                    name: c.name.to_string(),
+                    meaning: String::new(),
+                    samples: samples(&c.sample_data, (width * height).min(c.sample_data.len())),
+                })
+                .collect();
+            Layer { name: layer_name(stored), kind: LayerKind::Image { width, height }, channels }
+        })
+        .collect()
 }
 
 #[cfg(test)]

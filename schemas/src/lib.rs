@@ -15,7 +15,7 @@
 //! | [`solution::Solution`] | `solution.exr` | `solution` 1 | hierarchical-solve, gpu-shoot |
 //! | [`lightmap::Lightmap`] | `lightmap.exr` | `lightmap` 1 | gpu-shoot |
 //! | [`lightmap::Convergence`] | `convergence.ron` | `convergence` 1 | gpu-shoot |
-//! | [`image::HdrImage`] | `*.exr` | `image` 1 | grid-gather |
+//! | [`image::HdrImage`] | `*.exr` | `image` 2 | grid-gather (read also from foreign EXRs) |
 //! | [`threshold::ThresholdImage`] | `threshold.exr` | `threshold` 1 | mask |
 //! | [`report::Report`] | `*.report.ron` | `report` 1 | every stage |
 //!

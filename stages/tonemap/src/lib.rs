@@ -30,6 +30,7 @@
 //!     width: 2, height: 1,
 //!     rgb: vec![[0.5, 0.5, 0.5], [9.0, 9.0, 9.0]],
 //!     coverage: vec![1.0, 0.0],
+//!     surfaces: None,
 //! };
 //! let out = tonemap(&image, &Params::default()).unwrap();
 //! assert_eq!(out.pixels[0], [255, 255, 255]); // the brightest covered pixel is white
@@ -347,7 +348,7 @@ mod tests {
 
     fn image(width: usize, height: usize, rgb: Vec<[f32; 3]>, coverage: Vec<f32>) -> HdrImage {
         let provenance = Provenance::in_memory("test");
-        HdrImage { header: HdrImage::header(provenance), width, height, rgb, coverage }
+        HdrImage { header: HdrImage::header(provenance), width, height, rgb, coverage, surfaces: None }
     }
 
     fn grey(values: &[f32]) -> HdrImage {

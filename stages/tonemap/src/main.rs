@@ -1,7 +1,7 @@
 //! `tonemap IMAGE.exr -o OUT.png`: linear HDR image to 8-bit sRGB PNG.
 
 use clap::Parser;
-use schemas::image::HdrImage;
+use schemas::image::{HdrImage, Origin};
 use schemas::stage::{exit_code, load_params, print_params, Run, StageArgs};
 use schemas::Error;
 use std::path::{Path, PathBuf};
@@ -12,7 +12,7 @@ use tonemap::{Curve, Operator, Params, Setting};
 #[derive(Parser, Debug)]
 #[command(version, about)]
 struct Args {
-    /// Input HDR image (`image` artifact, EXR).
+    /// Input HDR image (`image` artifact of this pipeline, or any RGB(A) EXR).
     #[arg(required_unless_present = "print_params")]
     image: Option<PathBuf>,
     /// Output PNG.
@@ -56,7 +56,10 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         unreachable!("clap requires IMAGE and -o without --print-params")
     };
     let mut run = Run::start("tonemap", env!("CARGO_PKG_VERSION"));
-    let (image, record) = HdrImage::read(input)?;
+    let (image, record, origin) = HdrImage::read_any(input)?;
+    if origin == Origin::Foreign {
+        eprintln!("tonemap: note: {} is a foreign EXR (no provenance; SHA-256 {})", input.display(), record.sha256);
+    }
     run.input(record);
     let mapped = tonemap::tonemap(&image, &params).map_err(|e| Error::invalid(input, None, e.to_string()))?;
     let png = schemas::png::encode_png(mapped.width, mapped.height, &mapped.pixels)

@@ -18,7 +18,7 @@ fn write_image(path: &Path, rgb: Vec<[f32; 3]>, width: usize) {
     let provenance = Provenance::in_memory("test");
     let height = rgb.len() / width;
     let coverage = vec![1.0; rgb.len()];
-    HdrImage { header: HdrImage::header(provenance), width, height, rgb, coverage }.write(path).unwrap();
+    HdrImage { header: HdrImage::header(provenance), width, height, rgb, coverage, surfaces: None }.write(path).unwrap();
 }
 
 fn tonemap(args: &[&str]) -> Output {
@@ -74,5 +74,31 @@ fn printed_params_read_back_and_flags_override() {
     std::fs::write(&file, "(operater: Exposure)").unwrap();
     let out = tonemap(&["--print-params", "--params", file.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn foreign_exr_is_tonemapped_with_a_note() {
+    use exr::prelude::*;
+    let dir = scratch("foreign");
+    let (ours, theirs) = (dir.join("ours.exr"), dir.join("theirs.exr"));
+    let rgb = vec![[1.0; 3], [0.25; 3], [4.0; 3], [0.5; 3]];
+    write_image(&ours, rgb.clone(), 2);
+    let pixel = |p: Vec2<usize>| {
+        let v = rgb[p.y() * 2 + p.x()];
+        (v[0], v[1], v[2])
+    };
+    let layer = Layer::new((2, 2), LayerAttributes::default(), Encoding::FAST_LOSSLESS, SpecificChannels::rgb(pixel));
+    Image::from_layer(layer).write().to_file(&theirs).unwrap();
+    let (a, b) = (dir.join("ours.png"), dir.join("theirs.png"));
+    let out = tonemap(&[ours.to_str().unwrap(), "-o", a.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(out.stderr.is_empty());
+    let out = tonemap(&[theirs.to_str().unwrap(), "-o", b.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.starts_with("tonemap: note: ") && stderr.contains("foreign EXR (no provenance") && stderr.lines().count() == 1, "{stderr}");
+    // Same pixels, same picture (an alpha-less EXR counts as fully covered).
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     std::fs::remove_dir_all(&dir).unwrap();
 }
