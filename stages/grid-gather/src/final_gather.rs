@@ -4,6 +4,7 @@
 
 use crate::full::{brute_irradiance, FullGather, Surface, Work, CLASS_NAMES};
 use crate::grid::Grid;
+use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
 use crate::render::pixel_offset;
 use crate::senders::{Aabb, Senders};
 use crate::{GridKind, Mode, Params};
@@ -78,6 +79,8 @@ pub struct FullScene<'a> {
     pub triangles: &'a [TriangleGeometry],
     /// Material per triangle.
     pub surfaces: &'a [Surface],
+    /// Object and material of each triangle, for the surface layer.
+    pub ids: &'a [SurfaceId],
     /// The solution.
     pub solution: &'a Solution,
     /// The cluster hierarchy, if the solution was clustered.
@@ -94,6 +97,8 @@ pub struct FullImage {
     pub rgb: Vec<[f32; 3]>,
     /// Coverage per pixel.
     pub coverage: Vec<f32>,
+    /// What each pixel saw.
+    pub surfaces: schemas::image::PixelSurfaces,
     /// Diagnostics.
     pub diagnostics: Diagnostics,
     /// Work counters.
@@ -136,7 +141,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let vertex_contrast = vertex_contrast(params, &grid, &centres, w, h, scene.threshold);
     let gather = FullGather::new(&senders, &grid, &rays, scene.surfaces, params, vertex_contrast, width);
     let spp = params.spp;
-    let rows: Vec<(Vec<([f32; 3], f32, Work)>, u64)> = (0..height)
+    let rows: Vec<(Vec<([f32; 3], f32, Work, [u32; 3])>, u64)> = (0..height)
         .into_par_iter()
         .map(|y| {
             let mut links = Vec::new();
@@ -148,17 +153,22 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                     // Keyed by the brute sample count too, so a high-sample reference
                     // shares the camera jitter of a cheaper run but not its gather noise.
                     let mut gather_stream = Stream::new(params.seed, pixel, 1 + u64::from(params.brute_samples));
-                    let (mut sum, mut covered, mut work) = ([0.0f64; 3], 0u32, Work::default());
+                    let (mut sum, mut covered, mut work, mut tally) = ([0.0f64; 3], 0u32, Work::default(), PixelTally::default());
                     for k in 0..spp {
                         let (jx, jy) = pixel_offset(k, spp, &mut stream);
                         let d = camera.direction(f64::from(x) + jx, f64::from(y) + jy);
-                        let Some(hit) = rays.closest_hit(camera.eye, d, 0.0, f32::INFINITY, [u32::MAX; 2]) else { continue };
+                        let Some(hit) = rays.closest_hit(camera.eye, d, 0.0, f32::INFINITY, [u32::MAX; 2]) else {
+                            tally.other();
+                            continue;
+                        };
                         covered += 1;
                         hits += 1;
                         let tri = &scene.triangles[hit.triangle as usize];
                         if d.dot(tri.normal) > 0.0 {
+                            tally.other();
                             continue;
                         }
+                        tally.front(scene.ids[hit.triangle as usize]);
                         let p = camera.eye + d * f64::from(hit.t);
                         let leaf = senders.chain(hit.triangle, tri.uv_of(p), &mut links);
                         let mut sample = Work::default();
@@ -173,7 +183,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                         (0..3).for_each(|c| sum[c] += (s.emission[c] + s.reflectance[c] * irradiance[c]) / PI);
                     }
                     let n = f64::from(spp);
-                    (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, work)
+                    (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, work, tally.finish())
                 })
                 .collect();
             rows_done(1);
@@ -184,16 +194,19 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let mut image = FullImage {
         rgb: Vec::with_capacity(w * h),
         coverage: Vec::with_capacity(w * h),
+        surfaces: Default::default(),
         diagnostics: Diagnostics { width: w, height: h, ..Diagnostics::default() },
         counters: BTreeMap::new(),
     };
     let (mut total, mut hits) = (Work::default(), 0u64);
     let per = 1.0 / f64::from(spp);
+    let mut seen = Vec::with_capacity(w * h);
     for (row, row_hits) in rows {
         hits += row_hits;
-        for (rgb, coverage, work) in row {
+        for (rgb, coverage, work, surface) in row {
             image.rgb.push(rgb);
             image.coverage.push(coverage);
+            seen.push(surface);
             let d = &mut image.diagnostics;
             d.visibility_rays.push((work.visibility_rays as f64 * per) as f32);
             d.form_factors.push((work.form_factors as f64 * per) as f32);
@@ -204,6 +217,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
             total.add(&work);
         }
     }
+    image.surfaces = pixel_surfaces::collect(seen);
     let (mut class_rays, mut class_factors, mut vertex_classes, mut skipped) = (0u64, 0u64, [0u64; 4], 0u64);
     for (index, data) in gather.built() {
         class_rays += data.rays;

@@ -49,10 +49,12 @@ pub mod final_gather;
 pub mod full;
 pub mod gouraud;
 pub mod grid;
+pub mod pixel_surfaces;
 pub mod render;
 pub mod senders;
 
 use gouraud::{Gouraud, Smoothing};
+use pixel_surfaces::PixelTally;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::mesh_triangles;
 use radiometry::rays::SceneRays;
@@ -287,6 +289,8 @@ pub struct Rendered {
     pub rgb: Vec<[f32; 3]>,
     /// Coverage per pixel in [0, 1].
     pub coverage: Vec<f32>,
+    /// What each pixel saw (the image's `surface` layer).
+    pub surfaces: schemas::image::PixelSurfaces,
     /// Work counters for the report.
     pub counters: BTreeMap<String, f64>,
     /// What was skipped and why, for the report.
@@ -329,7 +333,8 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
     let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
     let rays = (!triangles.is_empty()).then(|| SceneRays::new(&triangles.iter().map(|t| t.corners).collect::<Vec<_>>()));
-    let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading };
+    let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
+    let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading, surfaces: &ids };
     let film = render::render(&view, Sampling { width, height, spp: params.spp, seed: params.seed }, rows_done);
 
     let pixels = f64::from(width) * f64::from(height);
@@ -350,6 +355,7 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
             height: height as usize,
             rgb: film.rgb,
             coverage: film.coverage,
+            surfaces: film.surfaces,
             counters,
             skipped: skipped_in_preview(scene.manifest),
         },
@@ -389,10 +395,12 @@ fn full_gather(
         .collect();
     if triangles.is_empty() {
         let n = width as usize * height as usize;
-        let rendered = Rendered { width: width as usize, height: height as usize, rgb: vec![[0.0; 3]; n], coverage: vec![0.0; n], counters: BTreeMap::new(), skipped: Vec::new() };
+        let surfaces = pixel_surfaces::collect(std::iter::repeat_n(PixelTally::default().finish(), n));
+        let rendered = Rendered { width: width as usize, height: height as usize, rgb: vec![[0.0; 3]; n], coverage: vec![0.0; n], surfaces, counters: BTreeMap::new(), skipped: Vec::new() };
         return Ok((rendered, final_gather::Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
     }
-    let full_scene = final_gather::FullScene { triangles, surfaces: &surfaces, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera };
+    let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
+    let full_scene = final_gather::FullScene { triangles, surfaces: &surfaces, ids: &ids, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera };
     let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
     let mut counters = image.counters;
     counters.insert("triangles".into(), triangles.len() as f64);
@@ -401,7 +409,7 @@ fn full_gather(
     let mut skipped = skipped_in_preview(scene.manifest);
     skipped.remove(0);
     Ok((
-        Rendered { width: width as usize, height: height as usize, rgb: image.rgb, coverage: image.coverage, counters, skipped },
+        Rendered { width: width as usize, height: height as usize, rgb: image.rgb, coverage: image.coverage, surfaces: image.surfaces, counters, skipped },
         image.diagnostics,
     ))
 }

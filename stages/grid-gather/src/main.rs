@@ -293,6 +293,7 @@ fn run(args: &Args) -> Result<ExitCode> {
         height: rendered.height,
         rgb: rendered.rgb,
         coverage: rendered.coverage,
+        surfaces: Some(rendered.surfaces),
     };
     outputs.write(output, |p| image.write(p))?;
     if let (Some(path), Some(d)) = (&args.diagnostics, &diagnostics) {

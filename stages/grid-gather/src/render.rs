@@ -1,6 +1,7 @@
 //! Camera rays through the pixels, closest hits, and the per-pixel mean.
 
 use crate::gouraud::Gouraud;
+use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::SceneRays;
@@ -18,6 +19,8 @@ pub struct View<'a> {
     pub rays: Option<&'a SceneRays>,
     /// Radiosity over the surfaces.
     pub shading: &'a Gouraud,
+    /// The surface of each triangle, for the image's surface layer.
+    pub surfaces: &'a [SurfaceId],
 }
 
 /// How pixels are sampled.
@@ -44,6 +47,8 @@ pub struct Film {
     pub hits: u64,
     /// Of those, hits on the back of a triangle (shaded black).
     pub back_face_hits: u64,
+    /// What each pixel saw.
+    pub surfaces: schemas::image::PixelSurfaces,
 }
 
 /// The `k`-th of `n` sample positions in the unit pixel: the first `m²`
@@ -69,7 +74,7 @@ pub fn pixel_offset(k: u32, n: u32, stream: &mut Stream) -> (f64, f64) {
 /// is black with no coverage. `rows_done` is called with 1 after each row.
 pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync)) -> Film {
     let Sampling { width, height, spp, seed } = sampling;
-    let rows: Vec<(Vec<([f32; 3], f32)>, u64, u64)> = (0..height)
+    let rows: Vec<(Vec<([f32; 3], f32, [u32; 3])>, u64, u64)> = (0..height)
         .into_par_iter()
         .map(|y| {
             let (mut hits, mut back) = (0, 0);
@@ -77,46 +82,58 @@ pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync))
                 .map(|x| {
                     let pixel = u64::from(y) * u64::from(width) + u64::from(x);
                     let mut stream = Stream::new(seed, pixel, 0);
-                    let (mut sum, mut covered) = ([0.0f64; 3], 0u32);
+                    let (mut sum, mut covered, mut tally) = ([0.0f64; 3], 0u32, PixelTally::default());
                     for k in 0..spp {
                         let (jx, jy) = pixel_offset(k, spp, &mut stream);
-                        let Some(sample) = trace(view, f64::from(x) + jx, f64::from(y) + jy) else { continue };
+                        let Some((triangle, sample)) = trace(view, f64::from(x) + jx, f64::from(y) + jy) else {
+                            tally.other();
+                            continue;
+                        };
                         covered += 1;
                         hits += 1;
                         match sample {
-                            Some(radiance) => sum.iter_mut().zip(radiance).for_each(|(s, r)| *s += r),
-                            None => back += 1,
+                            Some(radiance) => {
+                                sum.iter_mut().zip(radiance).for_each(|(s, r)| *s += r);
+                                tally.front(view.surfaces[triangle as usize]);
+                            }
+                            None => {
+                                back += 1;
+                                tally.other();
+                            }
                         }
                     }
                     let n = f64::from(spp);
-                    (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32)
+                    (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, tally.finish())
                 })
                 .collect();
             rows_done(1);
             (row, hits, back)
         })
         .collect();
-    let mut film = Film { rgb: Vec::new(), coverage: Vec::new(), hits: 0, back_face_hits: 0 };
+    let mut film = Film { rgb: Vec::new(), coverage: Vec::new(), hits: 0, back_face_hits: 0, surfaces: Default::default() };
+    let mut seen = Vec::with_capacity(width as usize * height as usize);
     for (row, hits, back) in rows {
         film.rgb.extend(row.iter().map(|p| p.0));
         film.coverage.extend(row.iter().map(|p| p.1));
+        seen.extend(row.iter().map(|p| p.2));
         film.hits += hits;
         film.back_face_hits += back;
     }
+    film.surfaces = pixel_surfaces::collect(seen);
     film
 }
 
-/// One camera ray through image point `(x, y)`: `None` for a miss,
-/// `Some(None)` for a back-face hit, `Some(Some(L))` for the radiance of a
-/// front-face hit.
-fn trace(view: &View, x: f64, y: f64) -> Option<Option<[f64; 3]>> {
+/// One camera ray through image point `(x, y)`: `None` for a miss, else
+/// the triangle hit with `None` for a back-face hit or `Some(L)`, the
+/// radiance of a front-face hit.
+fn trace(view: &View, x: f64, y: f64) -> Option<(u32, Option<[f64; 3]>)> {
     let direction = view.camera.direction(x, y);
     let hit = view.rays?.closest_hit(view.camera.eye, direction, 0.0, f32::INFINITY, [u32::MAX; 2])?;
     let triangle = &view.triangles[hit.triangle as usize];
     if direction.dot(triangle.normal) > 0.0 {
-        return Some(None);
+        return Some((hit.triangle, None));
     }
     let point = view.camera.eye + direction * f64::from(hit.t);
     let radiosity = view.shading.radiosity(hit.triangle, triangle.uv_of(point));
-    Some(Some(radiosity.map(|b| b / PI)))
+    Some((hit.triangle, Some(radiosity.map(|b| b / PI))))
 }

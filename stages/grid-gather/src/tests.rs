@@ -348,3 +348,55 @@ fn params_round_trip_through_ron_and_refuse_typos() {
 }
 
 mod full;
+
+#[test]
+fn surface_layer_tells_objects_edges_and_emitters_apart() {
+    // The square's two triangles as two objects; triangle 1 (above the
+    // diagonal, x < y) emits. Pixel centres are projected back onto the
+    // square plane to know which side they are on.
+    let mut mesh = mesh(&square());
+    mesh.triangles[1].object = 1;
+    mesh.triangles[1].material = 1;
+    let mut manifest = front_camera();
+    manifest.objects.push("lamp".into());
+    let mut lamp = manifest.materials[0].clone();
+    lamp.emission = [1.0; 3];
+    manifest.materials.push(lamp);
+    let params = Params { spp: 16, ..Params::default() };
+    let image = render(&params, &mesh, &manifest, &solution(2, 1, |_, _| 1.0));
+    let s = &image.surfaces;
+    let size = 64;
+    let camera = radiometry::camera::Pinhole::new(&manifest.camera, size, size).unwrap();
+    let on_plane = |x: f64, y: f64| {
+        let d = camera.direction(x, y);
+        camera.eye + d * (-camera.eye.z / d.z)
+    };
+    // 0: outside the square, 1: triangle 0 (x > y), 2: triangle 1.
+    let region = |p: DVec3| if !((0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y)) { 0 } else if p.x < p.y { 2 } else { 1 };
+    let (mut single, mut mixed) = (0, 0);
+    for i in 0..(size * size) as usize {
+        let (x, y) = ((i % 64) as f64, (i / 64) as f64);
+        // The share of each region in the pixel, on a fine 16 x 16 grid.
+        let mut share = [0.0f64; 3];
+        for k in 0..256 {
+            share[region(on_plane(x + (f64::from(k % 16) + 0.5) / 16.0, y + (f64::from(k / 16) + 0.5) / 16.0))] += 1.0 / 256.0;
+        }
+        let flags = s.flags[i];
+        if let Some(r) = (0..3).find(|&r| share[r] == 1.0) {
+            if r == 0 {
+                assert_eq!((s.object[i], flags), (schemas::image::NO_SURFACE, 0), "pixel {i} sees nothing");
+                continue;
+            }
+            let object = r as u32 - 1;
+            assert_eq!(flags & schemas::image::SINGLE_SURFACE, 1, "pixel {i} lies on one triangle");
+            assert_eq!((s.object[i], s.material[i]), (object, object));
+            assert_eq!(flags & schemas::image::EMITTER != 0, object == 1);
+            single += 1;
+        } else if share.iter().filter(|&&f| f >= 0.4).count() == 2 {
+            // Split about evenly by an edge: 16 stratified samples see both sides.
+            assert_eq!(flags & schemas::image::SINGLE_SURFACE, 0, "pixel {i} straddles an edge: {share:?}");
+            mixed += 1;
+        }
+    }
+    assert!(single > 500 && mixed > 20, "{single} single, {mixed} mixed pixels");
+}
