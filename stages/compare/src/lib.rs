@@ -5,19 +5,27 @@
 //! only pixel and element data are compared, never headers (provenance,
 //! command lines and timings differ between runs that agree).
 //!
-//! Two kinds of input, both EXR artifacts of this pipeline:
-//! - two [`HdrImage`]s of the same size: the samples are the pixels the
-//!   reference (B) covers, coverage > 0 ([`images`]);
+//! Two kinds of input:
+//! - two images of the same size, each an [`HdrImage`] of this pipeline or
+//!   any RGB(A) EXR of another renderer (read with a note that it carries
+//!   no provenance): the samples are the pixels the reference (B) covers,
+//!   coverage > 0, on a visible surface where a surface layer says so,
+//!   less emitters and edges where asked ([`images`]). The errors are also
+//!   given per object and per material, from the surface layer of B, or
+//!   of A when B (a foreign reference) has none;
 //! - two [`Solution`]s on the same mesh: per leaf element when both
 //!   hierarchies are identical, else per input triangle, weighted by area
 //!   ([`solutions`]).
 //!
-//! The metrics (RMSE, relative RMSE, relative luminance error, and paper
-//! 002's percentage of samples over τ) are defined in [`metrics::Metrics`].
+//! The metrics (RMSE, relative RMSE, mean signed error, relative luminance
+//! error, and paper 002's percentage of samples over τ, relative per
+//! sample) are defined in [`metrics::Metrics`].
 //!
 //! | parameter | type | meaning | default |
 //! |---|---|---|---|
-//! | `tau` | list of f64 | thresholds τ, fractions of the reference's mean luminance | `[0.01, 0.05, 0.1]` |
+//! | `tau` | list of f64 | thresholds τ on `|L_a − L_b| / L_b`, per sample | `[0.02, 0.05, 0.1]` |
+//! | `exclude_emitters` | bool | images: leave out pixels whose surface emits | false |
+//! | `exclude_edges` | optional count | images: leave out pixels within N px of a pixel not covered by one surface (and of an emitter, with `exclude_emitters`) | none |
 //! | `max_rel_rmse` | optional f64 | tolerance on `relative_rmse` | none |
 //! | `max_rmse` | optional f64 | tolerance on `rmse`, in the data's unit | none |
 //! | `max_pixels_over_tau` | optional f64 | tolerance, in percent, on the share of samples over the largest τ | none |
@@ -34,6 +42,7 @@
 
 pub mod images;
 pub mod metrics;
+pub mod scale_bar;
 pub mod solutions;
 
 use metrics::Metrics;
@@ -86,9 +95,14 @@ impl fmt::Display for CompareError {
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct Params {
-    /// Thresholds τ for the percentage-over-τ metric, each a fraction of
-    /// the reference's mean visible luminance.
+    /// Thresholds τ for the percentage-over-τ metric, each on the
+    /// sample's relative luminance difference `|L_a − L_b| / L_b`.
     pub tau: Vec<f64>,
+    /// Images: leave out the pixels whose surface emits.
+    pub exclude_emitters: bool,
+    /// Images: leave out the pixels within this many pixels of an edge
+    /// (see [`images::Exclusions::edges`]).
+    pub exclude_edges: Option<u32>,
     /// Largest allowed `relative_rmse`.
     pub max_rel_rmse: Option<f64>,
     /// Largest allowed `rmse`, in the data's unit (W/(m² sr) for images,
@@ -101,7 +115,14 @@ pub struct Params {
 
 impl Default for Params {
     fn default() -> Self {
-        Params { tau: vec![0.01, 0.05, 0.1], max_rel_rmse: None, max_rmse: None, max_pixels_over_tau: None }
+        Params {
+            tau: vec![0.02, 0.05, 0.1],
+            exclude_emitters: false,
+            exclude_edges: None,
+            max_rel_rmse: None,
+            max_rmse: None,
+            max_pixels_over_tau: None,
+        }
     }
 }
 
@@ -121,6 +142,11 @@ impl Params {
             }
         }
         Ok(())
+    }
+
+    /// The pixel exclusions asked for.
+    pub fn exclusions(&self) -> images::Exclusions {
+        images::Exclusions { emitters: self.exclude_emitters, edges: self.exclude_edges }
     }
 
     /// The largest τ (0 for an empty list).
@@ -145,8 +171,7 @@ impl Params {
     /// empty when the inputs match. A metric equal to its tolerance passes.
     pub fn exceeded(&self, m: &Metrics) -> Vec<String> {
         let tau_max = self.tau_max();
-        let over_tau_max =
-            m.percent_over_tau.iter().filter(|(t, _)| *t == tau_max).map(|(_, p)| *p).next().unwrap_or(0.0);
+        let over_tau_max = m.percent_over(tau_max);
         let checks = [
             ("relative_rmse".to_string(), m.relative_rmse, self.max_rel_rmse),
             ("rmse".to_string(), m.rmse, self.max_rmse),
@@ -165,21 +190,51 @@ impl Params {
 /// The outcome of comparing two images.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageComparison {
-    /// The metrics over the reference's covered pixels.
+    /// The metrics over the compared pixels.
     pub metrics: Metrics,
+    /// The metrics per object index, over the compared pixels of each
+    /// (empty without a surface layer).
+    pub by_object: Vec<(u32, Metrics)>,
+    /// The metrics per material index.
+    pub by_material: Vec<(u32, Metrics)>,
+    /// Which input's surface layer was used, if any.
+    pub surfaces_from: Option<Which>,
+    /// Pixels the reference covers that were not compared: no visible
+    /// surface, or left out by an exclusion.
+    pub excluded: usize,
     /// Pixels covered in exactly one of the two images.
     pub coverage_mismatches: usize,
     /// Pixels per image.
     pub pixels: usize,
+    /// Per pixel, whether it was compared.
+    pub compared: Vec<bool>,
+}
+
+/// The counter name of metric `name` of group `group` (`object`,
+/// `material`) `label`: `object[tall block].relative_rmse`.
+pub fn group_counter(group: &str, label: &str, name: &str) -> String {
+    format!("{group}[{label}].{name}")
 }
 
 impl ImageComparison {
-    /// Report counters: the metrics' plus `pixels` and
-    /// `coverage_mismatch_pixels`.
-    pub fn counters(&self) -> BTreeMap<String, f64> {
+    /// Report counters: the metrics', `pixels`, `coverage_mismatch_pixels`,
+    /// `excluded_pixels`, and for each object and material (labelled by
+    /// `object_label` / `material_label` from the index) its metrics as
+    /// [`group_counter`]s.
+    pub fn counters(&self, object_label: &dyn Fn(u32) -> String, material_label: &dyn Fn(u32) -> String) -> BTreeMap<String, f64> {
         let mut c = self.metrics.counters();
         c.insert("pixels".to_string(), self.pixels as f64);
         c.insert("coverage_mismatch_pixels".to_string(), self.coverage_mismatches as f64);
+        c.insert("excluded_pixels".to_string(), self.excluded as f64);
+        for (group, list, label) in [("object", &self.by_object, object_label), ("material", &self.by_material, material_label)] {
+            for (index, m) in list {
+                for (name, value) in m.counters() {
+                    if name != "total_weight" {
+                        c.insert(group_counter(group, &label(*index), &name), value);
+                    }
+                }
+            }
+        }
         c
     }
 }
@@ -187,11 +242,30 @@ impl ImageComparison {
 /// Compares image `a` with reference `b` (same size, finite values).
 pub fn compare_images(a: &HdrImage, b: &HdrImage, params: &Params) -> Result<ImageComparison, CompareError> {
     images::check_pair(a, b)?;
-    let samples = images::samples(a, b);
+    let compared = images::compared_pixels(a, b, params.exclusions())?;
+    let samples = images::samples(a, b, &compared);
+    let surfaces = images::surfaces(a, b);
+    let group = |index: &dyn Fn(usize) -> u32| {
+        let mut groups: BTreeMap<u32, Vec<metrics::Sample>> = BTreeMap::new();
+        for (pixel, sample) in &samples {
+            groups.entry(index(*pixel)).or_default().push(*sample);
+        }
+        groups.into_iter().map(|(k, v)| (k, metrics::metrics(&v, &params.tau))).collect::<Vec<_>>()
+    };
+    let (by_object, by_material) = match surfaces {
+        Some((s, _)) => (group(&|i| s.object[i]), group(&|i| s.material[i])),
+        None => (Vec::new(), Vec::new()),
+    };
+    let all: Vec<metrics::Sample> = samples.iter().map(|(_, s)| *s).collect();
     Ok(ImageComparison {
-        metrics: metrics::metrics(&samples, &params.tau),
+        metrics: metrics::metrics(&all, &params.tau),
+        by_object,
+        by_material,
+        surfaces_from: surfaces.map(|(_, w)| w),
+        excluded: b.coverage.iter().filter(|&&c| c > 0.0).count() - all.len(),
         coverage_mismatches: images::coverage_mismatches(a, b),
         pixels: b.rgb.len(),
+        compared,
     })
 }
 

@@ -3,7 +3,8 @@
 use clap::Parser;
 use compare::{CompareError, Params, Which};
 use schemas::header::Schema;
-use schemas::image::HdrImage;
+use schemas::image::{HdrImage, Origin};
+use schemas::mesh::Manifest;
 use schemas::report::Report;
 use schemas::solution::Solution;
 use schemas::stage::{bad_parameter, exit_code, load_params, print_params, Run};
@@ -13,12 +14,14 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Compares two images or two solutions; B is the reference. Exit 0: match
-/// (or no tolerance given), 1: a given tolerance is exceeded, 2: error.
+/// Compares two images or two solutions; B is the reference. Images may come
+/// from any renderer (any RGB(A) EXR); errors are given over the whole
+/// image and per object and material. Exit 0: match (or no tolerance
+/// given), 1: a given tolerance is exceeded, 2: error.
 #[derive(Parser, Debug)]
 #[command(version, about)]
 struct Args {
-    /// The approximation (`image` or `solution` artifact, EXR).
+    /// The approximation (`image` or `solution` artifact, or any RGB(A) EXR).
     #[arg(required_unless_present = "print_params")]
     a: Option<PathBuf>,
     /// The reference, of the same kind.
@@ -27,12 +30,21 @@ struct Args {
     /// Write the report (RON) here; without it the report goes to stdout.
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Write a false-colour luminance difference picture (PNG; images only).
+    /// Write a false-colour picture of the relative luminance difference, with a scale bar (PNG; images only).
     #[arg(long)]
     diff: Option<PathBuf>,
-    /// Thresholds tau, comma-separated, as fractions of the reference's mean luminance.
+    /// Thresholds tau on |L_a - L_b| / L_b per pixel, comma-separated [default: 0.02,0.05,0.1].
     #[arg(long, value_delimiter = ',')]
     tau: Option<Vec<f64>>,
+    /// Leave out pixels whose surface emits (needs a surface layer in A or B).
+    #[arg(long)]
+    exclude_emitters: bool,
+    /// Leave out pixels within N px of a silhouette or crease between surfaces (and of an emitter, with --exclude-emitters).
+    #[arg(long, value_name = "N")]
+    exclude_edges: Option<u32>,
+    /// The scene's manifest: names objects and materials in the report (else they are numbered).
+    #[arg(long)]
+    manifest: Option<PathBuf>,
     /// Tolerance on the relative RMSE.
     #[arg(long)]
     max_rel_rmse: Option<f64>,
@@ -55,6 +67,8 @@ fn params(args: &Args) -> schemas::Result<Params> {
     if let Some(tau) = &args.tau {
         params.tau = tau.clone();
     }
+    params.exclude_emitters |= args.exclude_emitters;
+    params.exclude_edges = args.exclude_edges.or(params.exclude_edges);
     params.max_rel_rmse = args.max_rel_rmse.or(params.max_rel_rmse);
     params.max_rmse = args.max_rmse.or(params.max_rmse);
     params.max_pixels_over_tau = args.max_pixels_over_tau.or(params.max_pixels_over_tau);
@@ -69,6 +83,8 @@ struct Outcome {
     metrics: compare::metrics::Metrics,
     notes: Vec<String>,
     diff_png: Option<Vec<u8>>,
+    /// Per-surface lines for stderr.
+    table: Vec<String>,
 }
 
 fn named(error: CompareError, a: &Path, b: &Path) -> Error {
@@ -79,38 +95,87 @@ fn named(error: CompareError, a: &Path, b: &Path) -> Error {
     Error::invalid(path, None, error.to_string())
 }
 
+/// Reads an image of this pipeline or a foreign EXR; a foreign one gets a
+/// note (here and on stderr) that it carries no provenance.
+fn read_image(path: &Path, run: &mut Run, notes: &mut Vec<String>) -> schemas::Result<HdrImage> {
+    let (image, record, origin) = HdrImage::read_any(path)?;
+    if origin == Origin::Foreign {
+        let note = format!("{} is a foreign EXR (no provenance; SHA-256 {})", path.display(), record.sha256);
+        eprintln!("compare: note: {note}");
+        notes.push(note);
+    }
+    run.input(record);
+    Ok(image)
+}
+
+/// Labels of object or material indices: the manifest's names where one
+/// is given, else `#<index>`; [`schemas::image::NO_SURFACE`] never appears
+/// (such pixels are not compared).
+fn labeller(names: Option<Vec<String>>) -> impl Fn(u32) -> String {
+    move |i| names.as_ref().and_then(|n| n.get(i as usize).cloned()).unwrap_or_else(|| format!("#{i}"))
+}
+
 fn compare_files(args: &Args, params: &Params, run: &mut Run, a: &Path, b: &Path) -> schemas::Result<Outcome> {
     // The kind is decided by A: an image, or else (when A's schema says it
     // is no image) a solution; B must then be of the same kind.
-    let (image_a, record_a) = match HdrImage::read(a) {
-        Ok(read) => read,
+    let mut notes = Vec::new();
+    let image_a = match read_image(a, run, &mut notes) {
+        Ok(image) => image,
         Err(image_error @ Error::Schema { .. }) => return compare_solution_files(args, params, run, a, b, image_error),
         Err(other) => return Err(other),
     };
-    run.input(record_a);
-    let (image_b, record_b) = HdrImage::read(b)?;
-    run.input(record_b);
-    let result = compare::compare_images(&image_a, &image_b, params).map_err(|e| named(e, a, b))?;
-    let diff_png = match args.diff.as_deref() {
+    let image_b = read_image(b, run, &mut notes)?;
+    let manifest = match args.manifest.as_deref() {
         Some(path) => {
-            let picture = compare::images::difference_picture(
-                &image_a,
-                &image_b,
-                result.metrics.mean_reference_luminance,
-                params.tau_max(),
-            );
-            Some(
-                schemas::png::encode_png(image_b.width, image_b.height, &picture)
-                    .map_err(|e| Error::invalid(path, None, e))?,
-            )
+            let loaded = schemas::ron_io::read_ron::<Manifest>(path)?;
+            run.input(loaded.input);
+            Some(loaded.value)
         }
         None => None,
     };
-    let mut notes = Vec::new();
+    let result = compare::compare_images(&image_a, &image_b, params).map_err(|e| named(e, a, b))?;
+    if let (Some(m), Some((s, which))) = (&manifest, compare::images::surfaces(&image_a, &image_b)) {
+        let out_of_range = |list: &[u32], len: usize| list.iter().any(|&i| i != schemas::image::NO_SURFACE && i as usize >= len);
+        if out_of_range(&s.object, m.objects.len()) || out_of_range(&s.material, m.materials.len()) {
+            let path = if which == Which::A { a } else { b };
+            return Err(Error::invalid(path, None, "surface layer names objects or materials the manifest does not have: is it this image's scene?"));
+        }
+    }
+    let diff_png = match args.diff.as_deref() {
+        Some(path) => {
+            let picture = compare::images::difference_picture(&image_a, &image_b, &result.compared, params.tau_max());
+            let (w, h, pixels) = compare::scale_bar::with_scale_bar(image_b.width, image_b.height, &picture, params.tau_max());
+            Some(schemas::png::encode_png(w, h, &pixels).map_err(|e| Error::invalid(path, None, e))?)
+        }
+        None => None,
+    };
     if result.coverage_mismatches > 0 {
         notes.push(format!("{} pixels are covered in one image only", result.coverage_mismatches));
     }
-    Ok(Outcome { counters: result.counters(), mode: "images", metrics: result.metrics, notes, diff_png })
+    if let Some(which) = result.surfaces_from {
+        notes.push(format!("surfaces (objects, materials, edges) from {}", if which == Which::A { "A" } else { "B" }));
+    }
+    let object_label = labeller(manifest.as_ref().map(|m| m.objects.clone()));
+    let material_label = labeller(manifest.as_ref().map(|m| m.materials.iter().map(|m| m.name.clone()).collect()));
+    let table = surface_table(&result, params.tau_max(), &object_label, &material_label);
+    Ok(Outcome { counters: result.counters(&object_label, &material_label), mode: "images", metrics: result.metrics, notes, diff_png, table })
+}
+
+/// The per-object and per-material lines printed on stderr.
+fn surface_table(result: &compare::ImageComparison, tau_max: f64, object: &dyn Fn(u32) -> String, material: &dyn Fn(u32) -> String) -> Vec<String> {
+    let mut lines = Vec::new();
+    for (group, list, label) in [("object", &result.by_object, object), ("material", &result.by_material, material)] {
+        if list.is_empty() {
+            continue;
+        }
+        let over_tau = format!("over {}", compare::scale_bar::percent(tau_max));
+        lines.push(format!("  {group:<24} {:>8} {:>13} {:>12} {over_tau:>10}", "pixels", "relative_rmse", "mean_signed"));
+        for (index, m) in list {
+            let over = m.percent_over(tau_max);
+            lines.push(format!("  {:<24} {:>8} {:>13.5} {:>+11.3}% {:>9.2}%", label(*index), m.samples, m.relative_rmse, 100.0 * m.mean_signed_error, over));
+        }
+    }
+    lines
 }
 
 fn compare_solution_files(
@@ -133,6 +198,9 @@ fn compare_solution_files(
     if args.diff.is_some() {
         return Err(bad_parameter("--diff applies to images only; the inputs are solutions"));
     }
+    if params.exclusions().any() || args.manifest.is_some() {
+        return Err(bad_parameter("--exclude-emitters, --exclude-edges and --manifest apply to images only; the inputs are solutions"));
+    }
     run.input(record_a);
     let (solution_b, record_b) = Solution::read(b)?;
     run.input(record_b);
@@ -143,6 +211,7 @@ fn compare_solution_files(
         metrics: result.metrics,
         notes: Vec::new(),
         diff_png: None,
+        table: Vec::new(),
     })
 }
 
@@ -190,14 +259,18 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     }
     let m = &outcome.metrics;
     eprintln!(
-        "compare: {verdict} ({}, {} samples: rmse {:.6}, relative_rmse {:.6}, {:.3}% over tau {})",
+        "compare: {verdict} ({}, {} samples: rmse {:.6}, relative_rmse {:.6}, mean_signed_error {:+.6}, {:.3}% over tau {})",
         outcome.mode,
         m.samples,
         m.rmse,
         m.relative_rmse,
-        m.percent_over_tau.iter().find(|(t, _)| *t == params.tau_max()).map_or(0.0, |(_, p)| *p),
+        m.mean_signed_error,
+        m.percent_over(params.tau_max()),
         params.tau_max()
     );
+    for line in &outcome.table {
+        eprintln!("{line}");
+    }
     Ok(if exceeded.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 

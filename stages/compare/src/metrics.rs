@@ -30,13 +30,16 @@ pub use radiometry::color::luminance;
 /// - per sample, on luminance, `e_s = |L_a − L_b| / max(L_b, floor)` with
 ///   `floor = 1e-3 · mean_reference_luminance` ([`RELATIVE_FLOOR`]):
 ///   `mean_relative_error = Σ w e / Σ w`, `max_relative_error = max e`;
+/// - `mean_signed_error = Σ w (L_a − L_b) / Σ w L_b`: the bias of the mean
+///   luminance, relative (−0.1: A is 10% too dark on average; 0 when the
+///   reference is black and A equals it);
 /// - for each τ, the percentage (of samples, weighted) with
-///   `|L_a − L_b| > τ · mean_reference_luminance`: the metric of paper 002
-///   (structured sampling, Section 4.1, Tables 1-3: "the percentage of
-///   pixels with an absolute difference greater than a certain tolerance
-///   τ"), on luminance. τ is a fraction of the reference's mean visible
-///   luminance rather than an absolute radiance, so one τ means the same in
-///   every scene whatever its units and brightness.
+///   `|L_a − L_b| > τ · L_b`, τ relative to *that sample's* reference
+///   luminance: the measure of paper 002 (structured sampling, Section 4.1
+///   and Table 3, "Error (>15%)": the percentage of visible pixels whose
+///   difference from the exact image exceeds a tolerance τ). Relative per
+///   pixel, so a dim wall counts as much as a bright one; a black
+///   reference sample is over every τ unless A is black there too.
 ///
 /// `mean_reference_luminance = Σ w L_b / Σ w`.
 #[derive(Clone, Debug, PartialEq)]
@@ -49,6 +52,8 @@ pub struct Metrics {
     pub rmse: f64,
     /// RMS difference relative to the reference's RMS.
     pub relative_rmse: f64,
+    /// Relative bias of the mean luminance, signed.
+    pub mean_signed_error: f64,
     /// Weighted mean of the per-sample relative luminance error.
     pub mean_relative_error: f64,
     /// Largest per-sample relative luminance error.
@@ -71,6 +76,11 @@ fn ratio(x: f64, y: f64) -> f64 {
     }
 }
 
+/// `x / y` for a signed `x`: 0/0 is 0, x/0 is ±∞.
+fn signed_ratio(x: f64, y: f64) -> f64 {
+    ratio(x.abs(), y).copysign(x)
+}
+
 /// Computes [`Metrics`] over `samples` for each τ in `taus`. With no
 /// samples (or zero total weight) every metric is 0.
 pub fn metrics(samples: &[Sample], taus: &[f64]) -> Metrics {
@@ -88,8 +98,10 @@ pub fn metrics(samples: &[Sample], taus: &[f64]) -> Metrics {
     let percent_over_tau = taus
         .iter()
         .map(|&tau| {
-            let threshold = tau * mean_reference_luminance;
-            let over = |s: &Sample| f64::from(u8::from((luminance(s.a) - luminance(s.b)).abs() > threshold));
+            let over = |s: &Sample| {
+                let lb = luminance(s.b);
+                f64::from(u8::from((luminance(s.a) - lb).abs() > tau * lb))
+            };
             (tau, 100.0 * mean(&over))
         })
         .collect();
@@ -98,6 +110,10 @@ pub fn metrics(samples: &[Sample], taus: &[f64]) -> Metrics {
         total_weight,
         rmse: ratio(sum_squared_difference, 3.0 * total_weight).sqrt(),
         relative_rmse: ratio(sum_squared_difference, sum_squared_reference).sqrt(),
+        mean_signed_error: signed_ratio(
+            samples.iter().map(|s| s.weight * (luminance(s.a) - luminance(s.b))).sum(),
+            samples.iter().map(|s| s.weight * luminance(s.b)).sum(),
+        ),
         mean_relative_error: mean(&relative_error),
         max_relative_error: samples.iter().map(relative_error).fold(0.0, f64::max),
         mean_reference_luminance,
@@ -112,8 +128,13 @@ pub fn tau_counter(tau: f64) -> String {
 }
 
 impl Metrics {
+    /// The percentage of samples over `tau`, 0 when `tau` was not measured.
+    pub fn percent_over(&self, tau: f64) -> f64 {
+        self.percent_over_tau.iter().find(|(t, _)| *t == tau).map_or(0.0, |(_, p)| *p)
+    }
+
     /// The report counters: `samples`, `total_weight`, `rmse`,
-    /// `relative_rmse`, `mean_relative_error`, `max_relative_error`,
+    /// `relative_rmse`, `mean_signed_error`, `mean_relative_error`, `max_relative_error`,
     /// `mean_reference_luminance` and one `percent_over_tau_<τ>` per τ.
     pub fn counters(&self) -> BTreeMap<String, f64> {
         let mut c = BTreeMap::new();
@@ -121,6 +142,7 @@ impl Metrics {
         c.insert("total_weight".to_string(), self.total_weight);
         c.insert("rmse".to_string(), self.rmse);
         c.insert("relative_rmse".to_string(), self.relative_rmse);
+        c.insert("mean_signed_error".to_string(), self.mean_signed_error);
         c.insert("mean_relative_error".to_string(), self.mean_relative_error);
         c.insert("max_relative_error".to_string(), self.max_relative_error);
         c.insert("mean_reference_luminance".to_string(), self.mean_reference_luminance);

@@ -22,7 +22,7 @@ fn scratch(test: &str) -> PathBuf {
 fn write_image(path: &Path, width: usize, rgb: Vec<[f32; 3]>) {
     let height = rgb.len() / width;
     let coverage = vec![1.0; rgb.len()];
-    HdrImage { header: HdrImage::header(provenance()), width, height, rgb, coverage }.write(path).unwrap();
+    HdrImage { header: HdrImage::header(provenance()), width, height, rgb, coverage, surfaces: None }.write(path).unwrap();
 }
 
 fn write_solution(path: &Path, radiosity: [f32; 3]) {
@@ -101,5 +101,56 @@ fn solutions_are_detected_and_mixed_kinds_refused() {
     let out = compare(&[&a, &image], &[]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("is a 'image' artifact, expected 'solution'"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Writes `rgb` as a plain float RGB EXR with the `exr` crate, with no
+/// custom attribute: what another renderer writes.
+fn write_foreign(path: &Path, width: usize, rgb: &[[f32; 3]]) {
+    use exr::prelude::*;
+    let height = rgb.len() / width;
+    let pixel = |p: Vec2<usize>| {
+        let v = rgb[p.y() * width + p.x()];
+        (v[0], v[1], v[2])
+    };
+    let layer = Layer::new((width, height), LayerAttributes::default(), Encoding::SMALL_LOSSLESS, SpecificChannels::rgb(pixel));
+    Image::from_layer(layer).write().to_file(path).unwrap();
+}
+
+#[test]
+fn foreign_reference_gives_the_same_metrics_with_one_note() {
+    let dir = scratch("foreign");
+    let (a, pipeline_b, foreign_b) = (dir.join("a.exr"), dir.join("b.exr"), dir.join("mitsuba.exr"));
+    let b_rgb: Vec<[f32; 3]> = (0..12).map(|i| [0.1 + 0.05 * i as f32, 0.3, 0.02 * i as f32]).collect();
+    let a_rgb: Vec<[f32; 3]> = b_rgb.iter().enumerate().map(|(i, p)| p.map(|v| v * (1.0 + 0.03 * (i % 5) as f32 - 0.05))).collect();
+    write_image(&a, 4, a_rgb);
+    write_image(&pipeline_b, 4, b_rgb.clone());
+    write_foreign(&foreign_b, 4, &b_rgb);
+    let (ours, theirs) = (dir.join("ours.ron"), dir.join("theirs.ron"));
+    let out = compare(&[&a, &pipeline_b], &["-o", ours.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = compare(&[&a, &foreign_b], &["-o", theirs.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.matches("foreign EXR (no provenance").count(), 1, "{stderr}");
+    let (ours, theirs) =
+        (schemas::ron_io::read_ron::<Report>(&ours).unwrap().value, schemas::ron_io::read_ron::<Report>(&theirs).unwrap().value);
+    assert_eq!(ours.counters.keys().collect::<Vec<_>>(), theirs.counters.keys().collect::<Vec<_>>());
+    for (name, value) in &ours.counters {
+        assert!((value - theirs.counters[name]).abs() <= 1e-12 * value.abs().max(1.0), "{name}: {value} vs {}", theirs.counters[name]);
+    }
+    assert!(ours.counters["relative_rmse"] > 0.01);
+    // The report names the foreign input with its hash and no provenance.
+    let input = &theirs.header.provenance.inputs[1];
+    assert!(input.made_by.is_none() && input.sha256 == schemas::header::sha256_hex(&std::fs::read(&foreign_b).unwrap()));
+    assert!(theirs.notes.iter().any(|n| n.contains("foreign EXR")));
+    // Sizes must match; exclusions need a surface layer.
+    write_foreign(&foreign_b, 3, &b_rgb);
+    let out = compare(&[&a, &foreign_b], &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is 4x3 pixels but the reference is 3x4"));
+    let out = compare(&[&a, &pipeline_b], &["--exclude-emitters"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("needs a surface layer"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
