@@ -153,7 +153,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                     // Keyed by the brute sample count too, so a high-sample reference
                     // shares the camera jitter of a cheaper run but not its gather noise.
                     let mut gather_stream = Stream::new(params.seed, pixel, 1 + u64::from(params.brute_samples));
-                    let (mut sum, mut covered, mut work, mut tally) = ([0.0f64; 3], 0u32, Work::default(), PixelTally::default());
+                    let (mut sum, mut covered, mut work, mut tally) = ([0.0f64; 3], 0u32, Work::default(), PixelTally::new(params.crease_angle_deg));
                     for k in 0..spp {
                         let (jx, jy) = pixel_offset(k, spp, &mut stream);
                         let d = camera.direction(f64::from(x) + jx, f64::from(y) + jy);
@@ -168,7 +168,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                             tally.other();
                             continue;
                         }
-                        tally.front(scene.ids[hit.triangle as usize]);
+                        tally.front(scene.ids[hit.triangle as usize], tri.normal);
                         let p = camera.eye + d * f64::from(hit.t);
                         let leaf = senders.chain(hit.triangle, tri.uv_of(p), &mut links);
                         let mut sample = Work::default();

@@ -25,7 +25,7 @@
 //! | `width`, `height` | pixels | image size | the manifest camera's |
 //! | `spp` | count | camera rays per pixel (stratified, jittered) | 4 |
 //! | `seed` | u64 | seed of the per-pixel random streams | 0 |
-//! | `crease_angle_deg` | degrees | leaves whose normals differ more do not blend at a shared corner | 30 |
+//! | `crease_angle_deg` | degrees | leaves whose normals differ more do not blend at a shared corner; a pixel whose hits differ more is an edge in the surface layer | 30 |
 //! | `weld_tolerance` | fraction of the bounding-box diagonal | corners closer than this are one point | 1e-7 |
 //! | `material_seams` | bool | leaves of different materials do not blend at a shared corner | true |
 //! | `grid` | `"perspective"` / `"regular"` | full: grid uniform in post-perspective space, or cubes | `"perspective"` |
@@ -54,7 +54,6 @@ pub mod render;
 pub mod senders;
 
 use gouraud::{Gouraud, Smoothing};
-use pixel_surfaces::PixelTally;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::mesh_triangles;
 use radiometry::rays::SceneRays;
@@ -334,7 +333,7 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
     let rays = (!triangles.is_empty()).then(|| SceneRays::new(&triangles.iter().map(|t| t.corners).collect::<Vec<_>>()));
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
-    let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading, surfaces: &ids };
+    let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading, surfaces: &ids, crease_angle_deg: params.crease_angle_deg };
     let film = render::render(&view, Sampling { width, height, spp: params.spp, seed: params.seed }, rows_done);
 
     let pixels = f64::from(width) * f64::from(height);
@@ -395,7 +394,7 @@ fn full_gather(
         .collect();
     if triangles.is_empty() {
         let n = width as usize * height as usize;
-        let surfaces = pixel_surfaces::collect(std::iter::repeat_n(PixelTally::default().finish(), n));
+        let surfaces = pixel_surfaces::collect(std::iter::repeat_n(pixel_surfaces::NOTHING, n));
         let rendered = Rendered { width: width as usize, height: height as usize, rgb: vec![[0.0; 3]; n], coverage: vec![0.0; n], surfaces, counters: BTreeMap::new(), skipped: Vec::new() };
         return Ok((rendered, final_gather::Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
     }

@@ -21,6 +21,8 @@ pub struct View<'a> {
     pub shading: &'a Gouraud,
     /// The surface of each triangle, for the image's surface layer.
     pub surfaces: &'a [SurfaceId],
+    /// Hit normals further apart than this make a pixel an edge, degrees.
+    pub crease_angle_deg: f64,
 }
 
 /// How pixels are sampled.
@@ -82,7 +84,7 @@ pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync))
                 .map(|x| {
                     let pixel = u64::from(y) * u64::from(width) + u64::from(x);
                     let mut stream = Stream::new(seed, pixel, 0);
-                    let (mut sum, mut covered, mut tally) = ([0.0f64; 3], 0u32, PixelTally::default());
+                    let (mut sum, mut covered, mut tally) = ([0.0f64; 3], 0u32, PixelTally::new(view.crease_angle_deg));
                     for k in 0..spp {
                         let (jx, jy) = pixel_offset(k, spp, &mut stream);
                         let Some((triangle, sample)) = trace(view, f64::from(x) + jx, f64::from(y) + jy) else {
@@ -94,7 +96,7 @@ pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync))
                         match sample {
                             Some(radiance) => {
                                 sum.iter_mut().zip(radiance).for_each(|(s, r)| *s += r);
-                                tally.front(view.surfaces[triangle as usize]);
+                                tally.front(view.surfaces[triangle as usize], view.triangles[triangle as usize].normal);
                             }
                             None => {
                                 back += 1;
