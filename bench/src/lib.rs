@@ -1,4 +1,7 @@
-//! Measuring helpers the benchmark binaries share.
+//! Measuring helpers the benchmark binaries share, and the sweep of error
+//! against time ([`sweep`], the `sweep` binary).
+
+pub mod sweep;
 
 /// The process's peak resident memory (VmHWM), MiB; `None` off Linux.
 pub fn peak_memory_mib() -> Option<f64> {
