@@ -43,6 +43,65 @@ pub fn point_to_rectangle(x: f64, y: f64, rect: [f64; 4], c: f64) -> f64 {
     corner(x1 - x, y1 - y) - corner(x0 - x, y1 - y) - corner(x1 - x, y0 - y) + corner(x0 - x, y0 - y)
 }
 
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// Lambert's formula: the form factor from a differential area at `point`
+/// with unit normal `normal` to a planar polygon wholly in front of it (at
+/// or above its tangent plane),
+///
+/// ```text
+/// F = 1/(2 pi) |sum_i beta_i n . g_i|
+/// ```
+///
+/// `beta_i` the angle edge `i` subtends at the point and `g_i` the unit
+/// normal of the plane through the point and that edge (Lambert's
+/// contour-integral form of the point-to-area factor, paper 002 Eq. 3;
+/// written here from the formula, apart from the stages' kernel).
+pub fn lambert_polygon(point: [f64; 3], normal: [f64; 3], polygon: &[[f64; 3]]) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..polygon.len() {
+        let a = sub(polygon[i], point);
+        let b = sub(polygon[(i + 1) % polygon.len()], point);
+        let g = cross(a, b);
+        let g_len = dot(g, g).sqrt();
+        if g_len == 0.0 {
+            continue;
+        }
+        let beta = g_len.atan2(dot(a, b));
+        sum += beta * dot(normal, g) / g_len;
+    }
+    sum.abs() / (2.0 * PI)
+}
+
+/// The part of the convex planar `polygon` on the front side of the plane
+/// through `origin` with normal `normal` (`(x - origin) . normal >= 0`):
+/// Sutherland-Hodgman against one plane.
+pub fn clip_to_front(polygon: &[[f64; 3]], origin: [f64; 3], normal: [f64; 3]) -> Vec<[f64; 3]> {
+    let mut out = Vec::new();
+    for i in 0..polygon.len() {
+        let (a, b) = (polygon[i], polygon[(i + 1) % polygon.len()]);
+        let (da, db) = (dot(sub(a, origin), normal), dot(sub(b, origin), normal));
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
+            let t = da / (da - db);
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])]);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -56,5 +115,15 @@ mod tests {
         // A point under the middle of a square equals four corner squares.
         let centre = point_to_rectangle(0.0, 0.0, [-1.0, 1.0, -1.0, 1.0], 1.0);
         assert!((centre - 4.0 * point_to_corner_rectangle(1.0, 1.0, 1.0)).abs() < 1e-15);
+        // Lambert's polygon formula agrees with the corner rectangles, and
+        // clipping a square to the half-space through its middle halves it
+        // for a point under that middle.
+        let square = [[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]];
+        assert!((lambert_polygon([0.0; 3], [0.0, 0.0, 1.0], &square) - centre).abs() < 1e-14);
+        let corner = point_to_rectangle(0.3, -0.2, [-1.0, 1.0, -1.0, 1.0], 1.0);
+        assert!((lambert_polygon([0.3, -0.2, 0.0], [0.0, 0.0, 1.0], &square) - corner).abs() < 1e-14);
+        let half = clip_to_front(&square, [0.0; 3], [1.0, 0.0, 0.0]);
+        assert_eq!(half.len(), 4);
+        assert!((lambert_polygon([0.0; 3], [0.0, 0.0, 1.0], &half) - 0.5 * centre).abs() < 1e-14);
     }
 }

@@ -122,3 +122,24 @@ pub fn closed_box(size: f64, rho: f64, emission: f64) -> QuadScene {
     }
     scene
 }
+
+/// A receiver square R (1 m, the plane x = 0, facing +x, reflectance
+/// `rho`) that is the front face of a closed black box `x in [-1, 0]`, lit
+/// by a 2 x 2 m black emitter (exitance `emission`) 0.5 m above the box,
+/// facing down, that straddles R's plane: `x in [-0.7, 1.3]`, `y in [-0.5,
+/// 1.5]`, `z = 1.5` (off-centre, so that no midpoint subdivision of the
+/// emitter ever falls on R's plane). Nothing occludes the emitter's front
+/// part from R; its back part is behind R's plane, above the box's body.
+/// Objects `R`, `box`, `lamp`.
+pub fn straddled_receiver(rho: f64, emission: f64) -> QuadScene {
+    let mut scene = QuadScene { camera: ([3.0, 0.5, 0.8], [0.0, 0.5, 0.5]), ..Default::default() };
+    scene.material("receiving", rho, 0.0).material("black", 0.0, 0.0).material("emitting", 0.0, emission);
+    scene.quad("R", "receiving", rectangle(0, 0.0, [0.0, 0.0], [1.0, 1.0]), [1.0, 0.0, 0.0]);
+    scene.quad("box", "black", rectangle(0, -1.0, [0.0, 0.0], [1.0, 1.0]), [-1.0, 0.0, 0.0]);
+    for (at, sign) in [(0.0, -1.0), (1.0, 1.0)] {
+        scene.quad("box", "black", rectangle(1, at, [0.0, -1.0], [1.0, 0.0]), [0.0, sign, 0.0]);
+        scene.quad("box", "black", rectangle(2, at, [-1.0, 0.0], [0.0, 1.0]), [0.0, 0.0, sign]);
+    }
+    scene.quad("lamp", "emitting", rectangle(2, 1.5, [-0.7, -0.5], [1.3, 1.5]), [0.0, 0.0, -1.0]);
+    scene
+}

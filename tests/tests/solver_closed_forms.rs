@@ -4,8 +4,8 @@
 //! clustering (clusters of one triangle, so that cluster nodes really sit
 //! between the triangles and the root).
 
-use end_to_end::closed_form::{parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
-use end_to_end::scenes::{closed_box, rectangle, QuadScene};
+use end_to_end::closed_form::{clip_to_front, lambert_polygon, parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
+use end_to_end::scenes::{closed_box, rectangle, straddled_receiver, QuadScene};
 use end_to_end::{run_ok, s, scratch, solve_prepared};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
@@ -176,6 +176,66 @@ fn lambert(clustered: bool) {
         checked += 1;
     }
     assert!(checked > 100, "only {checked} floor elements under the lamp");
+}
+
+/// Issue 10, item 1: a receiver whose senders straddle its plane, with a
+/// solid box behind it. Every leaf of R must have the irradiance of
+/// Lambert's formula for the part of the emitter in front of R's plane,
+/// averaged over the leaf (16 sub-triangle centroids), within 0.5%: R's
+/// radiosity is `rho E F`, nothing else reflects. Visibility as the plain
+/// clear fraction of rays to the whole emitter counts the rays to its back
+/// half, which run through the box, as shadowed.
+fn straddling_sender(clustered: bool) {
+    let (rho, emission) = (0.5, 1.0);
+    let scene = straddled_receiver(rho, emission);
+    let (solved, dir) = solve("straddling", &scene, &[], clustered);
+    let (mesh, _) = Mesh::read(&dir.join("mesh.exr")).unwrap();
+    let manifest = read_ron::<Manifest>(&dir.join("manifest.ron")).unwrap().value;
+    let origin = manifest.world_from_mesh_translation;
+    let lamp = [[-0.7, -0.5, 1.5], [1.3, -0.5, 1.5], [1.3, 1.5, 1.5], [-0.7, 1.5, 1.5]];
+    let (r_origin, r_normal) = ([0.0; 3], [1.0, 0.0, 0.0]);
+    let front = clip_to_front(&lamp, r_origin, r_normal);
+    let (mut checked, mut worst, mut sum_sq) = (0, 0.0f64, 0.0);
+    for (object, _, b, i) in solved.leaves() {
+        if object != "R" {
+            continue;
+        }
+        let e = &solved.solution.elements[i];
+        let t = &mesh.triangles[e.triangle as usize];
+        let p = |k: usize| mesh.positions[t.vertices[k] as usize].map(f64::from);
+        let (p0, p1, p2) = (p(0), p(1), p(2));
+        let world = |uv: [f64; 2]| std::array::from_fn::<f64, 3, _>(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a]);
+        let corners = e.corners.map(|c| world([f64::from(c[0]), f64::from(c[1])]));
+        let exact = mean_over_triangle(&corners, 2, &|x| lambert_polygon(x, r_normal, &front));
+        let error = (b / (rho * emission) - exact) / exact;
+        worst = worst.max(error.abs());
+        sum_sq += error * error;
+        checked += 1;
+    }
+    eprintln!("straddling, clustered {clustered}: {checked} leaves of R, largest relative error {worst:.2e}, rms {:.2e}", (sum_sq / f64::from(checked)).sqrt());
+    assert!(checked >= 8, "only {checked} leaves on R");
+    assert!(worst <= 0.005, "clustered {clustered}: a leaf of R is {worst:.2e} off Lambert's formula for the emitter's part in front");
+}
+
+/// The mean of `f` over a triangle: its centroids after `levels` midpoint
+/// subdivisions (4^levels sub-triangles of equal area).
+fn mean_over_triangle(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -> f64) -> f64 {
+    if levels == 0 {
+        return f(std::array::from_fn(|a| (c[0][a] + c[1][a] + c[2][a]) / 3.0));
+    }
+    let mid = |i: usize, j: usize| std::array::from_fn::<f64, 3, _>(|a| 0.5 * (c[i][a] + c[j][a]));
+    let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
+    [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]].iter().map(|t| mean_over_triangle(t, levels - 1, f)).sum::<f64>() / 4.0
+}
+
+#[test]
+fn straddling_senders_give_every_leaf_lamberts_irradiance_of_their_front_part() {
+    straddling_sender(false);
+}
+
+#[test]
+fn straddling_senders_give_every_leaf_lamberts_irradiance_of_their_front_part_with_clusters() {
+    straddling_sender(true);
 }
 
 fn energy_balance(test: &str, rho: f64, clustered: bool) {

@@ -19,13 +19,26 @@
 //! is what a plant's leaves or a wall's tessellation actually have, at the
 //! cost of noise that the refinement oracle keeps small (a link is kept
 //! only when its conservative bound says its whole transport is small).
-//! Visibility uses the same pairs: `V = sum k_i v_i / sum k_i`, the
-//! kernel-weighted fraction of clear pairs, so `F V` is the estimate of the
-//! occluded transfer.
+//! Visibility uses the same pairs, each weighted by its own point-to-point
+//! kernel:
+//!
+//! ```text
+//! V = sum_k G_k v_k / sum_k G_k,   G_k = min(A_s cos+(theta_r,k) cos+(theta_s,k) / (pi d_k^2), 1)
+//! ```
+//!
+//! the kernel-weighted fraction of clear pairs, so `F V` is the estimate of
+//! the occluded transfer (see [`crate::visibility`] for why the plain clear
+//! fraction is biased where a sender crosses the receiver's plane). Where
+//! the sender is an element, the form factor's sample is Lambert's factor
+//! to the *whole* sender, but the ray goes to one point `y_k` of it: the
+//! weight is still the pair's own kernel, so a ray to a point behind the
+//! receiver's plane, or to a point whose back faces `x_k`, weighs nothing
+//! and is not cast. Where no pair carries weight, `V = 1` (as in
+//! [`crate::visibility`]).
 
 use crate::elements::Hierarchy;
 use crate::nodes::key;
-use radiometry::form_factor::point_to_polygon;
+use radiometry::form_factor::{point_kernel, point_to_polygon};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use schemas::solution::Node;
@@ -39,8 +52,10 @@ pub struct Estimate {
     /// Largest minus smallest sample.
     pub spread: f64,
     /// Kernel-weighted clear fraction and nearest occluder distance, when
-    /// rays were cast.
+    /// a scene was given.
     pub visibility: Option<(f32, f32)>,
+    /// Rays cast (pairs of zero weight cast none).
+    pub rays: usize,
 }
 
 /// Estimates the transfer `receiver <- sender` (at least one a cluster)
@@ -50,37 +65,32 @@ pub struct Estimate {
 pub fn estimate(h: &Hierarchy, scene: Option<&SceneRays>, receiver: Node, sender: Node, samples: usize, seed: u64) -> Estimate {
     let mut stream = Stream::new(seed ^ 0x5eed_c105, key(receiver), key(sender));
     let sender_area = h.area(sender);
-    let (mut sum, mut min, mut max, mut visible) = (0.0, f64::INFINITY, 0.0f64, 0.0);
+    let (mut sum, mut min, mut max) = (0.0, f64::INFINITY, 0.0f64);
+    let (mut weight, mut visible, mut rays) = (0.0, 0.0, 0);
     let mut nearest = f64::INFINITY;
     for k in 0..samples {
         let x = h.sample(receiver, k, samples, &mut stream);
         let y = h.sample(sender, k, samples, &mut stream);
+        // The pair's point-to-point factor. It cannot exceed 1; the clamp
+        // only bites where two sample points nearly touch, links the oracle
+        // refines anyway.
+        let pair = (sender_area * point_kernel(x.point, x.normal, y.point, y.normal) / PI).min(1.0);
         let value = match sender {
             Node::Element(e) => point_to_polygon(x.point, x.normal, &h.elements[e as usize].points),
-            Node::Cluster(_) => {
-                let d = y.point - x.point;
-                let d2 = d.length_squared();
-                if d2 <= 0.0 {
-                    0.0
-                } else {
-                    let (cos_r, cos_s) = (x.normal.dot(d).max(0.0), (-y.normal.dot(d)).max(0.0));
-                    // A point-to-point factor cannot exceed 1; the clamp
-                    // only bites where two sample points nearly touch,
-                    // links the oracle refines anyway.
-                    (sender_area * cos_r * cos_s / (PI * d2 * d2)).min(1.0)
-                }
-            }
+            Node::Cluster(_) => pair,
         };
         sum += value;
         min = min.min(value);
         max = max.max(value);
-        if let (Some(scene), true) = (scene, value > 0.0) {
+        if let (Some(scene), true) = (scene, pair > 0.0) {
+            weight += pair;
+            rays += 1;
             match scene.first_blocker(x.point, y.point, [x.triangle, y.triangle]) {
-                None => visible += value,
+                None => visible += pair,
                 Some(distance) => nearest = nearest.min(distance),
             }
         }
     }
-    let visibility = scene.map(|_| ((if sum > 0.0 { visible / sum } else { 1.0 }) as f32, nearest as f32));
-    Estimate { form_factor: sum / samples as f64, spread: max - min.min(max), visibility }
+    let visibility = scene.map(|_| ((if weight > 0.0 { (visible / weight).clamp(0.0, 1.0) } else { 1.0 }) as f32, nearest as f32));
+    Estimate { form_factor: sum / samples as f64, spread: max - min.min(max), visibility, rays }
 }

@@ -1,39 +1,91 @@
 //! Visibility of a link, estimated by rays between jittered stratified
-//! points on receiver and sender, stored as the clear fraction, with the
-//! distance from the receiver to the nearest occluder that was hit (the final
-//! gather sizes penumbrae from it, paper 000 Section 5.3).
+//! points on receiver and sender, each ray weighted by the form-factor
+//! kernel of its two end points, with the distance from the receiver to the
+//! nearest occluder that a weighted ray hit (the final gather sizes
+//! penumbrae from it, paper 000 Section 5.3).
+//!
+//! The visibility `V` the gather multiplies the unoccluded factor `F_rs` by
+//! is the one that makes `F_rs V` the occluded transfer:
+//!
+//! ```text
+//! V = integral G(x, y) v(x, y) dA_y dA_x / integral G(x, y) dA_y dA_x
+//!   ~ sum_k G_k v_k / sum_k G_k,
+//! G(x, y) = cos+(theta_r) cos+(theta_s) / d²      (1/m², radiometry's point_kernel)
+//! ```
+//!
+//! over the pairs `(x_k, y_k)`, `v_k` 1 where the segment is clear. The
+//! plain clear fraction (every pair weighted alike) is the same estimate
+//! only where the kernel is positive everywhere; where a sender crosses the
+//! receiver's plane (the lamp, floor, walls and ceiling of the Cornell box
+//! all cross the planes of the blocks' faces), the pairs whose sender point
+//! lies behind that plane carry no light, and the rays to them run through
+//! the receiver's own body: the clear fraction read 0.936 for straddling
+//! lamp links that nothing occludes, and the tall block was lit 7% too
+//! little per leaf. Pairs with `G_k = 0` cast no ray.
+//!
+//! The occluder distance is the nearest hit of a ray of positive weight, so
+//! it still means what the full gather's penumbra width needs (an occluder
+//! between the parts of receiver and sender that exchange light); with the
+//! plain fraction, a straddling link reported the receiver's own body (the
+//! far side of the block the receiver is a face of) as its occluder.
+//!
+//! Where no pair carries weight (`sum_k G_k = 0`: the kernel's support is a
+//! sliver of both elements that no stratum sampled) the rays say nothing
+//! about it, and `V = 1`: such support is, in practice, the contact of two
+//! elements along a crease or a block's base (a floor element passing under
+//! a block, with a sliver in front of its face), where nothing lies between
+//! the two; the same rule as [`crate::transfer`]. On the built-in Cornell
+//! box 227 element links, 1% of the flux the links carry, have no weighted
+//! pair among 16; recomputed with 4,096 pairs, every one of them carrying
+//! more than 1e-4 of it came out at V = 1.0000 (floor leaves at the blocks'
+//! bases lit by a block's face). A clear fraction of all the pairs, the
+//! other candidate, would count the rays through the block's body again.
 
 use crate::elements::Hierarchy;
 use crate::links::{Link, Linking};
 use crate::transfer;
+use radiometry::form_factor::point_kernel;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
 use schemas::solution::Node;
 
-/// Visible fraction and nearest occluder of `link`: rays between stratified
-/// points for two elements ([`estimate`], `rays` of them), the kernel-weighted
-/// pairs of [`transfer::estimate`] where a cluster is at an end. Returns the
-/// rays cast too.
+/// Visible fraction and nearest occluder of `link`: kernel-weighted rays
+/// between stratified points for two elements ([`estimate`], at most `rays`
+/// of them), the kernel-weighted pairs of [`transfer::estimate`] where a
+/// cluster is at an end. Returns the rays cast too.
 pub fn of_link(h: &Hierarchy, scene: &SceneRays, link: &Link, rays: usize, linking: Linking) -> (f32, f32, usize) {
     match (link.receiver, link.sender) {
         (Node::Element(r), Node::Element(s)) => {
-            let (v, d) = estimate(h, scene, r, s, rays, linking.seed);
-            (v, d, rays)
+            let e = estimate(h, scene, r, s, rays, linking.seed);
+            (e.visibility, e.occluder_distance, e.rays)
         }
         (r, s) => {
             let e = transfer::estimate(h, Some(scene), r, s, linking.cluster_samples, linking.seed);
             let (v, d) = e.visibility.unwrap_or((1.0, f32::INFINITY));
-            (v, d, linking.cluster_samples)
+            (v, d, e.rays)
         }
     }
 }
 
-/// Clear fraction and nearest-occluder distance (+inf if no ray was
-/// blocked) of the link `receiver <- sender`, with `rays` rays. The random
-/// stream is keyed by the two elements, so the estimate does not depend on
-/// the order links are processed in.
-pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, rays: usize, seed: u64) -> (f32, f32) {
+/// A visibility estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Visibility {
+    /// Kernel-weighted clear fraction, in [0, 1] (module docs).
+    pub visibility: f32,
+    /// Distance from the receiver to the nearest occluder a ray of positive
+    /// weight hit, m; +inf if none was blocked.
+    pub occluder_distance: f32,
+    /// Rays cast (pairs of zero weight cast none).
+    pub rays: usize,
+}
+
+/// Kernel-weighted visibility (module docs) and nearest-occluder distance
+/// of the link `receiver <- sender`, from `rays` stratified pairs. The
+/// random stream is keyed by the two elements, so the estimate does not
+/// depend on the order links are processed in.
+pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, rays: usize, seed: u64) -> Visibility {
     let (r, s) = (&h.elements[receiver as usize], &h.elements[sender as usize]);
+    let (nr, ns) = (h.normal(receiver), h.normal(sender));
     let skip = [r.triangle, s.triangle];
     let mut stream = Stream::new(seed, receiver.into(), sender.into());
     // Pair receiver stratum k with a shuffled sender stratum, so that ray
@@ -43,15 +95,23 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
         let j = (stream.next_f64() * (i + 1) as f64) as usize;
         order.swap(i, j.min(i));
     }
-    let mut clear = 0usize;
+    let (mut weight, mut clear) = (0.0f64, 0.0f64);
     let mut nearest = f64::INFINITY;
+    let mut cast = 0;
     for (k, &k_sender) in order.iter().enumerate() {
         let from = stratified_point(&r.points, k, rays, &mut stream);
         let to = stratified_point(&s.points, k_sender, rays, &mut stream);
+        let g = point_kernel(from, nr, to, ns);
+        if g <= 0.0 {
+            continue;
+        }
+        weight += g;
+        cast += 1;
         match scene.first_blocker(from, to, skip) {
-            None => clear += 1,
+            None => clear += g,
             Some(distance) => nearest = nearest.min(distance),
         }
     }
-    (clear as f32 / rays as f32, nearest as f32)
+    let visibility = if weight > 0.0 { (clear / weight).clamp(0.0, 1.0) } else { 1.0 };
+    Visibility { visibility: visibility as f32, occluder_distance: nearest as f32, rays: cast }
 }
