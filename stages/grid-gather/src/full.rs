@@ -17,7 +17,9 @@
 //!    `x_k -> y_k` is blocked when it crosses more than `allowed_hits`
 //!    surfaces (1: double-sided sheets, 2: single-sided closed objects), so
 //!    a sample point that fell behind the receiving surface is not in
-//!    shadow of it.
+//!    shadow of it. The visible fraction is weighted by the kernel of each
+//!    pair, as every visibility estimate here is (see "Kernel-weighted
+//!    visibility" below), with the receiver facing the sender's centre.
 //! 3. `D^F = rho B_s (F_max - F_min) vis` (Eq. 2) and `D^vis = rho B_s
 //!    F_avg` where `0 < vis < 1` (Eq. 3; `rho` is the mean reflectance of
 //!    the receivers near the vertex: both estimate a radiosity change,
@@ -89,15 +91,40 @@
 //! # Brute force
 //!
 //! The classic final gather: every link of the chain at every camera
-//! sample, the exact point form factor times the visible fraction of
-//! `brute_samples` rays to uniform random points on the sender, drawn anew
-//! per camera sample.
+//! sample, the exact point form factor times the kernel-weighted visible
+//! fraction of `brute_samples` rays to uniform random points on the sender,
+//! drawn anew per camera sample.
+//!
+//! # Kernel-weighted visibility
+//!
+//! Every visibility this gather estimates from a receiver point `p` with
+//! normal `n_p` (the brute force, the resampled senders at render time, the
+//! leaf checks; the vertex classification with `n_p` facing the sender) is
+//! the one that makes `F(p) V` the occluded irradiance factor:
+//!
+//! ```text
+//! V(p) = integral G(p, y) v(p, y) dA_y / integral G(p, y) dA_y
+//!      ~ sum_k G(p, y_k) v_k / sum_k G(p, y_k),
+//! G(p, y) = cos+(theta_p) cos+(theta_y) / d²        (radiometry's point_kernel)
+//! ```
+//!
+//! over the sender samples `y_k` (uniform by area). The plain visible
+//! fraction weights a sample behind `p`'s plane like one in front; where the
+//! sender crosses that plane (the lamp, floor and walls of the Cornell box
+//! cross the planes of the blocks' faces) the rays to the samples behind run
+//! through the receiver's own body and are blocked, although they carry no
+//! light: the blocks came out 7% to 20% too dark. Samples of zero weight
+//! cast no ray. Where no sample has weight, no ray says anything about the
+//! part of the sender that lights `p`, and `V = 1` (the solver's rule:
+//! such support is a sliver of the sender at a contact, where nothing lies
+//! between); the leaf check then keeps the link's value.
 
 use crate::grid::Grid;
-use crate::senders::{Aabb, Senders};
+use crate::senders::{Aabb, SenderSample, Senders};
 use crate::Params;
 use glam::DVec3;
 use radiometry::color::luminance;
+use radiometry::form_factor::point_kernel;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{square_to_triangle, Stream};
 use schemas::solution::{Link, Node, NONE};
@@ -419,7 +446,8 @@ impl<'a> FullGather<'a> {
             }
             let share = if total > 0.0 { p.samples as f64 * i_s / total } else { 0.0 };
             let n = (share.round() as u32).clamp(p.min_samples, p.samples.max(p.min_samples));
-            let (mut f_sum, mut f_min, mut f_max, mut visible) = (0.0, f64::INFINITY, 0.0f64, 0u32);
+            let (mut f_sum, mut f_min, mut f_max) = (0.0, f64::INFINITY, 0.0f64);
+            let mut visible = Weighted::default();
             for k in 0..n as usize {
                 let g: [f64; 3] = std::array::from_fn(|a| lo[a] + (hi[a] - lo[a]) * stream.next_f64());
                 let x = self.grid.point(g);
@@ -430,11 +458,14 @@ impl<'a> FullGather<'a> {
                 f_sum += f;
                 f_min = f_min.min(f);
                 f_max = f_max.max(f);
-                let (blocked, cast) = blocked_by_count(self.rays, x, y.point, [y.triangle, NONE], p.allowed_hits);
-                data.rays += cast;
-                visible += u32::from(!blocked);
+                let weight = self.sample_weight(x, toward, y);
+                if weight > 0.0 {
+                    let (blocked, cast) = blocked_by_count(self.rays, x, y.point, [y.triangle, NONE], p.allowed_hits);
+                    data.rays += cast;
+                    visible.add(weight, !blocked);
+                }
             }
-            let vis = f64::from(visible) / f64::from(n);
+            let vis = visible.fraction();
             let partial = link_partial || (vis > 0.0 && vis < 1.0);
             estimates.push(Estimate { node, n, f_avg: f_sum / f64::from(n), spread: f_max - f_min, vis, partial, interior: false, occluder, b });
         }
@@ -472,19 +503,30 @@ impl<'a> FullGather<'a> {
     /// the same block, so each sub-image is continuous (fixed positions,
     /// Sec. 4.4.1), while a pixel's `spp` camera samples together see the
     /// first `spp n` points of the sequence rather than the same `n` again.
-    /// Adds the rays to `work`.
-    fn fixed_visibility(&self, p: DVec3, triangle: u32, node: Node, n: u32, pass: u32, work: &mut Work) -> f64 {
+    /// Kernel-weighted (module docs, with `p`'s normal `normal`). Adds the
+    /// rays to `work`.
+    #[allow(clippy::too_many_arguments)]
+    fn fixed_visibility(&self, p: DVec3, normal: DVec3, triangle: u32, node: Node, n: u32, pass: u32, work: &mut Work) -> f64 {
         if n == 0 {
             return 1.0;
         }
-        let mut visible = 0;
+        let mut visible = Weighted::default();
         let first = pass as usize * n as usize;
         for k in first..first + n as usize {
             let y = self.senders.sample(node, k);
-            work.visibility_rays += 1;
-            visible += u32::from(self.rays.segment_clear(p, y.point, [triangle, y.triangle]));
+            let weight = self.sample_weight(p, normal, y);
+            if weight > 0.0 {
+                work.visibility_rays += 1;
+                visible.add(weight, self.rays.segment_clear(p, y.point, [triangle, y.triangle]));
+            }
         }
-        f64::from(visible) / f64::from(n)
+        visible.fraction()
+    }
+
+    /// The kernel between `p` (unit normal `normal`) and sender sample `y`
+    /// ([`point_kernel`]); 0 for a sample on no triangle.
+    fn sample_weight(&self, p: DVec3, normal: DVec3, y: SenderSample) -> f64 {
+        sample_weight(self.senders, p, normal, y)
     }
 
     /// The links of `leaf`'s chain `links` whose solver visibility (0 or
@@ -523,15 +565,22 @@ impl<'a> FullGather<'a> {
                     continue;
                 }
                 let link = &solution.links[l];
-                let mut visible = 0;
+                let mut visible = Weighted::default();
                 for j in 0..m as usize {
                     let b = square_to_triangle(points.next_f64(), points.next_f64());
                     let x = corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2];
                     let y = self.senders.sample(link.sender, j);
-                    check.rays += 1;
-                    visible += u32::from(self.rays.segment_clear(x, y.point, [triangle, y.triangle]));
+                    let weight = self.sample_weight(x, normal, y);
+                    if weight > 0.0 {
+                        check.rays += 1;
+                        visible.add(weight, self.rays.segment_clear(x, y.point, [triangle, y.triangle]));
+                    }
                 }
-                let v = f64::from(visible) / f64::from(m);
+                // No ray of positive weight: nothing to contradict with.
+                if visible.weight <= 0.0 {
+                    continue;
+                }
+                let v = visible.fraction();
                 if v != f64::from(link.visibility).clamp(0.0, 1.0) {
                     check.contradicted.push((l, v));
                 }
@@ -582,7 +631,7 @@ impl<'a> FullGather<'a> {
             let v = if resampled {
                 work.classes[0] += 1;
                 let n = self.shadow_samples(p, sender, f64::from(solution.links[l].occluder_distance), rbf, tau, self.params.max_shadow_samples);
-                self.fixed_visibility(p, triangle, sender, n, pass, work)
+                self.fixed_visibility(p, normal, triangle, sender, n, pass, work)
             } else {
                 work.classes[2] += 1;
                 v
@@ -636,7 +685,7 @@ impl<'a> FullGather<'a> {
             } else {
                 0.0
             };
-            let v_exact = if need_v { self.fixed_visibility(p, triangle, s, (n_vis.ceil() as u32).max(1), pass, work) } else { 1.0 };
+            let v_exact = if need_v { self.fixed_visibility(p, normal, triangle, s, (n_vis.ceil() as u32).max(1), pass, work) } else { 1.0 };
             let mut fv = 0.0;
             for i in 0..4 {
                 let (f, v) = match entries[i] {
@@ -687,9 +736,47 @@ pub fn budget(d: &[f64], tau: f64) -> Vec<bool> {
     resample
 }
 
+/// A visible fraction weighted by the kernel (module docs, "Kernel-weighted
+/// visibility").
+#[derive(Clone, Copy, Debug, Default)]
+struct Weighted {
+    /// Sum of the weights of every ray cast.
+    weight: f64,
+    /// Sum of the weights of the clear rays.
+    clear: f64,
+}
+
+impl Weighted {
+    fn add(&mut self, weight: f64, clear: bool) {
+        self.weight += weight;
+        if clear {
+            self.clear += weight;
+        }
+    }
+
+    /// `sum G v / sum G`, in [0, 1]; 1 where no ray had weight.
+    fn fraction(&self) -> f64 {
+        if self.weight > 0.0 {
+            (self.clear / self.weight).clamp(0.0, 1.0)
+        } else {
+            1.0
+        }
+    }
+}
+
+/// The kernel between `p` (unit normal `normal`) and the sender sample `y`
+/// ([`point_kernel`], with the normal of `y`'s triangle); 0 for a sample on
+/// no triangle (an empty cluster's centre).
+fn sample_weight(senders: &Senders, p: DVec3, normal: DVec3, y: SenderSample) -> f64 {
+    if y.triangle == NONE {
+        return 0.0;
+    }
+    point_kernel(p, normal, y.point, senders.triangles[y.triangle as usize].normal)
+}
+
 /// Brute-force irradiance at `p`: every link in `links`, exact point form
-/// factor times the visible fraction of `samples` rays to uniform random
-/// points of the sender drawn from `stream` (module docs).
+/// factor times the kernel-weighted visible fraction of `samples` rays to
+/// uniform random points of the sender drawn from `stream` (module docs).
 pub fn brute_irradiance(
     senders: &Senders,
     rays: &SceneRays,
@@ -706,25 +793,25 @@ pub fn brute_irradiance(
         let s = senders.solution.links[l].sender;
         let (f, evals) = senders.form_factor(s, p, normal);
         work.form_factors += evals;
-        let mut visible = 0;
+        let mut visible = Weighted::default();
         for _ in 0..samples {
             let (u, v) = (stream.next_f64(), stream.next_f64());
-            let (point, tri) = match s {
+            let y = match s {
                 Node::Element(e) => {
                     let c = senders.element_corners(e);
                     let b = square_to_triangle(u, v);
-                    (c[0] * b[0] + c[1] * b[1] + c[2] * b[2], senders.solution.elements[e as usize].triangle)
+                    SenderSample { point: c[0] * b[0] + c[1] * b[1] + c[2] * b[2], triangle: senders.solution.elements[e as usize].triangle }
                 }
-                Node::Cluster(_) => {
-                    let y = senders.sample(s, (u * f64::from(1u32 << 20)) as usize);
-                    (y.point, y.triangle)
-                }
+                Node::Cluster(_) => senders.sample(s, (u * f64::from(1u32 << 20)) as usize),
             };
-            work.visibility_rays += 1;
-            visible += u32::from(rays.segment_clear(p, point, [triangle, tri]));
+            let weight = sample_weight(senders, p, normal, y);
+            if weight > 0.0 {
+                work.visibility_rays += 1;
+                visible.add(weight, rays.segment_clear(p, y.point, [triangle, y.triangle]));
+            }
         }
         work.classes[0] += 1;
-        let v = f64::from(visible) / f64::from(samples.max(1));
+        let v = visible.fraction();
         let b = senders.radiosity(s);
         (0..3).for_each(|c| h[c] += b[c] * f * v);
     }
