@@ -18,7 +18,7 @@
 //! | `visibility_rays` | rays per link between two elements | 16 |
 //! | `cluster_samples` | point pairs (and rays) per link with a cluster end | 16 |
 //! | `quadrature_depth` | deepest split of the adaptive receiver quadrature near touching elements | 3 |
-//! | `tolerance` | convergence: largest relative change of a leaf's radiosity | 1e-5 |
+//! | `tolerance` | convergence: bound of the remaining error of a leaf's radiosity, relative to the largest radiosity ([`gather::solve`]) | 1e-5 |
 //! | `max_iterations` | Jacobi iterations per solve, at most | 2000 |
 //! | `max_passes` | refine-and-solve passes, at most | 8 |
 //! | `seed` | seed of the visibility rays | 1 |
@@ -55,7 +55,8 @@ pub struct Params {
     pub cluster_samples: usize,
     /// Deepest split of the adaptive receiver quadrature.
     pub quadrature_depth: u32,
-    /// Relative change at which gathering stops.
+    /// Bound of the remaining error (relative to the largest radiosity) at
+    /// which gathering stops.
     pub tolerance: f64,
     /// Jacobi iterations per solve, at most.
     pub max_iterations: usize,
@@ -134,6 +135,18 @@ pub struct Work {
     pub iterations: usize,
     /// Relative change of the last iteration.
     pub relative_change: f64,
+    /// Bound of the remaining error of the last pass's solution, relative
+    /// to the largest radiosity ([`gather::solve`]).
+    pub error_bound: f64,
+    /// Contraction factor the last pass's bound used.
+    pub contraction: f64,
+    /// Whether the last pass's bound reached the tolerance (`false`: it
+    /// stopped at `max_iterations`).
+    pub converged: bool,
+    /// Passes whose solve stopped at `max_iterations`.
+    pub capped_passes: usize,
+    /// Geometric extrapolations of the Jacobi iterates, all passes.
+    pub extrapolations: usize,
     /// Seconds refining links (form factors, oracle).
     pub refine_seconds: f64,
     /// Seconds casting visibility rays.
@@ -205,6 +218,8 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
     work.refine_seconds += started.elapsed().as_secs_f64();
     // A scene without reflectors needs one pass: direct light only.
     let passes = if manifest.effects.diffuse_interreflection { params.max_passes } else { 1 };
+    // The rate of convergence of the previous pass's solve (gather::solve).
+    let mut rates = [0.0; 3];
     for pass in 1..=passes {
         let started = Instant::now();
         let mut refined_any = false;
@@ -257,9 +272,15 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         let started = Instant::now();
         all_links.par_sort_unstable_by_key(|l| (h.flat(l.receiver), h.flat(l.sender)));
         let offsets = csr_offsets(&h, &all_links, b.len());
-        let convergence = gather::solve(&h, &all_links, &offsets, &mut b, params.tolerance, params.max_iterations);
+        let convergence = gather::solve(&h, &all_links, &offsets, &mut b, params.tolerance, params.max_iterations, rates);
+        rates = convergence.rates;
         work.iterations += convergence.iterations;
         work.relative_change = convergence.relative_change;
+        work.error_bound = convergence.error_bound;
+        work.contraction = convergence.contraction;
+        work.converged = convergence.converged;
+        work.capped_passes += usize::from(!convergence.converged);
+        work.extrapolations += convergence.extrapolations;
         work.gather_seconds += started.elapsed().as_secs_f64();
         work.passes = pass;
         progress(&Progress { pass, links: all_links.len(), elements: h.elements.len() });

@@ -50,7 +50,7 @@ struct Args {
     /// Deepest split of the adaptive receiver quadrature between touching elements.
     #[arg(long)]
     quadrature_depth: Option<u32>,
-    /// Stop gathering when no leaf changes by more than this fraction of the largest radiosity.
+    /// Stop gathering when a bound of every leaf's remaining error is under this fraction of the largest radiosity.
     #[arg(long)]
     tolerance: Option<f64>,
     /// Jacobi iterations per solve, at most.
@@ -130,6 +130,15 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         "hierarchical-solve: {} passes, {} links, {} elements ({} leaves), {} rays, {} iterations",
         w.passes, w.links, w.elements, w.leaves, w.rays, w.iterations
     );
+    let mut notes = Vec::new();
+    if !w.converged {
+        let note = format!(
+            "tolerance not reached: the last pass stopped at max_iterations = {} with a remaining-error bound of {:.3e} of the largest radiosity (tolerance {:.1e}, contraction {:.6}); raise --max-iterations",
+            params.max_iterations, w.error_bound, params.tolerance, w.contraction
+        );
+        eprintln!("hierarchical-solve: warning: {note}");
+        notes.push(note);
+    }
     let solution = Solution {
         header: Solution::header(run.provenance(&params)),
         elements: solved.elements,
@@ -139,7 +148,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let mut outputs = Outputs::new();
     outputs.write(output, |p| solution.write(p))?;
     if let Some(report) = &args.stage.report {
-        let counters = BTreeMap::from([
+        let mut counters = BTreeMap::from([
             ("passes".to_string(), w.passes as f64),
             ("links".to_string(), w.links as f64),
             ("cluster_links".to_string(), w.cluster_links as f64),
@@ -149,16 +158,25 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("rays".to_string(), w.rays as f64),
             ("iterations".to_string(), w.iterations as f64),
             ("relative_change".to_string(), w.relative_change),
+            ("converged".to_string(), f64::from(u8::from(w.converged))),
+            ("capped_passes".to_string(), w.capped_passes as f64),
+            ("extrapolations".to_string(), w.extrapolations as f64),
             ("refine_seconds".to_string(), w.refine_seconds),
             ("visibility_seconds".to_string(), w.visibility_seconds),
             ("gather_seconds".to_string(), w.gather_seconds),
             ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
         ]);
+        // Left out where unknown (no contraction below 1 was known).
+        for (name, value) in [("error_bound", w.error_bound), ("contraction", w.contraction)] {
+            if value.is_finite() {
+                counters.insert(name.to_string(), value);
+            }
+        }
         let mut skipped = skipped(&manifest.effects);
         if !clustered && manifest.effects.fine_clustered_geometry {
             skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
         }
-        outputs.write(report, |p| run.write_report(p, &params, counters, skipped, vec![]))?;
+        outputs.write(report, |p| run.write_report(p, &params, counters, skipped, notes.clone()))?;
     }
     outputs.keep();
     Ok(ExitCode::SUCCESS)
