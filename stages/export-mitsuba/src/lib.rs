@@ -1,0 +1,383 @@
+//! # export-mitsuba: the prepared scene as a Mitsuba 3 scene
+//!
+//! Writes `mesh.exr` + `manifest.ron` as a Mitsuba 3 XML scene
+//! (`<scene version="3.0.0">`) with one binary little-endian PLY mesh per
+//! material, so that a path tracer renders the same scene, through the same
+//! camera, as this pipeline: the reference of `make bench-peer`.
+//!
+//! ## What maps to what
+//!
+//! | pipeline | Mitsuba 3 | exact? |
+//! |---|---|---|
+//! | triangles of one material | `<shape type="ply">`, `face_normals` true | yes: positions as stored (f32), winding kept |
+//! | diffuse reflectance rho | `<bsdf type="diffuse">`, `<rgb name="reflectance">` | yes (RGB variants: no spectral upsampling) |
+//! | emission (exitance M, W/m², front face) | `<emitter type="area">` nested in the shape, `radiance` = M / pi | yes: Lambertian, one-sided |
+//! | ideal mirror ks (no diffuse part) | `<bsdf type="conductor">`, `material` `none`, `specular_reflectance` ks | yes: `none` disables Fresnel |
+//! | diffuse rho + mirror ks | `<bsdf type="blendbsdf">`, weight w = max ks: diffuse rho/(1-w), conductor ks/w | yes where max rho <= 1 - max ks, else the mirror part is not exported |
+//! | specular or diffuse transmission, texture, alpha and normal maps, goniometric lights | nothing | not exported: listed in the report's `skipped` and on stderr |
+//! | manifest camera | `perspective`, `fov_axis` y, `<lookat origin target up>`, `hdrfilm` rgb float32, box filter | yes |
+//!
+//! Frames: the PLY positions and the camera are both in the mesh frame
+//! (metres, the world translated by `-world_from_mesh_translation`), so the
+//! Mitsuba world frame *is* the mesh frame and no transform is written.
+//!
+//! Orientation, checked against Mitsuba's sources: a PLY face's normal is
+//! `normalize(cross(p1 - p0, p2 - p0))` (`Mesh::face_normal`), so this
+//! pipeline's counter-clockwise-from-the-front triangles keep their front
+//! face, and Mitsuba's area emitter (radiance only where `cos_theta(wi) > 0`)
+//! and `diffuse` BSDF (zero below the surface) are one-sided on that front
+//! face as this pipeline's surfaces are. The camera: Mitsuba's `look_at`
+//! puts camera-space +x on `cross(up, dir)` (the *left* of the image) and
+//! its perspective projection maps camera +x to film x = 0 (scale by -0.5):
+//! film x grows to the right and film y downwards, row 0 at the top, as in
+//! `radiometry::camera::Pinhole`, so the image is not mirrored.
+//!
+//! Parameters (`--params`, flags override):
+//!
+//! | parameter | meaning | default |
+//! |---|---|---|
+//! | `spp` | samples per pixel, the scene's `$spp` default | 64 |
+//! | `max_depth` | path length of the `path` integrator, -1 unbounded | -1 |
+//! | `sampler` | Mitsuba sampler plugin (`independent`, `stratified`, `multijitter`, `orthogonal`, `ldsampler`) | `multijitter` |
+//! | `seed` | the sampler's seed | 0 |
+//! | `width`, `height` | film size, pixels | the manifest camera's |
+//!
+//! ```
+//! let (mesh, manifest) = mesh_prep::prepare_builtin("cornell-box", "doc").unwrap();
+//! let export = export_mitsuba::export(&mesh, &manifest, &export_mitsuba::Params::default(), "scene", "");
+//! assert!(export.xml.contains(r#"<scene version="3.0.0">"#));
+//! assert_eq!(export.meshes.iter().map(|m| m.triangles).sum::<usize>(), mesh.triangles.len());
+//! ```
+
+pub mod ply;
+pub mod xml;
+
+use schemas::mesh::{Manifest, Material, Mesh};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use xml::{attribute, comment};
+
+/// The sampler plugins of Mitsuba 3 that take `sample_count` and `seed`.
+pub const SAMPLERS: &[&str] = &["independent", "stratified", "multijitter", "orthogonal", "ldsampler"];
+
+/// The exporter's parameters (see the table in the crate documentation).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// Samples per pixel (the scene's `spp` default), at least 1.
+    pub spp: u32,
+    /// Longest path of the `path` integrator; -1: unbounded.
+    pub max_depth: i32,
+    /// Mitsuba sampler plugin, one of [`SAMPLERS`].
+    pub sampler: String,
+    /// The sampler's seed.
+    pub seed: u32,
+    /// Film width in pixels; `None`: the manifest camera's.
+    pub width: Option<u32>,
+    /// Film height in pixels; `None`: the manifest camera's.
+    pub height: Option<u32>,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params { spp: 64, max_depth: -1, sampler: "multijitter".into(), seed: 0, width: None, height: None }
+    }
+}
+
+impl Params {
+    /// Why these parameters cannot be exported, if they cannot.
+    pub fn check(&self) -> Result<(), String> {
+        if self.spp == 0 {
+            return Err("spp must be at least 1".into());
+        }
+        if self.max_depth < -1 || self.max_depth == 0 {
+            return Err(format!("max_depth must be -1 (unbounded) or at least 1, not {}", self.max_depth));
+        }
+        if !SAMPLERS.contains(&self.sampler.as_str()) {
+            return Err(format!("sampler must be one of {}, not {:?}", SAMPLERS.join(", "), self.sampler));
+        }
+        if self.width == Some(0) || self.height == Some(0) {
+            return Err("width and height must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// One PLY file of the export: the triangles of one material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlyMesh {
+    /// File name inside the mesh folder, e.g. `m003-white.ply`.
+    pub file_name: String,
+    /// Index of the material in the manifest.
+    pub material: usize,
+    /// Triangles in the file.
+    pub triangles: usize,
+    /// Vertices in the file (welded within the material).
+    pub vertices: usize,
+    /// The file's bytes (binary little-endian PLY).
+    pub bytes: Vec<u8>,
+}
+
+/// The exported scene, in memory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Export {
+    /// The XML scene text.
+    pub xml: String,
+    /// The PLY meshes it references, relative to the XML's directory as
+    /// `<mesh_folder>/<file_name>`.
+    pub meshes: Vec<PlyMesh>,
+    /// What could not be exported exactly, one line each.
+    pub skipped: Vec<String>,
+    /// Area emitters written.
+    pub emitters: usize,
+    /// Film size written.
+    pub film: (u32, u32),
+}
+
+/// The BSDF a material exports to, or why part of it does not.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Bsdf {
+    /// Lambertian reflector, reflectance rho.
+    Diffuse([f64; 3]),
+    /// Ideal mirror (Fresnel off), reflectance ks.
+    Mirror([f64; 3]),
+    /// `(1 - w) diffuse(rho / (1 - w)) + w mirror(ks / w)`.
+    Blend {
+        /// Blend weight w of the mirror.
+        weight: f64,
+        /// The diffuse part's reflectance rho / (1 - w).
+        diffuse: [f64; 3],
+        /// The mirror part's reflectance ks / w.
+        mirror: [f64; 3],
+    },
+}
+
+fn max3(v: [f64; 3]) -> f64 {
+    v[0].max(v[1]).max(v[2])
+}
+
+fn scaled(v: [f64; 3], s: f64) -> [f64; 3] {
+    [v[0] * s, v[1] * s, v[2] * s]
+}
+
+/// The Mitsuba BSDF of `material`, and a line for each part of it that has
+/// no exact Mitsuba equivalent (those parts are left out).
+pub fn material_bsdf(material: &Material) -> (Bsdf, Vec<String>) {
+    let name = &material.name;
+    let mut skipped = Vec::new();
+    let rho = material.diffuse;
+    let ks = material.specular_reflectance;
+    let (w, rho_max) = (max3(ks), max3(rho));
+    let bsdf = if w <= 0.0 {
+        Bsdf::Diffuse(rho)
+    } else if rho_max <= 0.0 {
+        Bsdf::Mirror(ks)
+    } else if rho_max <= 1.0 - w {
+        Bsdf::Blend { weight: w, diffuse: scaled(rho, 1.0 / (1.0 - w)), mirror: scaled(ks, 1.0 / w) }
+    } else {
+        skipped.push(format!(
+            "material '{name}': specular reflectance {ks:?} not exported (no blend weight fits beside diffuse {rho:?}); written as diffuse only"
+        ));
+        Bsdf::Diffuse(rho)
+    };
+    if max3(material.specular_transmittance) > 0.0 {
+        skipped.push(format!(
+            "material '{name}': specular transmittance {:?} not exported (Mitsuba's dielectrics add Fresnel reflection); surface written opaque",
+            material.specular_transmittance
+        ));
+    }
+    if max3(material.diffuse_transmittance) > 0.0 {
+        skipped.push(format!(
+            "material '{name}': diffuse transmittance {:?} not exported (Mitsuba 3 has no diffuse transmitter); surface written opaque",
+            material.diffuse_transmittance
+        ));
+    }
+    for (map, what) in [(&material.diffuse_map, "diffuse texture"), (&material.alpha_map, "alpha mask"), (&material.normal_map, "normal map")] {
+        if let Some(file) = map {
+            skipped.push(format!("material '{name}': {what} {file:?} not exported (the mesh has no texture coordinates)"));
+        }
+    }
+    (bsdf, skipped)
+}
+
+/// A file-name-safe form of `name`: ASCII letters, digits, `-` and `_`.
+pub fn safe_name(name: &str) -> String {
+    let s: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    if s.is_empty() {
+        "unnamed".into()
+    } else {
+        s
+    }
+}
+
+fn rgb(v: [f64; 3]) -> String {
+    format!("{}, {}, {}", v[0], v[1], v[2])
+}
+
+fn point(v: [f64; 3]) -> String {
+    rgb(v)
+}
+
+fn write_bsdf(out: &mut String, bsdf: &Bsdf, indent: &str) {
+    match bsdf {
+        Bsdf::Diffuse(rho) => {
+            let _ = writeln!(out, "{indent}<bsdf type=\"diffuse\">");
+            let _ = writeln!(out, "{indent}    <rgb name=\"reflectance\" value=\"{}\"/>", rgb(*rho));
+            let _ = writeln!(out, "{indent}</bsdf>");
+        }
+        Bsdf::Mirror(ks) => {
+            let _ = writeln!(out, "{indent}<bsdf type=\"conductor\">");
+            let _ = writeln!(out, "{indent}    <string name=\"material\" value=\"none\"/>");
+            let _ = writeln!(out, "{indent}    <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(*ks));
+            let _ = writeln!(out, "{indent}</bsdf>");
+        }
+        Bsdf::Blend { weight, diffuse, mirror } => {
+            let _ = writeln!(out, "{indent}<bsdf type=\"blendbsdf\">");
+            let _ = writeln!(out, "{indent}    <float name=\"weight\" value=\"{weight}\"/>");
+            let _ = writeln!(out, "{indent}    <bsdf type=\"diffuse\" name=\"bsdf_0\">");
+            let _ = writeln!(out, "{indent}        <rgb name=\"reflectance\" value=\"{}\"/>", rgb(*diffuse));
+            let _ = writeln!(out, "{indent}    </bsdf>");
+            let _ = writeln!(out, "{indent}    <bsdf type=\"conductor\" name=\"bsdf_1\">");
+            let _ = writeln!(out, "{indent}        <string name=\"material\" value=\"none\"/>");
+            let _ = writeln!(out, "{indent}        <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(*mirror));
+            let _ = writeln!(out, "{indent}    </bsdf>");
+            let _ = writeln!(out, "{indent}</bsdf>");
+        }
+    }
+}
+
+/// Clip distances that keep every point of the scene visible: Mitsuba
+/// clips at `near_clip` (default 1 cm) and `far_clip` (default 10 km),
+/// this pipeline's camera does not clip.
+fn clip_range(mesh: &Mesh, eye: [f64; 3]) -> (f64, f64) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &mesh.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(f64::from(p[k]));
+            hi[k] = hi[k].max(f64::from(p[k]));
+        }
+    }
+    if !lo[0].is_finite() {
+        return (1e-2, 1e4);
+    }
+    let far = (0..3).map(|k| (eye[k] - lo[k]).abs().max((eye[k] - hi[k]).abs()).powi(2)).sum::<f64>().sqrt();
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let far_clip = (2.0 * far).max(1e4);
+    let near_clip = (1e-5 * diagonal).clamp(1e-7, 1e-2);
+    (near_clip, far_clip)
+}
+
+/// Exports `mesh` + `manifest`: the XML text (PLY files referenced as
+/// `mesh_folder/<file>`, relative to the XML's directory) with
+/// `provenance` (any text) in a comment at its top, the PLY files, and
+/// what was not exported. `params` must pass [`Params::check`].
+pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &str, provenance: &str) -> Export {
+    let camera = &manifest.camera;
+    let film = (params.width.unwrap_or(camera.width), params.height.unwrap_or(camera.height));
+    let mut skipped = Vec::new();
+    for light in &manifest.goniometric_lights {
+        skipped.push(format!(
+            "goniometric light {:?} at {:?} not exported (Mitsuba 3 has no goniometric emitter)",
+            light.file, light.position
+        ));
+    }
+
+    // Triangles by material, vertices welded within each material.
+    let mut by_material: Vec<Vec<usize>> = vec![Vec::new(); manifest.materials.len()];
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        by_material[t.material as usize].push(i);
+    }
+    let mut meshes = Vec::new();
+    let mut shapes = String::new();
+    let mut emitters = 0;
+    for (m, triangles) in by_material.iter().enumerate() {
+        if triangles.is_empty() {
+            continue;
+        }
+        let material = &manifest.materials[m];
+        let file_name = format!("m{m:03}-{}.ply", safe_name(&material.name));
+        let mut local = vec![u32::MAX; mesh.positions.len()];
+        let mut positions: Vec<[f32; 3]> = Vec::new();
+        let mut faces: Vec<[u32; 3]> = Vec::with_capacity(triangles.len());
+        for &t in triangles {
+            let face = mesh.triangles[t].vertices.map(|v| {
+                let slot = &mut local[v as usize];
+                if *slot == u32::MAX {
+                    *slot = positions.len() as u32;
+                    positions.push(mesh.positions[v as usize]);
+                }
+                *slot
+            });
+            faces.push(face);
+        }
+        let bytes = ply::encode(&positions, &faces, &format!("material {} of the pipeline's manifest", m));
+        let (bsdf, material_skipped) = material_bsdf(material);
+        skipped.extend(material_skipped);
+
+        let _ = writeln!(shapes, "    <shape type=\"ply\" id={}>", attribute(&format!("m{m:03}-{}", safe_name(&material.name))));
+        let _ = writeln!(shapes, "        <string name=\"filename\" value={}/>", attribute(&format!("{mesh_folder}/{file_name}")));
+        let _ = writeln!(shapes, "        <boolean name=\"face_normals\" value=\"true\"/>");
+        write_bsdf(&mut shapes, &bsdf, "        ");
+        if max3(material.emission) > 0.0 {
+            let radiance = scaled(material.emission, 1.0 / std::f64::consts::PI);
+            let _ = writeln!(shapes, "        <emitter type=\"area\">");
+            let _ = writeln!(shapes, "            <rgb name=\"radiance\" value=\"{}\"/>", rgb(radiance));
+            let _ = writeln!(shapes, "        </emitter>");
+            emitters += 1;
+        }
+        let _ = writeln!(shapes, "    </shape>");
+        meshes.push(PlyMesh { file_name, material: m, triangles: faces.len(), vertices: positions.len(), bytes });
+    }
+
+    let (near_clip, far_clip) = clip_range(mesh, camera.eye);
+    let mut xml = String::new();
+    let _ = writeln!(xml, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
+    xml.push_str(&comment(&format!(
+        "Exported by export-mitsuba from this radiosity pipeline's prepared scene.\n\
+         Frame: the mesh frame (metres) of mesh.exr and manifest.ron, used as Mitsuba's world\n\
+         frame as it is: no transform. World position of its origin: {:?}.\n\
+         Emitters: radiance = exitance / pi (Lambertian, front face = counter-clockwise).\n\
+         Provenance (RON; XML comments cannot hold two hyphens in a row, so each '-' that\n\
+         follows a '-' is written as '&#45;'):\n{provenance}",
+        manifest.world_from_mesh_translation
+    )));
+    if !skipped.is_empty() {
+        xml.push_str(&comment(&format!("Not exported:\n{}", skipped.join("\n"))));
+    }
+    let _ = writeln!(xml, "<scene version=\"3.0.0\">");
+    let _ = writeln!(xml, "    <default name=\"spp\" value=\"{}\"/>", params.spp);
+    let _ = writeln!(xml, "    <default name=\"max_depth\" value=\"{}\"/>", params.max_depth);
+    let _ = writeln!(xml, "    <integrator type=\"path\">");
+    let _ = writeln!(xml, "        <integer name=\"max_depth\" value=\"$max_depth\"/>");
+    let _ = writeln!(xml, "    </integrator>");
+    let _ = writeln!(xml, "    <sensor type=\"perspective\">");
+    let _ = writeln!(xml, "        <string name=\"fov_axis\" value=\"y\"/>");
+    let _ = writeln!(xml, "        <float name=\"fov\" value=\"{}\"/>", camera.vertical_fov_deg);
+    let _ = writeln!(xml, "        <float name=\"near_clip\" value=\"{near_clip}\"/>");
+    let _ = writeln!(xml, "        <float name=\"far_clip\" value=\"{far_clip}\"/>");
+    let _ = writeln!(xml, "        <transform name=\"to_world\">");
+    let _ = writeln!(
+        xml,
+        "            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>",
+        point(camera.eye),
+        point(camera.target),
+        point(camera.up)
+    );
+    let _ = writeln!(xml, "        </transform>");
+    let _ = writeln!(xml, "        <sampler type={}>", attribute(&params.sampler));
+    let _ = writeln!(xml, "            <integer name=\"sample_count\" value=\"$spp\"/>");
+    let _ = writeln!(xml, "            <integer name=\"seed\" value=\"{}\"/>", params.seed);
+    let _ = writeln!(xml, "        </sampler>");
+    let _ = writeln!(xml, "        <film type=\"hdrfilm\">");
+    let _ = writeln!(xml, "            <integer name=\"width\" value=\"{}\"/>", film.0);
+    let _ = writeln!(xml, "            <integer name=\"height\" value=\"{}\"/>", film.1);
+    let _ = writeln!(xml, "            <string name=\"pixel_format\" value=\"rgb\"/>");
+    let _ = writeln!(xml, "            <string name=\"component_format\" value=\"float32\"/>");
+    let _ = writeln!(xml, "            <rfilter type=\"box\"/>");
+    let _ = writeln!(xml, "        </film>");
+    let _ = writeln!(xml, "    </sensor>");
+    xml.push_str(&shapes);
+    let _ = writeln!(xml, "</scene>");
+    Export { xml, meshes, skipped, emitters, film }
+}
