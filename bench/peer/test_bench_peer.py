@@ -1,0 +1,51 @@
+"""Checks of bench_peer.py's arithmetic (no Mitsuba needed):
+`python3 -m unittest bench/peer/test_bench_peer.py` with numpy installed
+(the bench's venv has it). Not part of `make test`."""
+
+import os
+import sys
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(__file__))
+import bench_peer as bp  # noqa: E402
+
+
+class TimeToError(unittest.TestCase):
+    def test_log_log_between_pareto_neighbours(self):
+        points = [(1.0, 0.1), (4.0, 0.05), (16.0, 0.025), (8.0, 0.2)]  # (8, 0.2) is off the front
+        self.assertEqual(bp.pareto(points), [(1.0, 0.1), (4.0, 0.05), (16.0, 0.025)])
+        self.assertAlmostEqual(bp.time_to_error(points, 0.05), 4.0)
+        # error ~ t^-1/2 between 4 and 16 s: 3% at 4 (5/3)^2 s
+        self.assertAlmostEqual(bp.time_to_error(points, 0.03), 4.0 * (0.05 / 0.03) ** 2)
+        self.assertAlmostEqual(bp.time_to_error(points, 0.2), 1.0)
+        self.assertIsNone(bp.time_to_error(points, 0.01))
+
+
+class Mask(unittest.TestCase):
+    def test_compare_mask(self):
+        h, w = 9, 9
+        flags = np.full((h, w), float(bp.SINGLE_SURFACE))
+        flags[4, 4] = bp.EMITTER | bp.SINGLE_SURFACE
+        flags[0, 8] = 0  # an edge pixel
+        objects = np.zeros((h, w))
+        objects[8, 0] = bp.NO_SURFACE
+        keep = bp.compared_pixels({"surface.flags": flags, "surface.object": objects}, 2)
+        self.assertFalse(keep[2:7, 2:7].any(), "emitter and 2 px around it left out")
+        self.assertTrue(keep[1, 1] and keep[7, 7] and keep[4, 1])
+        self.assertFalse(keep[0:3, 6:9].any(), "2 px around the edge left out")
+        self.assertFalse(keep[8, 0], "no surface")
+
+    def test_relative_rmse_and_halves(self):
+        rng = np.random.default_rng(1)
+        truth = np.ones((64, 64, 3))
+        halves = [truth + 0.1 * rng.standard_normal(truth.shape) for _ in range(2)]
+        mask = np.ones((64, 64), bool)
+        estimate = bp.relative_rmse(halves[0], halves[1], mask) / 2
+        actual = bp.relative_rmse((halves[0] + halves[1]) / 2, truth, mask)
+        self.assertAlmostEqual(estimate, actual, delta=0.03 * actual)
+
+
+if __name__ == "__main__":
+    unittest.main()
