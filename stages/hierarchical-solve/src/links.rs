@@ -9,6 +9,7 @@ use crate::transfer;
 use glam::DVec3;
 use radiometry::form_factor::triangle_to_polygon;
 use schemas::solution::Node;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// A link: `receiver` gathers from `sender`.
@@ -58,6 +59,47 @@ pub struct Linking {
     pub seed: u64,
     /// Deepest split of the adaptive receiver quadrature between elements.
     pub quadrature_depth: u32,
+}
+
+/// What a link's estimated error is compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Criterion {
+    /// Against `eps` times the largest emitted radiosity, the same for
+    /// every receiver (BF-style).
+    Absolute,
+    /// Against `eps_relative` times the receiver's own radiosity (its
+    /// brightest channel, in the current iterate), floored at
+    /// `relative_floor` times the scene's area-mean reflected radiosity.
+    Relative,
+}
+
+/// The oracle's allowance: how much error a link may make on its receiver.
+#[derive(Clone, Copy, Debug)]
+pub enum Allowance {
+    /// The same threshold (W/m²) for every receiver.
+    Absolute(f64),
+    /// `eps` times the receiver's brightest radiosity channel, at least
+    /// `floor` (W/m²).
+    Relative {
+        /// Fraction of the receiver's radiosity.
+        eps: f64,
+        /// Least radiosity it is taken to have.
+        floor: f64,
+    },
+}
+
+impl Allowance {
+    /// The error (W/m², any channel) the link may make on `receiver`.
+    pub fn of(&self, receiver: Node, radiosity: &[[f64; 3]], h: &Hierarchy) -> f64 {
+        match *self {
+            Allowance::Absolute(threshold) => threshold,
+            Allowance::Relative { eps, floor } => {
+                let b = radiosity[h.flat(receiver)];
+                eps * b.into_iter().fold(floor, f64::max)
+            }
+        }
+    }
 }
 
 /// The link `receiver <- sender`, or `None` where no light can pass.
@@ -164,13 +206,22 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
 /// mean of the two to the floor, which the lamp sees better than the
 /// ceiling does: a closed box lost 2.7% of its energy at eps 5e-2.
 /// Between elements, see [`decide_elements`].
-pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64, min_area: f64) -> Split {
+///
+/// `allowance` says what the error is compared with: one threshold for all
+/// receivers, or a fraction of each receiver's radiosity ([`Allowance`]).
+///
+/// `deviation[e]`, where given, is how far the radiosity of the leaves below
+/// element `e` strays from `e`'s own (per channel, [`leaf_deviation`]): the
+/// sender variation of an element sender then sees every level below it,
+/// not only its children, whose means can hide a bright spot.
+pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], allowance: &Allowance, min_area: f64) -> Split {
     let (r, s) = (link.receiver, link.sender);
     if r == s {
         return Split::Both;
     }
+    let threshold = allowance.of(r, radiosity, h);
     let wanted = match (r, s) {
-        (Node::Element(_), Node::Element(_)) => decide_elements(h, link, radiosity, threshold),
+        (Node::Element(_), Node::Element(_)) => decide_elements(h, link, radiosity, deviation, threshold),
         _ => {
             let rho = h.node_reflectance(r);
             let b = radiosity[h.flat(s)];
@@ -229,7 +280,7 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64
 /// smaller than `min_area` (see [`decide`]): then a shadow edge splits the
 /// other element, and the other errors keep the link (splitting the other
 /// element would not reduce them).
-fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold: f64) -> Split {
+fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], threshold: f64) -> Split {
     let (Node::Element(receiver), Node::Element(sender)) = (link.receiver, link.sender) else {
         unreachable!("an element link")
     };
@@ -239,6 +290,8 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold
     let sender_element = &h.elements[sender as usize];
     let sender_variation = if sender_element.is_leaf() {
         0.0
+    } else if let Some(d) = deviation.get(sender as usize) {
+        (0..3).map(|c| rho[c] * d[c]).fold(0.0, f64::max)
     } else {
         (sender_element.first_child..sender_element.first_child + 4)
             .flat_map(|child| (0..3).map(move |c| (child, c)))
@@ -257,6 +310,35 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], threshold
     } else {
         wanted
     }
+}
+
+/// Per element, the largest difference (per channel) between the radiosity
+/// of a leaf below it and the element's own, in `radiosity` (children are
+/// stored after their parents, so one backward sweep gathers it).
+pub fn leaf_deviation(h: &Hierarchy, radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let n = h.elements.len();
+    let mut lo = vec![[f64::INFINITY; 3]; n];
+    let mut hi = vec![[f64::NEG_INFINITY; 3]; n];
+    for e in (0..n).rev() {
+        let element = &h.elements[e];
+        if element.is_leaf() {
+            let b = radiosity[h.flat(Node::Element(e as u32))];
+            (lo[e], hi[e]) = (b, b);
+        }
+        if element.parent != schemas::solution::NONE {
+            let p = element.parent as usize;
+            for c in 0..3 {
+                lo[p][c] = lo[p][c].min(lo[e][c]);
+                hi[p][c] = hi[p][c].max(hi[e][c]);
+            }
+        }
+    }
+    (0..n)
+        .map(|e| {
+            let b = radiosity[h.flat(Node::Element(e as u32))];
+            std::array::from_fn(|c| (hi[e][c] - b[c]).max(b[c] - lo[e][c]).max(0.0))
+        })
+        .collect()
 }
 
 /// The links replacing `link` after `split` (children already exist).

@@ -1,7 +1,7 @@
 //! `hierarchical-solve`: see the library's documentation and `--help`.
 
 use clap::Parser;
-use hierarchical_solve::{solve, Params};
+use hierarchical_solve::{solve, Criterion, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::Effects;
@@ -12,7 +12,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Hierarchical radiosity (Hanrahan, Salzman, Aupperle 1991) on a prepared
-/// mesh: BF refinement against a threshold and a minimum element area,
+/// mesh: refinement of each link whose estimated error exceeds a fraction of
+/// its receiver's radiosity (or, `--criterion absolute`, of the largest
+/// emission), down to a minimum element area,
 /// Lambert's closed-form form factors, ray-cast visibility per link, Jacobi
 /// gather with push-pull. Writes solution.exr: the element hierarchy with
 /// radiosity, and every link (form factor, visibility, unoccluded
@@ -35,9 +37,21 @@ struct Args {
     output: Option<PathBuf>,
     #[command(flatten)]
     stage: StageArgs,
-    /// BF refinement threshold, as a fraction of the largest emitted radiosity.
+    /// What a link's estimated error is compared with: `relative` (a fraction
+    /// of its receiver's radiosity) or `absolute` (a fraction of the largest
+    /// emitted radiosity).
+    #[arg(long, value_enum)]
+    criterion: Option<CriterionArg>,
+    /// BF refinement threshold, as a fraction of the largest emitted radiosity
+    /// (absolute criterion; the relative one's first pass).
     #[arg(long)]
     eps: Option<f64>,
+    /// Relative criterion: a link's error as a fraction of its receiver's radiosity (default: eps x largest emission / (3 x mean reflected radiosity)).
+    #[arg(long)]
+    eps_relative: Option<f64>,
+    /// Relative criterion: least receiver radiosity, as a fraction of the scene's area-mean reflected radiosity.
+    #[arg(long)]
+    relative_floor: Option<f64>,
     /// Smallest element area, as a fraction of the scene's total area.
     #[arg(long)]
     min_area: Option<f64>,
@@ -64,9 +78,23 @@ struct Args {
     seed: Option<u64>,
 }
 
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum CriterionArg {
+    Absolute,
+    Relative,
+}
+
 fn params_of(args: &Args) -> schemas::Result<Params> {
     let mut p: Params = load_params(args.stage.params.as_deref())?;
+    if let Some(c) = args.criterion {
+        p.criterion = match c {
+            CriterionArg::Absolute => Criterion::Absolute,
+            CriterionArg::Relative => Criterion::Relative,
+        };
+    }
     p.eps = args.eps.unwrap_or(p.eps);
+    p.eps_relative = args.eps_relative.or(p.eps_relative);
+    p.relative_floor = args.relative_floor.unwrap_or(p.relative_floor);
     p.min_area = args.min_area.unwrap_or(p.min_area);
     p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
     p.cluster_samples = args.cluster_samples.unwrap_or(p.cluster_samples);
