@@ -143,3 +143,18 @@ pub fn straddled_receiver(rho: f64, emission: f64) -> QuadScene {
     scene.quad("lamp", "emitting", rectangle(2, 1.5, [-0.7, -0.5], [1.3, 1.5]), [0.0, 0.0, -1.0]);
     scene
 }
+
+/// Paper 002's one-bounce configuration: a 1 m square emitter L (black,
+/// exitance `emission`, `x in [0, 1]`, `y in [0, 1]`, `z = 0`) and a 1 m
+/// square receiver B beside it in the same plane (`x in [1, 2]`,
+/// reflectance `rho_b`), both facing up at a 2 x 1 m receiver A
+/// (reflectance `rho_a`) 0.5 m above them, facing down. L and B are
+/// coplanar, so B gets only what A reflects. Objects `L`, `A`, `B`.
+pub fn one_bounce(rho_a: f64, rho_b: f64, emission: f64) -> QuadScene {
+    let mut scene = QuadScene { camera: ([1.0, -1.5, 0.25], [1.0, 0.5, 0.25]), ..Default::default() };
+    scene.material("emitting", 0.0, emission).material("upper", rho_a, 0.0).material("lower", rho_b, 0.0);
+    scene.quad("L", "emitting", rectangle(2, 0.0, [0.0, 0.0], [1.0, 1.0]), [0.0, 0.0, 1.0]);
+    scene.quad("B", "lower", rectangle(2, 0.0, [1.0, 0.0], [2.0, 1.0]), [0.0, 0.0, 1.0]);
+    scene.quad("A", "upper", rectangle(2, 0.5, [0.0, 0.0], [2.0, 1.0]), [0.0, 0.0, -1.0]);
+    scene
+}

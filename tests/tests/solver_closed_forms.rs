@@ -5,7 +5,7 @@
 //! between the triangles and the root).
 
 use end_to_end::closed_form::{clip_to_front, lambert_polygon, parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
-use end_to_end::scenes::{closed_box, rectangle, straddled_receiver, QuadScene};
+use end_to_end::scenes::{closed_box, one_bounce, rectangle, straddled_receiver, QuadScene};
 use end_to_end::{run_ok, s, scratch, solve_prepared};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::report::Report;
@@ -317,4 +317,99 @@ fn closed_box_conserves_energy_rho_0_5() {
 fn closed_box_conserves_energy_rho_0_9() {
     energy_balance("energy_0_9", 0.9, false);
     energy_balance("energy_0_9", 0.9, true);
+}
+
+/// The one-bounce configuration ([`one_bounce`]), by quadrature written
+/// here apart from the solver: A's radiosity is `rho_A E F_{x->L}` (Lambert's
+/// formula, exact) plus what it reflects of B's first-bounce radiosity; B's
+/// is `rho_B / pi` times the integral over A of `B_A(x) cos cos / r^2`
+/// (parallel planes 0.5 m apart: `h^2 / (pi r^4)`), midpoint rule on a 2 cm
+/// grid of A (and of B for the second bounce). Bounces past the second
+/// change B by less than `rho_A rho_B F_AB F_BA` ~ 1e-3 relative at
+/// rho_B = 0.05 and are left out. Returns `B(y)` per point `y` of B.
+fn one_bounce_reference(rho_a: f64, rho_b: f64, emission: f64, points: &[[f64; 3]]) -> Vec<f64> {
+    let h = 0.5;
+    let lamp = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let cell = 0.02;
+    let grid = |x0: f64, nx: usize, ny: usize, z: f64| -> Vec<[f64; 3]> {
+        (0..nx).flat_map(|i| (0..ny).map(move |j| [x0 + (i as f64 + 0.5) * cell, (j as f64 + 0.5) * cell, z])).collect()
+    };
+    let a_grid = grid(0.0, 100, 50, h);
+    let b_grid = grid(1.0, 50, 50, 0.0);
+    let kernel = |x: &[f64; 3], y: &[f64; 3]| {
+        let r2 = (x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + h * h;
+        h * h / (std::f64::consts::PI * r2 * r2) * cell * cell
+    };
+    let direct_a: Vec<f64> = a_grid.iter().map(|x| rho_a * emission * lambert_polygon(*x, [0.0, 0.0, -1.0], &lamp)).collect();
+    let gather_b = |b_a: &[f64], y: &[f64; 3]| rho_b * a_grid.iter().zip(b_a).map(|(x, b)| b * kernel(x, y)).sum::<f64>();
+    let first_b: Vec<f64> = b_grid.iter().map(|y| gather_b(&direct_a, y)).collect();
+    let b_a: Vec<f64> = a_grid
+        .iter()
+        .zip(&direct_a)
+        .map(|(x, d)| d + rho_a * b_grid.iter().zip(&first_b).map(|(y, b)| b * kernel(x, y)).sum::<f64>())
+        .collect();
+    points.iter().map(|y| gather_b(&b_a, y)).collect()
+}
+
+/// Per leaf of B: the relative error against [`one_bounce_reference`]
+/// (the leaf's mean over 4 sub-triangles), for the solver's `args`.
+fn one_bounce_errors(test: &str, rho_b: f64, args: &[&str]) -> Vec<f64> {
+    let (rho_a, emission) = (0.5, 1.0);
+    let (solved, dir) = solve(test, &one_bounce(rho_a, rho_b, emission), args, false);
+    let (mesh, _) = Mesh::read(&dir.join("mesh.exr")).unwrap();
+    let manifest = read_ron::<Manifest>(&dir.join("manifest.ron")).unwrap().value;
+    let origin = manifest.world_from_mesh_translation;
+    let mut leaves = Vec::new();
+    for (object, _, b, i) in solved.leaves() {
+        if object != "B" {
+            continue;
+        }
+        let e = &solved.solution.elements[i];
+        let t = &mesh.triangles[e.triangle as usize];
+        let p = |k: usize| mesh.positions[t.vertices[k] as usize].map(f64::from);
+        let (p0, p1, p2) = (p(0), p(1), p(2));
+        let world = |uv: [f64; 2]| std::array::from_fn::<f64, 3, _>(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a]);
+        let corners = e.corners.map(|c| world([f64::from(c[0]), f64::from(c[1])]));
+        let points = std::cell::RefCell::new(Vec::new());
+        mean_over_triangle(&corners, 1, &|x| {
+            points.borrow_mut().push(x);
+            0.0
+        });
+        leaves.push((b, points.into_inner()));
+    }
+    let all: Vec<[f64; 3]> = leaves.iter().flat_map(|(_, p)| p.iter().copied()).collect();
+    let reference = one_bounce_reference(rho_a, rho_b, emission, &all);
+    leaves.iter().zip(reference.chunks(4)).map(|((b, _), r)| {
+        let exact = r.iter().sum::<f64>() / 4.0;
+        (b - exact) / exact
+    }).collect()
+}
+
+/// Issue 10, item 2: B (rho_B 0.05, so the second bounce, which the
+/// reference includes, is already about 1% and later ones ~1e-3) is lit
+/// only by what A reflects, its radiosity ~2e-3 of the lamp's. The absolute
+/// criterion (error in units of the lamp's exitance) leaves links onto B
+/// carrying the mean radiosity of large parts of A, whose radiosity falls
+/// off from above the lamp to above B's far edge: measured, B's worst leaf
+/// 71% off, rms 11%. The relative criterion (error against B's own
+/// radiosity, sender variation at every level below the sender) splits A
+/// where it matters: worst 8.9%, rms 2.2%, at default settings (404 -> 1820
+/// leaves on B). Bound: worst leaf within 12% and rms within 3%, which the
+/// relative criterion meets and the absolute one fails. Not the issue's 2%: even at `--criterion absolute
+/// --eps 1e-6 --min-area 1e-5` B's leaves stay up to 6.7% off (rms 1.4%)
+/// while A's leaves match Lambert within 2.6% and B under a uniformly
+/// emitting A matches Lambert to 4e-6; that residual is left to find.
+#[test]
+fn one_bounce_receiver_leaves_closer_to_quadrature_with_the_relative_criterion() {
+    let rho_b = 0.05;
+    let mut worst = [0.0f64; 2];
+    let mut rms = [0.0f64; 2];
+    for (k, criterion) in ["absolute", "relative"].into_iter().enumerate() {
+        let errors = one_bounce_errors(&format!("one_bounce_{criterion}"), rho_b, &["--criterion", criterion]);
+        rms[k] = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        worst[k] = errors.iter().fold(0.0f64, |w, e| w.max(e.abs()));
+        eprintln!("one bounce, rho_B {rho_b}, {criterion}: {} leaves of B, largest relative error {:.2e}, rms {:.2e}", errors.len(), worst[k], rms[k]);
+    }
+    assert!(worst[1] <= 0.12 && rms[1] <= 0.03, "relative criterion: a leaf of B is {:.2e} off the quadrature reference (rms {:.2e})", worst[1], rms[1]);
+    assert!(worst[0] > 0.12, "the absolute criterion also meets 12% ({:.2e}); the test no longer tells them apart", worst[0]);
 }
