@@ -201,12 +201,7 @@ fn straddling_sender(clustered: bool) {
         if object != "R" {
             continue;
         }
-        let e = &solved.solution.elements[i];
-        let t = &mesh.triangles[e.triangle as usize];
-        let p = |k: usize| mesh.positions[t.vertices[k] as usize].map(f64::from);
-        let (p0, p1, p2) = (p(0), p(1), p(2));
-        let world = |uv: [f64; 2]| std::array::from_fn::<f64, 3, _>(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a]);
-        let corners = e.corners.map(|c| world([f64::from(c[0]), f64::from(c[1])]));
+        let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
         let exact = mean_over_triangle(&corners, 2, &|x| lambert_polygon(x, r_normal, &front));
         let error = (b / (rho * emission) - exact) / exact;
         worst = worst.max(error.abs());
@@ -364,12 +359,7 @@ fn one_bounce_errors(test: &str, rho_b: f64, args: &[&str]) -> Vec<f64> {
         if object != "B" {
             continue;
         }
-        let e = &solved.solution.elements[i];
-        let t = &mesh.triangles[e.triangle as usize];
-        let p = |k: usize| mesh.positions[t.vertices[k] as usize].map(f64::from);
-        let (p0, p1, p2) = (p(0), p(1), p(2));
-        let world = |uv: [f64; 2]| std::array::from_fn::<f64, 3, _>(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a]);
-        let corners = e.corners.map(|c| world([f64::from(c[0]), f64::from(c[1])]));
+        let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
         let points = std::cell::RefCell::new(Vec::new());
         mean_over_triangle(&corners, 1, &|x| {
             points.borrow_mut().push(x);
@@ -412,4 +402,15 @@ fn one_bounce_receiver_leaves_closer_to_quadrature_with_the_relative_criterion()
     }
     assert!(worst[1] <= 0.12 && rms[1] <= 0.03, "relative criterion: a leaf of B is {:.2e} off the quadrature reference (rms {:.2e})", worst[1], rms[1]);
     assert!(worst[0] > 0.12, "the absolute criterion also meets 12% ({:.2e}); the test no longer tells them apart", worst[0]);
+}
+
+/// World corners of solution element `e`: its barycentric corners mapped
+/// onto its mesh triangle, plus the mesh frame's world translation.
+fn leaf_world_corners(mesh: &Mesh, origin: [f64; 3], e: &schemas::solution::Element) -> [[f64; 3]; 3] {
+    let t = &mesh.triangles[e.triangle as usize];
+    let [p0, p1, p2] = t.vertices.map(|v| mesh.positions[v as usize].map(f64::from));
+    e.corners.map(|c| {
+        let uv = c.map(f64::from);
+        std::array::from_fn(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a])
+    })
 }
