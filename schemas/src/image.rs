@@ -53,6 +53,15 @@ pub enum Origin {
     Foreign,
 }
 
+impl Origin {
+    /// For a foreign image read from `path` (input record `input`), the
+    /// one-line note a stage prints and reports: it carries no provenance,
+    /// and its SHA-256; `None` for an image of this pipeline.
+    pub fn foreign_note(self, path: &Path, input: &Input) -> Option<String> {
+        (self == Origin::Foreign).then(|| format!("{} is a foreign EXR (no provenance; SHA-256 {})", path.display(), input.sha256))
+    }
+}
+
 /// A linear HDR image, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HdrImage {

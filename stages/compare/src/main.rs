@@ -3,7 +3,7 @@
 use clap::Parser;
 use compare::{CompareError, Params, Which};
 use schemas::header::Schema;
-use schemas::image::{HdrImage, Origin};
+use schemas::image::HdrImage;
 use schemas::mesh::Manifest;
 use schemas::report::Report;
 use schemas::solution::Solution;
@@ -99,8 +99,7 @@ fn named(error: CompareError, a: &Path, b: &Path) -> Error {
 /// note (here and on stderr) that it carries no provenance.
 fn read_image(path: &Path, run: &mut Run, notes: &mut Vec<String>) -> schemas::Result<HdrImage> {
     let (image, record, origin) = HdrImage::read_any(path)?;
-    if origin == Origin::Foreign {
-        let note = format!("{} is a foreign EXR (no provenance; SHA-256 {})", path.display(), record.sha256);
+    if let Some(note) = origin.foreign_note(path, &record) {
         eprintln!("compare: note: {note}");
         notes.push(note);
     }

@@ -1,7 +1,7 @@
 //! `tonemap IMAGE.exr -o OUT.png`: linear HDR image to 8-bit sRGB PNG.
 
 use clap::Parser;
-use schemas::image::{HdrImage, Origin};
+use schemas::image::HdrImage;
 use schemas::stage::{exit_code, load_params, print_params, Run, StageArgs};
 use schemas::Error;
 use std::path::{Path, PathBuf};
@@ -57,8 +57,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     };
     let mut run = Run::start("tonemap", env!("CARGO_PKG_VERSION"));
     let (image, record, origin) = HdrImage::read_any(input)?;
-    if origin == Origin::Foreign {
-        eprintln!("tonemap: note: {} is a foreign EXR (no provenance; SHA-256 {})", input.display(), record.sha256);
+    if let Some(note) = origin.foreign_note(input, &record) {
+        eprintln!("tonemap: note: {note}");
     }
     run.input(record);
     let mapped = tonemap::tonemap(&image, &params).map_err(|e| Error::invalid(input, None, e.to_string()))?;
