@@ -52,7 +52,8 @@
 pub mod ply;
 pub mod xml;
 
-use schemas::mesh::{Manifest, Material, Mesh};
+use radiometry::color::max_channel;
+use schemas::mesh::{Manifest, Material, Mesh, MeshStatistics};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use xml::{attribute, comment};
@@ -152,10 +153,6 @@ pub enum Bsdf {
     },
 }
 
-fn max3(v: [f64; 3]) -> f64 {
-    v[0].max(v[1]).max(v[2])
-}
-
 fn scaled(v: [f64; 3], s: f64) -> [f64; 3] {
     [v[0] * s, v[1] * s, v[2] * s]
 }
@@ -167,7 +164,7 @@ pub fn material_bsdf(material: &Material) -> (Bsdf, Vec<String>) {
     let mut skipped = Vec::new();
     let rho = material.diffuse;
     let ks = material.specular_reflectance;
-    let (w, rho_max) = (max3(ks), max3(rho));
+    let (w, rho_max) = (max_channel(ks), max_channel(rho));
     let bsdf = if w <= 0.0 {
         Bsdf::Diffuse(rho)
     } else if rho_max <= 0.0 {
@@ -180,13 +177,13 @@ pub fn material_bsdf(material: &Material) -> (Bsdf, Vec<String>) {
         ));
         Bsdf::Diffuse(rho)
     };
-    if max3(material.specular_transmittance) > 0.0 {
+    if max_channel(material.specular_transmittance) > 0.0 {
         skipped.push(format!(
             "material '{name}': specular transmittance {:?} not exported (Mitsuba's dielectrics add Fresnel reflection); surface written opaque",
             material.specular_transmittance
         ));
     }
-    if max3(material.diffuse_transmittance) > 0.0 {
+    if max_channel(material.diffuse_transmittance) > 0.0 {
         skipped.push(format!(
             "material '{name}': diffuse transmittance {:?} not exported (Mitsuba 3 has no diffuse transmitter); surface written opaque",
             material.diffuse_transmittance
@@ -210,36 +207,33 @@ pub fn safe_name(name: &str) -> String {
     }
 }
 
-fn rgb(v: [f64; 3]) -> String {
+/// Three numbers as Mitsuba's `rgb` values and `lookat` points take them.
+fn triple(v: [f64; 3]) -> String {
     format!("{}, {}, {}", v[0], v[1], v[2])
-}
-
-fn point(v: [f64; 3]) -> String {
-    rgb(v)
 }
 
 fn write_bsdf(out: &mut String, bsdf: &Bsdf, indent: &str) {
     match bsdf {
         Bsdf::Diffuse(rho) => {
             let _ = writeln!(out, "{indent}<bsdf type=\"diffuse\">");
-            let _ = writeln!(out, "{indent}    <rgb name=\"reflectance\" value=\"{}\"/>", rgb(*rho));
+            let _ = writeln!(out, "{indent}    <rgb name=\"reflectance\" value=\"{}\"/>", triple(*rho));
             let _ = writeln!(out, "{indent}</bsdf>");
         }
         Bsdf::Mirror(ks) => {
             let _ = writeln!(out, "{indent}<bsdf type=\"conductor\">");
             let _ = writeln!(out, "{indent}    <string name=\"material\" value=\"none\"/>");
-            let _ = writeln!(out, "{indent}    <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(*ks));
+            let _ = writeln!(out, "{indent}    <rgb name=\"specular_reflectance\" value=\"{}\"/>", triple(*ks));
             let _ = writeln!(out, "{indent}</bsdf>");
         }
         Bsdf::Blend { weight, diffuse, mirror } => {
             let _ = writeln!(out, "{indent}<bsdf type=\"blendbsdf\">");
             let _ = writeln!(out, "{indent}    <float name=\"weight\" value=\"{weight}\"/>");
             let _ = writeln!(out, "{indent}    <bsdf type=\"diffuse\" name=\"bsdf_0\">");
-            let _ = writeln!(out, "{indent}        <rgb name=\"reflectance\" value=\"{}\"/>", rgb(*diffuse));
+            let _ = writeln!(out, "{indent}        <rgb name=\"reflectance\" value=\"{}\"/>", triple(*diffuse));
             let _ = writeln!(out, "{indent}    </bsdf>");
             let _ = writeln!(out, "{indent}    <bsdf type=\"conductor\" name=\"bsdf_1\">");
             let _ = writeln!(out, "{indent}        <string name=\"material\" value=\"none\"/>");
-            let _ = writeln!(out, "{indent}        <rgb name=\"specular_reflectance\" value=\"{}\"/>", rgb(*mirror));
+            let _ = writeln!(out, "{indent}        <rgb name=\"specular_reflectance\" value=\"{}\"/>", triple(*mirror));
             let _ = writeln!(out, "{indent}    </bsdf>");
             let _ = writeln!(out, "{indent}</bsdf>");
         }
@@ -249,18 +243,8 @@ fn write_bsdf(out: &mut String, bsdf: &Bsdf, indent: &str) {
 /// Clip distances that keep every point of the scene visible: Mitsuba
 /// clips at `near_clip` (default 1 cm) and `far_clip` (default 10 km),
 /// this pipeline's camera does not clip.
-fn clip_range(mesh: &Mesh, eye: [f64; 3]) -> (f64, f64) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in &mesh.positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(f64::from(p[k]));
-            hi[k] = hi[k].max(f64::from(p[k]));
-        }
-    }
-    if !lo[0].is_finite() {
-        return (1e-2, 1e4);
-    }
+fn clip_range(statistics: &MeshStatistics, eye: [f64; 3]) -> (f64, f64) {
+    let (lo, hi) = (statistics.bounds_min, statistics.bounds_max);
     let far = (0..3).map(|k| (eye[k] - lo[k]).abs().max((eye[k] - hi[k]).abs()).powi(2)).sum::<f64>().sqrt();
     let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     let far_clip = (2.0 * far).max(1e4);
@@ -319,10 +303,10 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
         let _ = writeln!(shapes, "        <string name=\"filename\" value={}/>", attribute(&format!("{mesh_folder}/{file_name}")));
         let _ = writeln!(shapes, "        <boolean name=\"face_normals\" value=\"true\"/>");
         write_bsdf(&mut shapes, &bsdf, "        ");
-        if max3(material.emission) > 0.0 {
+        if max_channel(material.emission) > 0.0 {
             let radiance = scaled(material.emission, 1.0 / std::f64::consts::PI);
             let _ = writeln!(shapes, "        <emitter type=\"area\">");
-            let _ = writeln!(shapes, "            <rgb name=\"radiance\" value=\"{}\"/>", rgb(radiance));
+            let _ = writeln!(shapes, "            <rgb name=\"radiance\" value=\"{}\"/>", triple(radiance));
             let _ = writeln!(shapes, "        </emitter>");
             emitters += 1;
         }
@@ -330,7 +314,7 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
         meshes.push(PlyMesh { file_name, material: m, triangles: faces.len(), vertices: positions.len(), bytes });
     }
 
-    let (near_clip, far_clip) = clip_range(mesh, camera.eye);
+    let (near_clip, far_clip) = clip_range(&manifest.statistics, camera.eye);
     let mut xml = String::new();
     let _ = writeln!(xml, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
     xml.push_str(&comment(&format!(
@@ -360,9 +344,9 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
     let _ = writeln!(
         xml,
         "            <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>",
-        point(camera.eye),
-        point(camera.target),
-        point(camera.up)
+        triple(camera.eye),
+        triple(camera.target),
+        triple(camera.up)
     );
     let _ = writeln!(xml, "        </transform>");
     let _ = writeln!(xml, "        <sampler type={}>", attribute(&params.sampler));
