@@ -64,15 +64,8 @@ pub fn integrating_sphere(mesh: &Mesh, manifest: &Manifest) -> Result<Vec<[f64; 
             return Err(format!("triangle {i} faces away from the centre"));
         }
     }
-    let total_area: f64 = mesh.triangles.iter().map(|t| f64::from(t.area)).sum();
-    let mut emitted = [0.0f64; 3];
-    for t in &mesh.triangles {
-        let emission = manifest.materials[t.material as usize].emission;
-        for c in 0..3 {
-            emitted[c] += emission[c] * f64::from(t.area);
-        }
-    }
-    let irradiance: [f64; 3] = std::array::from_fn(|c| emitted[c] / (total_area * (1.0 - rho[c])));
+    let statistics = &manifest.statistics;
+    let irradiance: [f64; 3] = std::array::from_fn(|c| statistics.emitted_power[c] / (statistics.total_area * (1.0 - rho[c])));
     Ok(mesh
         .triangles
         .iter()
