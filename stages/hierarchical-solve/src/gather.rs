@@ -209,7 +209,9 @@ pub fn solve(h: &Hierarchy, links: &[Link], offsets: &[usize], b: &mut [[f64; 3]
     let n = b.len();
     let topology = Topology::new(h, n);
     let senders: Vec<usize> = links.iter().map(|l| h.flat(l.sender)).collect();
-    let norm = max_norm(&topology, links, offsets);
+    // Each link's visibility-weighted form factor, once per solve.
+    let coupling: Vec<f64> = links.iter().map(|l| l.form_factor * f64::from(l.visibility.unwrap_or(1.0))).collect();
+    let norm = max_norm(&topology, &coupling, offsets);
     let mut h_down = vec![[0.0f64; 3]; n];
     let mut delta = vec![[0.0f64; 3]; n];
     let mut convergence =
@@ -220,8 +222,7 @@ pub fn solve(h: &Hierarchy, links: &[Link], offsets: &[usize], b: &mut [[f64; 3]
             .into_par_iter()
             .map(|i| {
                 let mut g = [0.0; 3];
-                for (l, &s) in links[offsets[i]..offsets[i + 1]].iter().zip(&senders[offsets[i]..offsets[i + 1]]) {
-                    let weight = l.form_factor * f64::from(l.visibility.unwrap_or(1.0));
+                for (&weight, &s) in coupling[offsets[i]..offsets[i + 1]].iter().zip(&senders[offsets[i]..offsets[i + 1]]) {
                     for c in 0..3 {
                         g[c] += weight * b[s][c];
                     }
@@ -382,14 +383,14 @@ impl Rate {
 
 /// The max-norm of the iteration matrix per channel (see [`solve`]): the
 /// largest `rho_leaf sum V F` over the links into a leaf and its ancestors.
-fn max_norm(topology: &Topology, links: &[Link], offsets: &[usize]) -> [f64; 3] {
+fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize]) -> [f64; 3] {
     let n = topology.parent.len();
     // Visibility-weighted factor sum into each node and its ancestors
     // (parents come first, one forward sweep).
     let mut chain = vec![0.0f64; n];
     let mut norm = [0.0f64; 3];
     for i in 0..n {
-        let own: f64 = links[offsets[i]..offsets[i + 1]].iter().map(|l| l.form_factor * f64::from(l.visibility.unwrap_or(1.0))).sum();
+        let own: f64 = coupling[offsets[i]..offsets[i + 1]].iter().sum();
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
             for c in 0..3 {

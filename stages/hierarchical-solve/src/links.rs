@@ -62,7 +62,7 @@ pub struct Linking {
 }
 
 /// What a link's estimated error is compared with.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Criterion {
     /// Against `eps` times the largest emitted radiosity, the same for

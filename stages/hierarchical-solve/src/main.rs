@@ -41,7 +41,7 @@ struct Args {
     /// of its receiver's radiosity) or `absolute` (a fraction of the largest
     /// emitted radiosity).
     #[arg(long, value_enum)]
-    criterion: Option<CriterionArg>,
+    criterion: Option<Criterion>,
     /// BF refinement threshold, as a fraction of the largest emitted radiosity
     /// (absolute criterion; the relative one's first pass).
     #[arg(long)]
@@ -78,20 +78,9 @@ struct Args {
     seed: Option<u64>,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-enum CriterionArg {
-    Absolute,
-    Relative,
-}
-
 fn params_of(args: &Args) -> schemas::Result<Params> {
     let mut p: Params = load_params(args.stage.params.as_deref())?;
-    if let Some(c) = args.criterion {
-        p.criterion = match c {
-            CriterionArg::Absolute => Criterion::Absolute,
-            CriterionArg::Relative => Criterion::Relative,
-        };
-    }
+    p.criterion = args.criterion.unwrap_or(p.criterion);
     p.eps = args.eps.unwrap_or(p.eps);
     p.eps_relative = args.eps_relative.or(p.eps_relative);
     p.relative_floor = args.relative_floor.unwrap_or(p.relative_floor);
