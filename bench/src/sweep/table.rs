@@ -135,11 +135,11 @@ pub struct Point {
 
 impl Point {
     /// The median time of the stage that plays `role` in the pipeline:
-    /// `cluster`, `solve` (hierarchical-solve or gpu-shoot) or `gather`.
+    /// `cluster`, `solve` (the point's solver stage) or `gather`.
     pub fn stage_median(&self, role: &str) -> Option<f64> {
         let wanted = |stage: &str| match role {
             "cluster" => stage == "cluster",
-            "solve" => stage == "hierarchical-solve" || stage == "gpu-shoot",
+            "solve" => stage == self.solver.stage(),
             "gather" => stage == "grid-gather",
             _ => false,
         };
