@@ -124,7 +124,7 @@ use crate::senders::{Aabb, SenderSample, Senders};
 use crate::Params;
 use glam::DVec3;
 use radiometry::color::luminance;
-use radiometry::form_factor::point_kernel;
+use radiometry::form_factor::{point_kernel, WeightedVisibility};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{square_to_triangle, Stream};
 use schemas::solution::{Link, Node, NONE};
@@ -447,7 +447,7 @@ impl<'a> FullGather<'a> {
             let share = if total > 0.0 { p.samples as f64 * i_s / total } else { 0.0 };
             let n = (share.round() as u32).clamp(p.min_samples, p.samples.max(p.min_samples));
             let (mut f_sum, mut f_min, mut f_max) = (0.0, f64::INFINITY, 0.0f64);
-            let mut visible = Weighted::default();
+            let mut visible = WeightedVisibility::default();
             for k in 0..n as usize {
                 let g: [f64; 3] = std::array::from_fn(|a| lo[a] + (hi[a] - lo[a]) * stream.next_f64());
                 let x = self.grid.point(g);
@@ -465,7 +465,7 @@ impl<'a> FullGather<'a> {
                     visible.add(weight, !blocked);
                 }
             }
-            let vis = visible.fraction();
+            let vis = visible.fraction().unwrap_or(1.0);
             let partial = link_partial || (vis > 0.0 && vis < 1.0);
             estimates.push(Estimate { node, n, f_avg: f_sum / f64::from(n), spread: f_max - f_min, vis, partial, interior: false, occluder, b });
         }
@@ -510,7 +510,7 @@ impl<'a> FullGather<'a> {
         if n == 0 {
             return 1.0;
         }
-        let mut visible = Weighted::default();
+        let mut visible = WeightedVisibility::default();
         let first = pass as usize * n as usize;
         for k in first..first + n as usize {
             let y = self.senders.sample(node, k);
@@ -520,7 +520,7 @@ impl<'a> FullGather<'a> {
                 visible.add(weight, self.rays.segment_clear(p, y.point, [triangle, y.triangle]));
             }
         }
-        visible.fraction()
+        visible.fraction().unwrap_or(1.0)
     }
 
     /// The kernel between `p` (unit normal `normal`) and sender sample `y`
@@ -565,7 +565,7 @@ impl<'a> FullGather<'a> {
                     continue;
                 }
                 let link = &solution.links[l];
-                let mut visible = Weighted::default();
+                let mut visible = WeightedVisibility::default();
                 for j in 0..m as usize {
                     let b = square_to_triangle(points.next_f64(), points.next_f64());
                     let x = corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2];
@@ -577,10 +577,7 @@ impl<'a> FullGather<'a> {
                     }
                 }
                 // No ray of positive weight: nothing to contradict with.
-                if visible.weight <= 0.0 {
-                    continue;
-                }
-                let v = visible.fraction();
+                let Some(v) = visible.fraction() else { continue };
                 if v != f64::from(link.visibility).clamp(0.0, 1.0) {
                     check.contradicted.push((l, v));
                 }
@@ -736,34 +733,6 @@ pub fn budget(d: &[f64], tau: f64) -> Vec<bool> {
     resample
 }
 
-/// A visible fraction weighted by the kernel (module docs, "Kernel-weighted
-/// visibility").
-#[derive(Clone, Copy, Debug, Default)]
-struct Weighted {
-    /// Sum of the weights of every ray cast.
-    weight: f64,
-    /// Sum of the weights of the clear rays.
-    clear: f64,
-}
-
-impl Weighted {
-    fn add(&mut self, weight: f64, clear: bool) {
-        self.weight += weight;
-        if clear {
-            self.clear += weight;
-        }
-    }
-
-    /// `sum G v / sum G`, in [0, 1]; 1 where no ray had weight.
-    fn fraction(&self) -> f64 {
-        if self.weight > 0.0 {
-            (self.clear / self.weight).clamp(0.0, 1.0)
-        } else {
-            1.0
-        }
-    }
-}
-
 /// The kernel between `p` (unit normal `normal`) and the sender sample `y`
 /// ([`point_kernel`], with the normal of `y`'s triangle); 0 for a sample on
 /// no triangle (an empty cluster's centre).
@@ -793,7 +762,7 @@ pub fn brute_irradiance(
         let s = senders.solution.links[l].sender;
         let (f, evals) = senders.form_factor(s, p, normal);
         work.form_factors += evals;
-        let mut visible = Weighted::default();
+        let mut visible = WeightedVisibility::default();
         for _ in 0..samples {
             let (u, v) = (stream.next_f64(), stream.next_f64());
             let y = match s {
@@ -811,7 +780,7 @@ pub fn brute_irradiance(
             }
         }
         work.classes[0] += 1;
-        let v = visible.fraction();
+        let v = visible.fraction().unwrap_or(1.0);
         let b = senders.radiosity(s);
         (0..3).for_each(|c| h[c] += b[c] * f * v);
     }

@@ -38,7 +38,7 @@
 
 use crate::elements::Hierarchy;
 use crate::nodes::key;
-use radiometry::form_factor::{point_kernel, point_to_polygon};
+use radiometry::form_factor::{point_kernel, point_to_polygon, WeightedVisibility};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use schemas::solution::Node;
@@ -66,7 +66,7 @@ pub fn estimate(h: &Hierarchy, scene: Option<&SceneRays>, receiver: Node, sender
     let mut stream = Stream::new(seed ^ 0x5eed_c105, key(receiver), key(sender));
     let sender_area = h.area(sender);
     let (mut sum, mut min, mut max) = (0.0, f64::INFINITY, 0.0f64);
-    let (mut weight, mut visible, mut rays) = (0.0, 0.0, 0);
+    let (mut visible, mut rays) = (WeightedVisibility::default(), 0);
     let mut nearest = f64::INFINITY;
     for k in 0..samples {
         let x = h.sample(receiver, k, samples, &mut stream);
@@ -83,14 +83,14 @@ pub fn estimate(h: &Hierarchy, scene: Option<&SceneRays>, receiver: Node, sender
         min = min.min(value);
         max = max.max(value);
         if let (Some(scene), true) = (scene, pair > 0.0) {
-            weight += pair;
             rays += 1;
-            match scene.first_blocker(x.point, y.point, [x.triangle, y.triangle]) {
-                None => visible += pair,
-                Some(distance) => nearest = nearest.min(distance),
+            let blocker = scene.first_blocker(x.point, y.point, [x.triangle, y.triangle]);
+            visible.add(pair, blocker.is_none());
+            if let Some(distance) = blocker {
+                nearest = nearest.min(distance);
             }
         }
     }
-    let visibility = scene.map(|_| ((if weight > 0.0 { (visible / weight).clamp(0.0, 1.0) } else { 1.0 }) as f32, nearest as f32));
+    let visibility = scene.map(|_| (visible.fraction().unwrap_or(1.0) as f32, nearest as f32));
     Estimate { form_factor: sum / samples as f64, spread: max - min.min(max), visibility, rays }
 }

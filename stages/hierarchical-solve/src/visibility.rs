@@ -44,7 +44,7 @@
 use crate::elements::Hierarchy;
 use crate::links::{Link, Linking};
 use crate::transfer;
-use radiometry::form_factor::point_kernel;
+use radiometry::form_factor::{point_kernel, WeightedVisibility};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
 use schemas::solution::Node;
@@ -95,7 +95,7 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
         let j = (stream.next_f64() * (i + 1) as f64) as usize;
         order.swap(i, j.min(i));
     }
-    let (mut weight, mut clear) = (0.0f64, 0.0f64);
+    let mut visible = WeightedVisibility::default();
     let mut nearest = f64::INFINITY;
     let mut cast = 0;
     for (k, &k_sender) in order.iter().enumerate() {
@@ -105,13 +105,13 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
         if g <= 0.0 {
             continue;
         }
-        weight += g;
         cast += 1;
-        match scene.first_blocker(from, to, skip) {
-            None => clear += g,
-            Some(distance) => nearest = nearest.min(distance),
+        let blocker = scene.first_blocker(from, to, skip);
+        visible.add(g, blocker.is_none());
+        if let Some(distance) = blocker {
+            nearest = nearest.min(distance);
         }
     }
-    let visibility = if weight > 0.0 { (clear / weight).clamp(0.0, 1.0) } else { 1.0 };
+    let visibility = visible.fraction().unwrap_or(1.0);
     Visibility { visibility: visibility as f32, occluder_distance: nearest as f32, rays: cast }
 }

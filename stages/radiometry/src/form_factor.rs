@@ -79,6 +79,34 @@ pub fn point_kernel(x: DVec3, nx: DVec3, y: DVec3, ny: DVec3) -> f64 {
     nx.dot(d).max(0.0) * (-ny.dot(d)).max(0.0) / (d2 * d2)
 }
 
+/// A visible fraction weighted by the kernel, `V = sum G_k v_k / sum G_k`
+/// over ray pairs of weight `G_k` ([`point_kernel`], or anything
+/// proportional to it), as the solver and the gathers estimate it. Callers
+/// cast no ray for a pair of zero weight.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WeightedVisibility {
+    /// Sum of the weights of every ray cast.
+    pub weight: f64,
+    /// Sum of the weights of the clear rays.
+    pub clear: f64,
+}
+
+impl WeightedVisibility {
+    /// One ray of weight `weight`, clear or blocked.
+    pub fn add(&mut self, weight: f64, clear: bool) {
+        self.weight += weight;
+        if clear {
+            self.clear += weight;
+        }
+    }
+
+    /// `sum G v / sum G` in [0, 1]; `None` where no ray had weight (the
+    /// pairs carry no light: callers take 1, or leave a value alone).
+    pub fn fraction(&self) -> Option<f64> {
+        (self.weight > 0.0).then(|| (self.clear / self.weight).clamp(0.0, 1.0))
+    }
+}
+
 /// Clips `polygon` to the half-space `(x - point) . normal >= 0`
 /// (Sutherland-Hodgman against one plane); writes the result into `out` and
 /// returns its vertex count.
