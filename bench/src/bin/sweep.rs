@@ -105,7 +105,7 @@ fn config(args: &Args) -> Result<Config> {
 
 fn run(args: Args) -> Result<ExitCode> {
     let config = config(&args)?;
-    bench::sweep::plan(&config)?;
+    let plans = bench::sweep::plan(&config)?;
     let out = &config.out;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let paths = ["sweep.ron", "sweep.csv", "sweep.svg", "sweep.png"].map(|name| out.join(name));
@@ -113,7 +113,7 @@ fn run(args: Args) -> Result<ExitCode> {
         check_writable(path)?;
     }
     let stages = Stages::beside_this_executable()?;
-    let sweep = bench::sweep::run(&config, &stages, &mut |line| eprintln!("sweep: {line}"))?;
+    let sweep = bench::sweep::run(&config, &plans, &stages, &mut |line| eprintln!("sweep: {line}"))?;
     let svg = plot::svg(&sweep).map_err(|e| Error::invalid(&paths[2], None, e))?;
     let png = plot::png(&sweep).map_err(|e| Error::invalid(&paths[3], None, e))?;
     schemas::ron_io::write_ron(&paths[0], &sweep)?;

@@ -26,7 +26,7 @@
 //! (corners are darker), so it has no per-element reference here and a
 //! sweep of it falls through to the next kind of reference.
 
-use schemas::header::{Input, Provenance, Schema};
+use schemas::header::{Provenance, Schema};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::{Element, Solution, NONE};
 use std::collections::HashMap;
@@ -79,9 +79,9 @@ pub fn integrating_sphere(mesh: &Mesh, manifest: &Manifest) -> Result<Vec<[f64; 
 /// The closed form as a solution artifact: one leaf element per input
 /// triangle with its constant radiosity, no links, so that `compare
 /// solution.exr closed_form.exr` measures a solver per triangle
-/// (area-weighted, leaves averaged over each triangle). `inputs` are the
-/// mesh and manifest it was computed from.
-pub fn solution(mesh: &Mesh, radiosity: &[[f64; 3]], inputs: Vec<Input>) -> Solution {
+/// (area-weighted, leaves averaged over each triangle), with the
+/// provenance of the run that computed it.
+pub fn solution(mesh: &Mesh, radiosity: &[[f64; 3]], provenance: Provenance) -> Solution {
     let elements = mesh
         .triangles
         .iter()
@@ -97,13 +97,6 @@ pub fn solution(mesh: &Mesh, radiosity: &[[f64; 3]], inputs: Vec<Input>) -> Solu
             radiosity: b.map(|x| x as f32),
         })
         .collect();
-    let provenance = Provenance {
-        stage: "sweep".into(),
-        stage_version: env!("CARGO_PKG_VERSION").into(),
-        command_line: std::env::args().collect(),
-        parameters: ron::value::RawValue::from_rust(&"closed form: integrating sphere").expect("a string serializes"),
-        inputs,
-    };
     Solution { header: Solution::header(provenance), elements, clusters: Vec::new(), links: Vec::new() }
 }
 

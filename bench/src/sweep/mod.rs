@@ -58,10 +58,10 @@ pub mod table;
 
 use knobs::{Gather, Knob, Setting, Solver, Target};
 use pareto::Spread;
-use schemas::header::{Input, Provenance, Schema};
+use schemas::header::{Input, Schema};
 use schemas::mesh::{Manifest, Mesh};
-use schemas::ron_io::{read_bytes, read_ron};
-use schemas::stage::bad_parameter;
+use schemas::ron_io::read_bytes;
+use schemas::stage::{bad_parameter, read_prepared, Run};
 use schemas::{Error, Result};
 use serde::Serialize;
 use stages::Stages;
@@ -336,10 +336,9 @@ fn check_flags(stages: &Stages, config: &Config, plans: &[Plan]) -> Result<()> {
     Ok(())
 }
 
-/// Runs the sweep; `progress` gets one line per run.
-pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> Result<Sweep> {
-    let plans = plan(config)?;
-    check_flags(stages, config, &plans)?;
+/// Runs the sweep of `plans` (from [`plan`]); `progress` gets one line per run.
+pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn FnMut(&str)) -> Result<Sweep> {
+    check_flags(stages, config, plans)?;
     if let Some(reference) = &config.reference {
         if !reference.is_file() {
             return Err(bad_parameter(format!("--reference {}: no such file", reference.display())));
@@ -348,16 +347,14 @@ pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> 
     let out = &config.out;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let mut notes = Vec::new();
+    let mut record = Run::start("sweep", env!("CARGO_PKG_VERSION"));
 
     // The scene, once.
     let prepared = Prepared { mesh: out.join("mesh.exr"), manifest: out.join("manifest.ron") };
     let mut args = config.scene_args();
     args.extend(["--mesh".into(), s(&prepared.mesh), "--manifest".into(), s(&prepared.manifest)]);
     let mesh_prep = stages.run("mesh-prep", &args, &out.join("mesh-prep.report.ron"))?;
-    let (mesh, mesh_input) = Mesh::read(&prepared.mesh)?;
-    let manifest = read_ron::<Manifest>(&prepared.manifest)?;
-    let mut inputs: Vec<Input> = vec![mesh_input, manifest.input];
-    let manifest = manifest.value;
+    let (mesh, manifest) = read_prepared(&mut record, &prepared.mesh, &prepared.manifest)?;
     progress(&format!("mesh-prep: {} triangles, {:.2} s", mesh.triangles.len(), mesh_prep.wall_time_s));
 
     // The reference.
@@ -366,7 +363,7 @@ pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> 
     let (reference, measure) = match closed_form::integrating_sphere(&mesh, &manifest) {
         Ok(radiosity) => {
             let path = reference_dir.join("closed_form.exr");
-            closed_form::solution(&mesh, &radiosity, inputs.clone()).write(&path)?;
+            closed_form::solution(&mesh, &radiosity, record.provenance(&"closed form: integrating sphere")).write(&path)?;
             if let Some(given) = &config.reference {
                 notes.push(format!("--reference {} not used: the scene has a closed form, which comes first", given.display()));
             }
@@ -378,7 +375,7 @@ pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> 
             notes.push(format!("no closed form per element: {why}"));
             match &config.reference {
                 Some(path) => {
-                    inputs.push(Input::new(path, &read_bytes(path)?, None));
+                    record.input(Input::new(path, &read_bytes(path)?, None));
                     let name = path.file_name().map_or_else(|| s(path), |n| n.to_string_lossy().into_owned());
                     let label = format!("reference: {name} (foreign EXR)");
                     let flags = vec!["--exclude-emitters", "--exclude-edges", "2"];
@@ -400,7 +397,7 @@ pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> 
     let runs_total: usize = plans.iter().map(|p| p.settings.len() * config.reps).sum();
     let mut done = 0;
     let mut points = Vec::new();
-    for plan in &plans {
+    for plan in plans {
         for setting in &plan.settings {
             let point_dir = out.join("runs").join(plan.solver.name()).join(setting_dir(setting));
             let mut reps: Vec<RepFigures> = Vec::new();
@@ -437,15 +434,8 @@ pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> 
         ReferenceKind::ForeignExr => "relative RMSE of the image (compare's relative_rmse, emitters and pixels within 2 of an edge left out)",
         ReferenceKind::StrictestRun => "relative RMSE of the image (compare's relative_rmse, emitters and pixels that mix surfaces left out)",
     };
-    let provenance = Provenance {
-        stage: "sweep".into(),
-        stage_version: env!("CARGO_PKG_VERSION").into(),
-        command_line: std::env::args().collect(),
-        parameters: ron::value::RawValue::from_rust(&config.parameters()).expect("parameters serialize to RON"),
-        inputs,
-    };
     Ok(Sweep {
-        header: Sweep::header(provenance),
+        header: Sweep::header(record.provenance(&config.parameters())),
         scene: config.scene.clone(),
         triangles: mesh.triangles.len(),
         reference,
