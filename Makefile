@@ -50,7 +50,7 @@ BIN := target/release
 STAGES := mesh-prep cluster hierarchical-solve grid-gather tonemap compare
 BINS := $(addprefix $(BIN)/,$(STAGES))
 
-.PHONY: all test bench clean FORCE
+.PHONY: all test fuzz bench clean FORCE
 all: $(OUT)/image.png
 
 # Cargo decides what to rebuild; a binary it leaves alone keeps its time
@@ -73,6 +73,13 @@ include $(sort $(wildcard pipelines/*.mk))
 
 test: $(BINS)
 	cargo test --release --workspace
+
+# The mutation fuzz targets (tests named fuzz_*: OBJ, MTL, scene.ron, ...)
+# for many more cases than `make test` runs (300 each); FUZZ_SEED picks
+# another master seed, FUZZ_REPLAY=<case> reruns one reported case.
+FUZZ_CASES ?= 20000
+fuzz: $(BINS)
+	FUZZ_CASES=$(FUZZ_CASES) cargo test --release --workspace -- fuzz_
 
 # Medians of 5 solves of the Cornell box at about 10k leaf elements, and
 # obvhs's raw traversal rate measured in the same run (see README).

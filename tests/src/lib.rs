@@ -6,6 +6,7 @@
 //! runs before the tests.
 
 pub mod closed_form;
+pub mod fuzz;
 pub mod scenes;
 
 use std::path::{Path, PathBuf};
