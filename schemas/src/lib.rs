@@ -25,6 +25,7 @@
 //! ```
 
 pub mod atomic;
+pub mod cli;
 pub mod cluster;
 pub mod error;
 pub mod exr_io;

@@ -1,10 +1,11 @@
 //! `cluster`: see the library's documentation and `cluster --help`.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use cluster::{build, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,9 +47,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
         unreachable!("clap requires the inputs and output without --print-params")
     };
-    for path in [Some(output), args.stage.report.as_ref()].into_iter().flatten() {
-        check_writable(path)?;
-    }
+    check_outputs(&[args.mesh.as_deref(), args.manifest.as_deref()], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start("cluster", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let started = Instant::now();
@@ -81,5 +80,5 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("cluster", run(Args::parse()))
+    main_of("cluster", run)
 }

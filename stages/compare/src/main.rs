@@ -1,13 +1,14 @@
 //! `compare A.exr B.exr`: error of A against reference B, with tolerances.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use compare::{CompareError, Params, Which};
 use schemas::header::Schema;
 use schemas::image::HdrImage;
 use schemas::mesh::Manifest;
 use schemas::report::Report;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, exit_code, load_params, print_params, Run};
+use schemas::stage::{bad_parameter, load_params, print_params, Run};
 use schemas::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -224,6 +225,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(a), Some(b)) = (args.a.as_deref(), args.b.as_deref()) else {
         unreachable!("clap requires A and B without --print-params")
     };
+    check_outputs(&[Some(a), Some(b), args.manifest.as_deref()], &[args.output.as_deref(), args.diff.as_deref()])?;
     let mut run = Run::start("compare", env!("CARGO_PKG_VERSION"));
     let outcome = compare_files(&args, &params, &mut run, a, b)?;
     let exceeded = params.exceeded(&outcome.metrics);
@@ -274,5 +276,5 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("compare", run(Args::parse()))
+    main_of("compare", run)
 }

@@ -1,9 +1,10 @@
 //! `export-mitsuba`: see the library's documentation and `export-mitsuba --help`.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use export_mitsuba::{export, Params};
 use schemas::atomic::write_bytes_atomically;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
 use schemas::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -79,9 +80,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         unreachable!("clap requires the inputs and output without --print-params")
     };
     let (folder, folder_name) = mesh_folder(output)?;
-    for path in [Some(output), args.stage.report.as_ref()].into_iter().flatten() {
-        check_writable(path)?;
-    }
+    check_outputs(&[args.mesh.as_deref(), args.manifest.as_deref()], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start("export-mitsuba", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let (width, height) = (params.width.unwrap_or(manifest.camera.width), params.height.unwrap_or(manifest.camera.height));
@@ -142,5 +141,5 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("export-mitsuba", run(Args::parse()))
+    main_of("export-mitsuba", run)
 }

@@ -227,8 +227,12 @@ impl Params {
         if self.spp == 0 {
             return Err(bad_parameter("spp must be at least 1"));
         }
-        if self.width == Some(0) || self.height == Some(0) {
-            return Err(bad_parameter("width and height must be at least 1 pixel"));
+        // The whole size (with the camera's for a side not given) is
+        // checked by `gather_with`.
+        for (name, side) in [("width", self.width), ("height", self.height)] {
+            if let Some(side) = side.filter(|s| !(1..=MAX_SIDE).contains(s)) {
+                return Err(bad_parameter(format!("{name} must be 1 to {MAX_SIDE} pixels, got {side}")));
+            }
         }
         if !(0.0..=180.0).contains(&self.crease_angle_deg) {
             return Err(bad_parameter(format!("crease_angle_deg must be in [0, 180], got {}", self.crease_angle_deg)));
@@ -296,6 +300,25 @@ pub struct Rendered {
     pub skipped: Vec<String>,
 }
 
+/// Largest image side, pixels.
+pub const MAX_SIDE: u32 = 16_384;
+/// Largest image, pixels (64 Mpx: with the film's accumulators and the
+/// surface channels about 3 GiB of memory).
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Checks that a `width` x `height` image can be rendered: each side in
+/// `1..=MAX_SIDE`, at most [`MAX_PIXELS`] in all, so a mistyped size is an
+/// error at once rather than an hour of work or an allocation failure.
+pub fn check_image_size(width: u32, height: u32) -> std::result::Result<(), String> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(format!("image size {width}x{height}: each side must be 1 to {MAX_SIDE} pixels"));
+    }
+    if u64::from(width) * u64::from(height) > MAX_PIXELS {
+        return Err(format!("image size {width}x{height}: more than {MAX_PIXELS} pixels"));
+    }
+    Ok(())
+}
+
 /// The image size: `params`' where given, else the camera's.
 pub fn image_size(params: &Params, manifest: &Manifest) -> (u32, u32) {
     (params.width.unwrap_or(manifest.camera.width), params.height.unwrap_or(manifest.camera.height))
@@ -313,6 +336,7 @@ pub fn gather(params: &Params, scene: &Scene, rows_done: &(dyn Fn(u64) + Sync)) 
 pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(dyn Fn(u64) + Sync)) -> Result<(Rendered, Option<final_gather::Diagnostics>)> {
     params.validate()?;
     let (width, height) = image_size(params, scene.manifest);
+    check_image_size(width, height).map_err(|e| Error::invalid(scene.manifest_path, None, format!("{e} (the camera's size, or --width/--height)")))?;
     let camera = Pinhole::new(&scene.manifest.camera, width, height).ok_or_else(|| {
         Error::invalid(
             scene.manifest_path,

@@ -2,6 +2,7 @@
 //! mode: Gouraud interpolation of element radiosity). See the library docs.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use grid_gather::final_gather::{ContrastImage, Diagnostics, CLASS_NAMES_PIXEL};
 use grid_gather::{gather_with, image_size, Extras, GridKind, Mode, Params, Scene};
 use schemas::cluster::Clusters;
@@ -10,7 +11,7 @@ use schemas::header::{Header, Schema};
 use schemas::image::HdrImage;
 use schemas::solution::Solution;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use schemas::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -129,6 +130,9 @@ struct Args {
     /// Full: rays per leaf to check a fully visible or occluded link of the surface-based gather, 0 to trust the solver [default: 8].
     #[arg(long, value_name = "N")]
     leaf_check_rays: Option<u32>,
+    /// Full: rays from a vertex inside a sender cluster [default: 100].
+    #[arg(long, value_name = "N")]
+    interior_rays: Option<u32>,
     /// Full: surface-based gather where leaves are finer than the grid [default: on].
     #[arg(long, overrides_with = "no_surface_gather")]
     surface_gather: bool,
@@ -216,7 +220,7 @@ impl Args {
         macro_rules! set {
             ($($f:ident),*) => { $(if let Some(v) = self.$f { p.$f = v; })* };
         }
-        set!(grid_pixels, grid_depth, samples, min_samples, max_shadow_samples, contrast, allowed_hits, leaf_check_rays, brute_samples);
+        set!(grid_pixels, grid_depth, samples, min_samples, max_shadow_samples, contrast, allowed_hits, leaf_check_rays, interior_rays, brute_samples);
         if self.surface_gather {
             p.surface_gather = true;
         }
@@ -253,10 +257,10 @@ fn run(args: &Args) -> Result<ExitCode> {
         return Err(bad_parameter("--mesh, --manifest, --solution and -o are required"));
     };
 
-    check_writable(output)?;
-    if let Some(d) = &args.diagnostics {
-        check_writable(d)?;
-    }
+    check_outputs(
+        &[args.mesh.as_deref(), args.manifest.as_deref(), args.solution.as_deref()],
+        &[Some(output), args.diagnostics.as_deref(), args.stage.report.as_deref()],
+    )?;
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let (solution, input) = Solution::read(solution_path)?;
@@ -307,6 +311,5 @@ fn run(args: &Args) -> Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    let args = Args::parse();
-    exit_code(STAGE, run(&args))
+    main_of(STAGE, |args: Args| run(&args))
 }

@@ -1,12 +1,13 @@
 //! `hierarchical-solve`: see the library's documentation and `--help`.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use hierarchical_solve::{solve, Criterion, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::Effects;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -121,9 +122,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
         unreachable!("clap requires the inputs and output without --print-params")
     };
-    for path in [Some(output), args.stage.report.as_ref()].into_iter().flatten() {
-        check_writable(path)?;
-    }
+    check_outputs(&[args.mesh.as_deref(), args.manifest.as_deref(), args.clusters.as_deref()], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start("hierarchical-solve", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let clusters = match &args.clusters {
@@ -200,5 +199,5 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("hierarchical-solve", run(Args::parse()))
+    main_of("hierarchical-solve", run)
 }

@@ -2,11 +2,12 @@
 //! a tone-mapped preview (TVI x masking elevation). See the library docs.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use mask::{display_luminance, thresholds, Params};
 use schemas::header::{Input, Schema};
 use schemas::ron_io::read_bytes;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run, StageArgs};
+use schemas::stage::{load_params, print_params, Outputs, Run, StageArgs};
 use schemas::{Error, Result};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -76,10 +77,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     let (Some(input), Some(output)) = (&args.image, &args.output) else {
         return Err(schemas::stage::bad_parameter("IMAGE and -o are required"));
     };
-    check_writable(output)?;
-    if let Some(report) = &args.stage.report {
-        check_writable(report)?;
-    }
+    check_outputs(&[Some(input)], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
     let bytes = read_bytes(input)?;
     run.input(Input::new(input, &bytes, None));
@@ -102,6 +100,5 @@ fn run(args: &Args) -> Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    let args = Args::parse();
-    exit_code(STAGE, run(&args))
+    main_of(STAGE, |args: Args| run(&args))
 }

@@ -1,8 +1,9 @@
 //! `tonemap IMAGE.exr -o OUT.png`: linear HDR image to 8-bit sRGB PNG.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use schemas::image::HdrImage;
-use schemas::stage::{exit_code, load_params, print_params, Run, StageArgs};
+use schemas::stage::{load_params, print_params, Run, StageArgs};
 use schemas::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -55,6 +56,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(input), Some(output)) = (args.image.as_deref(), args.output.as_deref()) else {
         unreachable!("clap requires IMAGE and -o without --print-params")
     };
+    check_outputs(&[Some(input)], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start("tonemap", env!("CARGO_PKG_VERSION"));
     let (image, record, origin) = HdrImage::read_any(input)?;
     if let Some(note) = origin.foreign_note(input, &record) {
@@ -92,5 +94,5 @@ fn write_report(run: &Run, path: &Path, params: &Params, stats: &tonemap::Stats)
 }
 
 fn main() -> ExitCode {
-    exit_code("tonemap", run(Args::parse()))
+    main_of("tonemap", run)
 }
