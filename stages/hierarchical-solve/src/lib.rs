@@ -206,15 +206,42 @@ pub struct Work {
     pub gather_seconds: f64,
 }
 
-/// Progress of a solve, reported after each pass.
+/// Progress of a solve, reported as each phase of a pass begins and when
+/// the pass ends.
 #[derive(Clone, Debug)]
 pub struct Progress {
-    /// Pass just finished (1-based).
+    /// Pass (1-based).
     pub pass: usize,
+    /// What the pass is doing.
+    pub phase: Phase,
     /// Links now.
     pub links: usize,
     /// Elements now.
     pub elements: usize,
+}
+
+/// The phases of one refinement pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Splitting links whose error bound exceeds the threshold.
+    Refining,
+    /// Casting shadow rays for the new links.
+    Visibility,
+    /// Jacobi gathering to convergence.
+    Gathering,
+    /// The pass is finished.
+    Done,
+}
+
+impl std::fmt::Display for Phase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Phase::Refining => "refining links",
+            Phase::Visibility => "casting shadow rays",
+            Phase::Gathering => "gathering",
+            Phase::Done => "done",
+        })
+    }
 }
 
 /// The solve's result: the solution's tables (without header) and the work.
@@ -231,7 +258,8 @@ pub struct Solved {
 
 /// Solves the scene, with the cluster hierarchy `clusters` if given (then
 /// one self-link of the root cluster starts the refinement; without, every
-/// pair of input triangles). `progress` is called after each pass.
+/// pair of input triangles). `progress` is called as each phase of a pass
+/// begins and after the pass.
 pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, params: &Params, progress: &dyn Fn(&Progress)) -> Result<Solved, String> {
     if let Some(problem) = params.problem() {
         return Err(problem);
@@ -274,6 +302,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
     for pass in 1..=passes {
         let started = Instant::now();
         let mut refined_any = false;
+        progress(&Progress { pass, phase: Phase::Refining, links: all_links.len(), elements: h.elements.len() });
         let allowance = match params.criterion {
             // Before the first solve no receiver's radiosity is known.
             Criterion::Relative if pass > 1 => {
@@ -323,6 +352,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         }
         work.refine_seconds += started.elapsed().as_secs_f64();
 
+        progress(&Progress { pass, phase: Phase::Visibility, links: all_links.len(), elements: h.elements.len() });
         let started = Instant::now();
         let rays: usize = all_links
             .par_iter_mut()
@@ -337,6 +367,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         work.rays += rays as u64;
         work.visibility_seconds += started.elapsed().as_secs_f64();
 
+        progress(&Progress { pass, phase: Phase::Gathering, links: all_links.len(), elements: h.elements.len() });
         let started = Instant::now();
         all_links.par_sort_unstable_by_key(|l| (h.flat(l.receiver), h.flat(l.sender)));
         let offsets = csr_offsets(&h, &all_links, b.len());
@@ -351,7 +382,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         work.extrapolations += convergence.extrapolations;
         work.gather_seconds += started.elapsed().as_secs_f64();
         work.passes = pass;
-        progress(&Progress { pass, links: all_links.len(), elements: h.elements.len() });
+        progress(&Progress { pass, phase: Phase::Done, links: all_links.len(), elements: h.elements.len() });
         if !refined_any && pass > 1 {
             break;
         }

@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use schemas::cli::{check_outputs, main_of};
-use hierarchical_solve::{solve, Criterion, Params};
+use hierarchical_solve::{solve, Criterion, Params, Phase};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::Effects;
@@ -106,7 +106,6 @@ fn skipped(effects: &Effects) -> Vec<String> {
         (effects.specular_reflection, "specular reflection: not simulated by hierarchical-solve; mirrors keep their diffuse part only"),
         (effects.specular_transmission, "specular transmission: not simulated by hierarchical-solve"),
         (effects.diffuse_transmission, "diffuse transmission: not simulated by hierarchical-solve"),
-        (effects.goniometric_lights, "goniometric lights: not simulated by hierarchical-solve; only emitting surfaces light the scene"),
         (effects.textures, "textures: radiosity uses each material's mean diffuse reflectance"),
         (effects.alpha_masks, "alpha masks: surfaces are treated as opaque"),
         (effects.normal_maps, "normal maps: radiosity uses geometric normals"),
@@ -125,6 +124,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     check_outputs(&[args.mesh.as_deref(), args.manifest.as_deref(), args.clusters.as_deref()], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start("hierarchical-solve", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
+    radiometry::photometry::Luminaire::all(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
     let clusters = match &args.clusters {
         Some(path) => {
             let (clusters, input) = Clusters::read(path, mesh.triangles.len())?;
@@ -135,9 +135,11 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     };
     let clustered = clusters.is_some();
     let bar = progress(params.max_passes as u64, "passes");
+    // Ticking, so a long phase shows it is alive.
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
     let solved = solve(&mesh, &manifest, clusters, &params, &|p| {
-        bar.set_position(p.pass as u64);
-        bar.set_message(format!("{} links", p.links));
+        bar.set_position(p.pass as u64 - u64::from(p.phase != Phase::Done));
+        bar.set_message(format!("pass {}: {} ({} links, {} elements)", p.pass, p.phase, p.links, p.elements));
     })
     .map_err(|message| schemas::Error::invalid(mesh_path, None, message))?;
     bar.finish_and_clear();
@@ -180,6 +182,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("refine_seconds".to_string(), w.refine_seconds),
             ("visibility_seconds".to_string(), w.visibility_seconds),
             ("gather_seconds".to_string(), w.gather_seconds),
+            ("luminaires".to_string(), manifest.goniometric_lights.len() as f64),
+            ("luminaire_rays".to_string(), w.luminaire_rays as f64),
+            ("luminaire_seconds".to_string(), w.luminaire_seconds),
             ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
         ]);
         // Left out where unknown (no contraction below 1 was known).
