@@ -10,7 +10,7 @@
 //! continue below them in the solution.
 
 use crate::error::{Error, Result};
-use crate::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer};
+use crate::exr_io::{check_finite, check_forest, read_exr, write_exr, Channel, ExrArtifact, Layer};
 use crate::header::{Header, Input, Schema};
 use crate::solution::NONE;
 use std::path::Path;
@@ -101,11 +101,14 @@ impl Clusters {
         write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![cluster, order] })
     }
 
-    /// Reads `clusters.exr` and checks its indices against `triangles`
-    /// input triangles.
+    /// Reads `clusters.exr` over a mesh of `triangles` input triangles and
+    /// checks its structure (see [`Clusters::check`]), so that a stage may
+    /// walk and index it without further checks.
     pub fn read(path: &Path, triangles: usize) -> Result<(Clusters, Input)> {
         let (artifact, input) = read_exr::<Clusters>(path)?;
         let l = artifact.layer(path, "cluster")?;
+        let floats = ["min.X", "min.Y", "min.Z", "max.X", "max.Y", "max.Z", "area", "rhoA.R", "rhoA.G", "rhoA.B", "axis.X", "axis.Y", "axis.Z", "cos"];
+        check_finite(path, l, "cluster", &floats)?;
         let u = |name: &str| l.u32s(path, name);
         let f = |name: &str| l.f32s(path, name);
         let (parent, first_child, child_count, first_triangle, triangle_count) =
@@ -114,8 +117,7 @@ impl Clusters {
         let (area, rho) = (f("area")?, [f("rhoA.R")?, f("rhoA.G")?, f("rhoA.B")?]);
         let (axis, cos) = ([f("axis.X")?, f("axis.Y")?, f("axis.Z")?], f("cos")?);
         let order = artifact.layer(path, "order")?.u32s(path, "triangle")?.to_vec();
-        let count = l.len();
-        let nodes: Vec<ClusterNode> = (0..count)
+        let nodes: Vec<ClusterNode> = (0..l.len())
             .map(|i| ClusterNode {
                 parent: parent[i],
                 first_child: first_child[i],
@@ -130,17 +132,181 @@ impl Clusters {
                 normal_cos: cos[i],
             })
             .collect();
-        if order.len() != triangles || order.iter().any(|&t| t as usize >= triangles) {
-            return Err(Error::invalid(path, None, format!("cluster order does not cover the mesh's {triangles} triangles")));
+        Clusters::check(path, &nodes, &order, triangles)?;
+        Ok((Clusters { header: artifact.header, nodes, order }, input))
+    }
+
+    /// The invariants every reader of a hierarchy relies on, checked on
+    /// read; a file that breaks one is refused with the cluster and the
+    /// field it concerns:
+    ///
+    /// - `order` holds every one of the mesh's `triangles` exactly once;
+    /// - there is a root, cluster 0, whose `parent` is [`NONE`] and whose
+    ///   range is all of `order`;
+    /// - the clusters form a tree below the root: child ranges lie inside
+    ///   the table, no cycle, every cluster reached exactly once, each child
+    ///   naming its parent (see [`check_forest`]);
+    /// - a cluster is a leaf exactly when `first_child` is [`NONE`];
+    /// - every cluster is non-empty, its triangle range inside `order`;
+    /// - the children of a cluster split its triangle range in order;
+    /// - bounds, areas, reflectances and cone axes are finite (checked with
+    ///   the channels), areas not negative, the cone cosine in [-1, 1].
+    fn check(path: &Path, nodes: &[ClusterNode], order: &[u32], triangles: usize) -> Result<()> {
+        let invalid = |message: String| Err(Error::invalid(path, None, message));
+        if order.len() != triangles {
+            return invalid(format!("layer 'order' lists {} triangles; the mesh has {triangles}", order.len()));
         }
-        for (i, c) in nodes.iter().enumerate() {
-            let children_ok = c.child_count == 0 || (c.first_child != NONE && (c.first_child + c.child_count) as usize <= count);
-            let range_ok = (c.first_triangle as u64 + c.triangle_count as u64) <= order.len() as u64;
-            let parent_ok = (i == 0) == (c.parent == NONE) && (c.parent == NONE || (c.parent as usize) < i);
-            if !children_ok || !range_ok || !parent_ok {
-                return Err(Error::invalid(path, None, format!("cluster {i} links outside the hierarchy")));
+        let mut listed = vec![false; triangles];
+        for (k, &t) in order.iter().enumerate() {
+            match listed.get_mut(t as usize) {
+                None => return invalid(format!("order {k}: triangle {t} is not one of the mesh's {triangles}")),
+                Some(true) => return invalid(format!("order {k}: triangle {t} is listed twice")),
+                Some(seen) => *seen = true,
             }
         }
-        Ok((Clusters { header: artifact.header, nodes, order }, input))
+        let Some(root) = nodes.first() else { return invalid("layer 'cluster' has no root cluster".into()) };
+        if root.parent != NONE || root.first_triangle != 0 || root.triangle_count as usize != triangles {
+            return invalid(format!(
+                "cluster 0: the root must have parent {NONE} and all {triangles} triangles, not parent {} and triangles {}+{} (fields parent, first_triangle, triangle_count)",
+                root.parent, root.first_triangle, root.triangle_count
+            ));
+        }
+        for (i, c) in nodes.iter().enumerate() {
+            if (c.child_count == 0) != (c.first_child == NONE) {
+                return invalid(format!("cluster {i}: first_child {} does not agree with child_count {}", c.first_child, c.child_count));
+            }
+            if c.triangle_count == 0 {
+                return invalid(format!("cluster {i}: holds no triangle (field triangle_count)"));
+            }
+            if c.first_triangle as u64 + c.triangle_count as u64 > triangles as u64 {
+                return invalid(format!(
+                    "cluster {i}: triangles {}+{} run past the end of the order of {triangles} (fields first_triangle, triangle_count)",
+                    c.first_triangle, c.triangle_count
+                ));
+            }
+            if c.area < 0.0 || !(-1.0..=1.0).contains(&c.normal_cos) {
+                return invalid(format!("cluster {i}: area {} or cone cosine {} out of range (fields area, cos)", c.area, c.normal_cos));
+            }
+        }
+        check_forest(path, "cluster", nodes.len(), 0..1, |i| (nodes[i].first_child, nodes[i].child_count), |i| nodes[i].parent)?;
+        for (i, c) in nodes.iter().enumerate().filter(|(_, c)| !c.is_leaf()) {
+            let mut next = c.first_triangle;
+            for k in c.first_child..c.first_child + c.child_count {
+                let child = &nodes[k as usize];
+                if child.first_triangle != next {
+                    return invalid(format!(
+                        "cluster {k}: triangles start at {}, but its parent cluster {i} has them start at {next} (field first_triangle)",
+                        child.first_triangle
+                    ));
+                }
+                next += child.triangle_count;
+            }
+            if next != c.first_triangle + c.triangle_count {
+                return invalid(format!(
+                    "cluster {i}: its children hold {} of its {} triangles (field triangle_count)",
+                    next - c.first_triangle,
+                    c.triangle_count
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::header::Provenance;
+
+    fn node(parent: u32, children: (u32, u32), triangles: (u32, u32)) -> ClusterNode {
+        ClusterNode {
+            parent,
+            first_child: if children.1 == 0 { NONE } else { children.0 },
+            child_count: children.1,
+            first_triangle: triangles.0,
+            triangle_count: triangles.1,
+            bounds_min: [0.0; 3],
+            bounds_max: [1.0; 3],
+            area: 1.0,
+            reflectance_area: [0.5; 3],
+            normal_axis: [0.0, 0.0, 1.0],
+            normal_cos: 1.0,
+        }
+    }
+
+    /// A root over four triangles with two leaves of two each.
+    fn clusters() -> Clusters {
+        Clusters {
+            header: Clusters::header(Provenance::in_memory("test")),
+            nodes: vec![node(NONE, (1, 2), (0, 4)), node(0, (0, 0), (0, 2)), node(0, (0, 0), (2, 2))],
+            order: vec![3, 1, 0, 2],
+        }
+    }
+
+    /// Writes `clusters` with the writer, reads it back over 4 triangles.
+    fn round_trip(name: &str, clusters: &Clusters) -> (std::path::PathBuf, Result<Clusters>) {
+        let path = std::env::temp_dir().join(format!("clusters-{name}-{}.exr", std::process::id()));
+        clusters.write(&path).unwrap();
+        let back = Clusters::read(&path, 4).map(|(c, _)| c);
+        (path, back)
+    }
+
+    /// The message reading `clusters` gives; it must name the file.
+    fn refusal(name: &str, clusters: &Clusters) -> String {
+        let (path, back) = round_trip(name, clusters);
+        let message = back.unwrap_err().to_string();
+        assert!(message.starts_with(&path.display().to_string()), "{message}");
+        std::fs::remove_file(&path).unwrap();
+        message
+    }
+
+    #[test]
+    fn a_valid_hierarchy_round_trips() {
+        let (path, back) = round_trip("valid", &clusters());
+        assert_eq!(back.unwrap(), clusters());
+        std::fs::remove_file(&path).unwrap();
+    }
+
+    #[test]
+    fn a_cycle_is_refused_naming_the_cluster_reached_twice() {
+        let mut cyclic = clusters();
+        cyclic.nodes[2] = node(0, (0, 1), (2, 2));
+        let message = refusal("cycle", &cyclic);
+        assert!(message.ends_with("cluster 0: reached twice from the root, through cluster 2 (a cycle or a shared child; field first_child)"), "{message}");
+        // A cycle the root does not reach: still refused, never walked forever.
+        let mut detached = clusters();
+        detached.nodes.extend([node(4, (4, 1), (0, 1)), node(3, (3, 1), (0, 1))]);
+        let message = refusal("detached", &detached);
+        assert!(message.ends_with("cluster 3: not reachable from the root (field parent is 4)"), "{message}");
+    }
+
+    #[test]
+    fn an_empty_cluster_is_refused() {
+        let mut empty = clusters();
+        empty.nodes[1].triangle_count = 0;
+        let message = refusal("empty", &empty);
+        assert!(message.ends_with("cluster 1: holds no triangle (field triangle_count)"), "{message}");
+    }
+
+    #[test]
+    fn a_child_range_past_the_end_is_refused() {
+        let mut past = clusters();
+        past.nodes[0].child_count = 5;
+        let message = refusal("past", &past);
+        assert!(message.ends_with("cluster 0: children 1..6 run past the end of the table of 3 (field first_child)"), "{message}");
+    }
+
+    #[test]
+    fn children_that_do_not_split_their_parent_are_refused() {
+        let mut overlapping = clusters();
+        overlapping.nodes[2].first_triangle = 1;
+        let message = refusal("overlap", &overlapping);
+        assert!(message.ends_with("cluster 2: triangles start at 1, but its parent cluster 0 has them start at 2 (field first_triangle)"), "{message}");
+        let mut twice = clusters();
+        twice.order[3] = 3;
+        assert!(refusal("twice", &twice).ends_with("order 3: triangle 3 is listed twice"));
+        let mut nan = clusters();
+        nan.nodes[1].area = f32::NAN;
+        assert!(refusal("nan", &nan).ends_with("cluster 1: field area is NaN"));
     }
 }

@@ -143,10 +143,7 @@ impl Layer {
 
     /// Number of records (tables) or pixels (images).
     pub fn len(&self) -> usize {
-        match self.kind {
-            LayerKind::Image { width, height } => width * height,
-            LayerKind::Table { records } => records,
-        }
+        self.kind.len()
     }
 
     /// Whether the layer holds no record.
@@ -165,15 +162,90 @@ impl Layer {
         Error::invalid(path, None, format!("channel '{name}' of layer '{}' is not {wanted}", self.name))
     }
 
-    /// Pixel dimensions of the layer in the file.
-    fn stored_size(&self) -> (usize, usize) {
-        match self.kind {
+}
+
+impl LayerKind {
+    /// Number of records (tables) or pixels (images).
+    fn len(self) -> usize {
+        match self {
+            LayerKind::Image { width, height } => width * height,
+            LayerKind::Table { records } => records,
+        }
+    }
+
+    /// Pixel dimensions of a layer of this kind in the file.
+    fn stored_size(self) -> (usize, usize) {
+        match self {
             LayerKind::Image { width, height } => (width, height),
             LayerKind::Table { records } => {
                 let width = records.clamp(1, TABLE_WIDTH);
                 (width, records.div_ceil(width).max(1))
             }
         }
+    }
+}
+
+/// Refuses a table whose `f32` channels `names` hold a value that is not
+/// finite, naming the first such record: `record 12: field area is NaN`.
+/// `record` is what one row of the layer is (`cluster`, `element`).
+pub(crate) fn check_finite(path: &Path, layer: &Layer, record: &str, names: &[&str]) -> Result<()> {
+    for name in names {
+        let values = layer.f32s(path, name)?;
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::invalid(path, None, format!("{record} {i}: field {name} is {}", values[i])));
+        }
+    }
+    Ok(())
+}
+
+/// Checks that the `count` records of a hierarchy table form a forest
+/// whose roots are the records `roots`, so that a walk from them visits
+/// every record exactly once and ends: `children(i)` gives record `i`'s
+/// children as `(first, number)`, the records `first .. first + number`;
+/// `parent(i)` the parent record `i` names. Refused, naming the record and
+/// the field: a child range past the end of the table (`first_child`), a
+/// record reached twice, which a cycle or a child of two parents gives
+/// (`first_child`), a child whose `parent` is another record, and a record
+/// no root reaches (`parent`). `record` is what one row is (`cluster`).
+/// The walk keeps its own stack, so a deep or cyclic file cannot overflow
+/// or hang it. `roots` must lie in `0..count`.
+pub(crate) fn check_forest(
+    path: &Path,
+    record: &str,
+    count: usize,
+    roots: std::ops::Range<usize>,
+    children: impl Fn(usize) -> (u32, u32),
+    parent: impl Fn(usize) -> u32,
+) -> Result<()> {
+    let invalid = |message: String| Err(Error::invalid(path, None, message));
+    let mut reached = vec![false; count];
+    let mut stack: Vec<usize> = roots.collect();
+    for &root in &stack {
+        reached[root] = true;
+    }
+    while let Some(i) = stack.pop() {
+        let (first, number) = children(i);
+        let end = first as u64 + number as u64;
+        if number > 0 && end > count as u64 {
+            return invalid(format!("{record} {i}: children {first}..{end} run past the end of the table of {count} (field first_child)"));
+        }
+        for child in first as usize..end as usize {
+            if reached[child] {
+                return invalid(format!(
+                    "{record} {child}: reached twice from the root, through {record} {i} (a cycle or a shared child; field first_child)"
+                ));
+            }
+            let named = parent(child);
+            if named as usize != i {
+                return invalid(format!("{record} {child}: field parent is {named}, but {record} {i} lists it as a child"));
+            }
+            reached[child] = true;
+            stack.push(child);
+        }
+    }
+    match reached.iter().position(|r| !r) {
+        Some(lost) => invalid(format!("{record} {lost}: not reachable from the root (field parent is {})", parent(lost))),
+        None => Ok(()),
     }
 }
 
@@ -215,7 +287,7 @@ pub fn write_exr(path: &Path, artifact: &ExrArtifact) -> Result<()> {
     let mut exr_layers = Vec::with_capacity(artifact.layers.len());
     let mut bounds = (1, 1);
     for layer in &artifact.layers {
-        let (width, height) = layer.stored_size();
+        let (width, height) = layer.kind.stored_size();
         bounds = (bounds.0.max(width), bounds.1.max(height));
         let stored = width * height;
         let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = layer
@@ -323,10 +395,17 @@ pub fn read_exr_or_foreign<S: Schema>(path: &Path) -> Result<(ExrFile, Input)> {
             .iter()
             .find(|l| layer_name(l) == described.name)
             .ok_or_else(|| Error::invalid(path, None, format!("layer '{}' described but absent", described.name)))?;
-        let layer_len = match described.kind {
-            LayerKind::Image { width, height } => width * height,
-            LayerKind::Table { records } => records,
-        };
+        // The described size must be the stored one: it bounds every index
+        // computed from it by data that was actually decoded.
+        let size = (stored.size.width(), stored.size.height());
+        if described.kind.stored_size() != size {
+            return Err(Error::invalid(
+                path,
+                None,
+                format!("layer '{}': header says {:?}, but the stored layer is {}x{} pixels", described.name, described.kind, size.0, size.1),
+            ));
+        }
+        let layer_len = described.kind.len();
         let mut channels = Vec::with_capacity(described.channels.len());
         for (name, meaning) in &described.channels {
             let data = stored

@@ -36,7 +36,7 @@
 //! a refined triangle would get a larger `size`.
 
 use crate::error::{Error, Result};
-use crate::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer, LayerKind};
+use crate::exr_io::{check_finite, read_exr, write_exr, Channel, ExrArtifact, Layer, LayerKind};
 use crate::header::{Header, Input, Provenance, Schema};
 use crate::ron_io::RonArtifact;
 use serde::{Deserialize, Serialize};
@@ -149,13 +149,19 @@ impl Lightmap {
         write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![atlas, region] })
     }
 
-    /// Reads `lightmap.exr` and checks that every region lies in the atlas.
+    /// Reads `lightmap.exr` and checks its structure: every atlas value
+    /// finite; every region non-empty (`size` at least 1), inside the
+    /// atlas with its gutter, with `covered = size (size + 1) / 2` and a
+    /// finite, non-negative `texel_area`. A region that breaks one is
+    /// refused with its triangle and field.
     pub fn read(path: &Path) -> Result<(Lightmap, Input)> {
         let (artifact, input) = read_exr::<Lightmap>(path)?;
         let atlas = artifact.layer(path, "atlas")?;
         let LayerKind::Image { width, height } = atlas.kind else {
             return Err(Error::invalid(path, None, "layer 'atlas' is a table"));
         };
+        let floats = ["B.R", "B.G", "B.B", "dB.R", "dB.G", "dB.B", "coverage", "area", "P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z"];
+        check_finite(path, atlas, "texel", &floats)?;
         let three = |names: [&str; 3]| -> Result<Vec<[f32; 3]>> {
             let (a, b, c) = (atlas.f32s(path, names[0])?, atlas.f32s(path, names[1])?, atlas.f32s(path, names[2])?);
             Ok((0..width * height).map(|i| [a[i], b[i], c[i]]).collect())
@@ -173,7 +179,17 @@ impl Lightmap {
         for i in 0..table.len() {
             let r = Region { x: x[i], y: y[i], size: size[i], covered: covered[i], texel_area: area[i] };
             if r.x as usize + r.size as usize + 2 > width || r.y as usize + r.size as usize + 2 > height {
-                return Err(Error::invalid(path, None, format!("region of triangle {i} lies outside the {width}x{height} atlas")));
+                return Err(Error::invalid(
+                    path,
+                    None,
+                    format!("region {i}: {0}x{0} texels at ({1}, {2}) lie outside the {width}x{height} atlas (fields x, y, size)", r.size as u64 + 2, r.x, r.y),
+                ));
+            }
+            if r.size == 0 || r.covered as u64 != r.size as u64 * (r.size as u64 + 1) / 2 {
+                return Err(Error::invalid(path, None, format!("region {i}: size {} with {} covered texels (fields size, covered)", r.size, r.covered)));
+            }
+            if !r.texel_area.is_finite() || r.texel_area < 0.0 {
+                return Err(Error::invalid(path, None, format!("region {i}: field texel_area is {}", r.texel_area)));
             }
             regions.push(r);
         }
@@ -258,7 +274,11 @@ mod tests {
         lightmap.regions[0].x = 2;
         lightmap.write(&path).unwrap();
         let message = Lightmap::read(&path).unwrap_err().to_string();
-        assert!(message.contains("outside"), "{message}");
+        assert_eq!(message, format!("{}: region 0: 5x5 texels at (2, 0) lie outside the 6x5 atlas (fields x, y, size)", path.display()));
+        lightmap.regions[0] = Region { x: 0, y: 0, size: 3, covered: 5, texel_area: 0.125 };
+        lightmap.write(&path).unwrap();
+        let message = Lightmap::read(&path).unwrap_err().to_string();
+        assert!(message.ends_with("region 0: size 3 with 5 covered texels (fields size, covered)"), "{message}");
         std::fs::remove_file(&path).unwrap();
     }
 }

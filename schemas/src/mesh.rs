@@ -7,7 +7,7 @@
 //! when the scene file places the model a thousand kilometres away.
 
 use crate::error::{Error, Result};
-use crate::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer};
+use crate::exr_io::{check_finite, read_exr, write_exr, Channel, ExrArtifact, Layer};
 use crate::header::{Header, Input, Provenance, Schema};
 use crate::ron_io::RonArtifact;
 use serde::{Deserialize, Serialize};
@@ -76,24 +76,25 @@ impl Mesh {
         write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![vertex, triangle] })
     }
 
-    /// Reads and validates `mesh.exr`: indices in range, positions finite.
+    /// Reads and validates `mesh.exr`: positions, areas and normals finite,
+    /// every vertex index in range. The material and object indices are
+    /// checked against the manifest by [`Manifest::check_mesh`].
     pub fn read(path: &Path) -> Result<(Mesh, Input)> {
         let (artifact, input) = read_exr::<Mesh>(path)?;
         let vertex = artifact.layer(path, "vertex")?;
+        check_finite(path, vertex, "vertex", &["P.X", "P.Y", "P.Z"])?;
         let (x, y, z) = (vertex.f32s(path, "P.X")?, vertex.f32s(path, "P.Y")?, vertex.f32s(path, "P.Z")?);
         let positions: Vec<[f32; 3]> = (0..vertex.len()).map(|i| [x[i], y[i], z[i]]).collect();
-        if let Some(i) = positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-            return Err(Error::invalid(path, None, format!("vertex {i} has a non-finite coordinate")));
-        }
         let tri = artifact.layer(path, "triangle")?;
+        check_finite(path, tri, "triangle", &["area", "N.X", "N.Y", "N.Z"])?;
         let v = [tri.u32s(path, "v0")?, tri.u32s(path, "v1")?, tri.u32s(path, "v2")?];
         let (material, object, area) = (tri.u32s(path, "material")?, tri.u32s(path, "object")?, tri.f32s(path, "area")?);
         let n = [tri.f32s(path, "N.X")?, tri.f32s(path, "N.Y")?, tri.f32s(path, "N.Z")?];
         let mut triangles = Vec::with_capacity(tri.len());
         for i in 0..tri.len() {
             let vertices = [v[0][i], v[1][i], v[2][i]];
-            if vertices.iter().any(|&k| k as usize >= positions.len()) {
-                return Err(Error::invalid(path, None, format!("triangle {i} indexes a vertex out of range")));
+            if let Some(k) = vertices.iter().position(|&k| k as usize >= positions.len()) {
+                return Err(Error::invalid(path, None, format!("triangle {i}: field v{k} names vertex {}, but the mesh has {}", vertices[k], positions.len())));
             }
             triangles.push(Triangle { vertices, material: material[i], object: object[i], area: area[i], normal: [n[0][i], n[1][i], n[2][i]] });
         }
@@ -143,18 +144,38 @@ pub struct Material {
     pub normal_map: Option<String>,
 }
 
-/// A goniometric point light: an EULUMDAT or IES file placed in the scene.
+/// A goniometric point light (luminaire) as data: `mesh-prep` read and
+/// validated its EULUMDAT or IES file, expanded the file's symmetry to a
+/// full sphere of type C angles and converted it to absolute candela; no
+/// later stage opens a photometric file. The radiant intensity towards a
+/// direction with angles `(C, gamma)` in the frame `(c0, nadir x c0,
+/// nadir)` is `scale x I(C, gamma) / 683` W/sr (paper 004 Eq. 2.12, 3.4),
+/// `I` the bicubic Catmull-Rom interpolation of the table
+/// (`radiometry::photometry`).
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct GoniometricLight {
-    /// Photometric file (.ldt or .ies), as given in the scene.
-    pub file: String,
+    /// The photometric file it was read from, as the scene names it: a
+    /// label only (the table below is the data).
+    pub label: String,
     /// Position, mesh frame, m.
     pub position: [f64; 3],
-    /// Direction of the luminaire's nadir (C-plane axis), unit.
+    /// Direction of the luminaire's nadir (gamma = 0), unit.
     pub nadir: [f64; 3],
-    /// Multiplier on the file's intensities.
+    /// Direction of the C0 half-plane, unit, perpendicular to `nadir`.
+    pub c0: [f64; 3],
+    /// Multiplier on the table's intensities, finite and > 0.
     pub scale: f64,
+    /// C angles, degrees, strictly increasing in `[0, 360)`; periodic.
+    pub c_angles_deg: Vec<f64>,
+    /// Gamma angles, degrees, strictly increasing from 0 to 180.
+    pub gamma_angles_deg: Vec<f64>,
+    /// Luminous intensity, cd, before `scale`: `[c * gamma_angles_deg.len()
+    /// + gamma]`.
+    pub intensity_cd: Vec<f64>,
+    /// Total luminous flux of the light as placed (`scale` included), lm,
+    /// integrated from the interpolated table.
+    pub flux_lm: f64,
 }
 
 /// Which phenomena the scene contains. Every stage reads this and runs only
@@ -243,7 +264,7 @@ pub struct Manifest {
 
 impl Schema for Manifest {
     const NAME: &'static str = "manifest";
-    const VERSION: u32 = 1;
+    const VERSION: u32 = 2;
 }
 
 impl RonArtifact for Manifest {
@@ -253,16 +274,15 @@ impl RonArtifact for Manifest {
 }
 
 impl Manifest {
-    /// Checks that `mesh` belongs to this manifest: every material and
-    /// object index in range.
+    /// Checks that `mesh` fits this manifest: every material and object
+    /// index in range of its lists. (That both come from one run is
+    /// checked by [`crate::stage::read_prepared`].)
     pub fn check_mesh(&self, mesh_path: &Path, mesh: &Mesh) -> Result<()> {
         for (i, t) in mesh.triangles.iter().enumerate() {
-            if t.material as usize >= self.materials.len() || t.object as usize >= self.objects.len() {
-                return Err(Error::invalid(
-                    mesh_path,
-                    None,
-                    format!("triangle {i} names material {} / object {}, which the manifest does not have", t.material, t.object),
-                ));
+            for (field, index, count) in [("material", t.material, self.materials.len()), ("object", t.object, self.objects.len())] {
+                if index as usize >= count {
+                    return Err(Error::invalid(mesh_path, None, format!("triangle {i}: field {field} is {index}, but the manifest has {count} {field}s")));
+                }
             }
         }
         Ok(())

@@ -5,7 +5,7 @@
 //! clusters (the final gather reads them).
 
 use crate::error::{Error, Result};
-use crate::exr_io::{read_exr, write_exr, Channel, ExrArtifact, Layer};
+use crate::exr_io::{check_finite, check_forest, read_exr, write_exr, Channel, ExrArtifact, Layer};
 use crate::header::{Header, Input, Schema};
 use std::path::Path;
 
@@ -62,11 +62,13 @@ impl Node {
         matches!(self, Node::Cluster(_)) as u32
     }
 
-    fn new(index: u32, is_cluster: u32) -> Self {
-        if is_cluster == 0 {
-            Node::Element(index)
-        } else {
-            Node::Cluster(index)
+    /// The `end` (`receiver` or `sender`) of link `link` as stored: its
+    /// index and its `_is_cluster` flag, which must be 0 or 1.
+    fn read(path: &Path, link: usize, end: &str, index: u32, is_cluster: u32) -> Result<Self> {
+        match is_cluster {
+            0 => Ok(Node::Element(index)),
+            1 => Ok(Node::Cluster(index)),
+            other => Err(Error::invalid(path, None, format!("link {link}: field {end}_is_cluster is {other}, not 0 or 1"))),
         }
     }
 }
@@ -179,10 +181,13 @@ impl Solution {
         write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![element, cluster, link] })
     }
 
-    /// Reads `solution.exr` and checks the hierarchy's indices.
+    /// Reads `solution.exr` and checks its structure (see
+    /// [`Solution::check_elements`] and [`Solution::check_link`]), so that a
+    /// stage may walk and index it without further checks.
     pub fn read(path: &Path) -> Result<(Solution, Input)> {
         let (artifact, input) = read_exr::<Solution>(path)?;
         let el = artifact.layer(path, "element")?;
+        check_finite(path, el, "element", &["c0.u", "c0.v", "c1.u", "c1.v", "c2.u", "c2.v", "area", "B.R", "B.G", "B.B"])?;
         let u = |name: &str| el.u32s(path, name);
         let f = |name: &str| el.f32s(path, name);
         let (triangle, parent, first_child, level) = (u("triangle")?, u("parent")?, u("first_child")?, u("level")?);
@@ -200,41 +205,169 @@ impl Solution {
                 radiosity: [b[0][i], b[1][i], b[2][i]],
             })
             .collect();
-        for (i, e) in elements.iter().enumerate() {
-            let bad_parent = e.parent != NONE && e.parent as usize >= n;
-            let bad_child = e.first_child != NONE && e.first_child as usize + 4 > n;
-            if bad_parent || bad_child {
-                return Err(Error::invalid(path, None, format!("element {i} links outside the element table")));
-            }
-        }
+        Solution::check_elements(path, &elements)?;
         let cl = artifact.layer(path, "cluster")?;
+        check_finite(path, cl, "cluster", &["area", "B.R", "B.G", "B.B"])?;
         let (cluster_area, cb) = (cl.f32s(path, "area")?, [cl.f32s(path, "B.R")?, cl.f32s(path, "B.G")?, cl.f32s(path, "B.B")?]);
         let clusters: Vec<ClusterRadiosity> =
             (0..cl.len()).map(|i| ClusterRadiosity { area: cluster_area[i], radiosity: [cb[0][i], cb[1][i], cb[2][i]] }).collect();
         let li = artifact.layer(path, "link")?;
+        check_finite(path, li, "link", &["F", "V", "Eu.R", "Eu.G", "Eu.B"])?;
         let (receiver, sender) = (li.u32s(path, "receiver")?, li.u32s(path, "sender")?);
         let (receiver_kind, sender_kind) = (li.u32s(path, "receiver_is_cluster")?, li.u32s(path, "sender_is_cluster")?);
         let (ff, vis, dist) = (li.f32s(path, "F")?, li.f32s(path, "V")?, li.f32s(path, "occluder_distance")?);
         let eu = [li.f32s(path, "Eu.R")?, li.f32s(path, "Eu.G")?, li.f32s(path, "Eu.B")?];
         let mut links = Vec::with_capacity(li.len());
-        let in_range = |node: Node| match node {
-            Node::Element(e) => (e as usize) < n,
-            Node::Cluster(c) => (c as usize) < clusters.len(),
-        };
         for i in 0..li.len() {
-            let (r, s) = (Node::new(receiver[i], receiver_kind[i]), Node::new(sender[i], sender_kind[i]));
-            if !in_range(r) || !in_range(s) {
-                return Err(Error::invalid(path, None, format!("link {i} names an element or cluster out of range")));
-            }
-            links.push(Link {
+            let (r, s) = (Node::read(path, i, "receiver", receiver[i], receiver_kind[i])?, Node::read(path, i, "sender", sender[i], sender_kind[i])?);
+            let link = Link {
                 receiver: r,
                 sender: s,
                 form_factor: ff[i],
                 visibility: vis[i],
                 unoccluded_irradiance: [eu[0][i], eu[1][i], eu[2][i]],
                 occluder_distance: dist[i],
-            });
+            };
+            Solution::check_link(path, i, &link, n, clusters.len())?;
+            links.push(link);
         }
         Ok((Solution { header: artifact.header, elements, clusters, links }, input))
+    }
+
+    /// The invariants of the element table, checked on read; a file that
+    /// breaks one is refused with the element and the field it concerns:
+    ///
+    /// - the input triangles' elements come first: element `t < roots` has
+    ///   `parent` [`NONE`], `triangle` `t` and `level` 0, and no later
+    ///   element is a root;
+    /// - the elements form a forest below them: each inner element's four
+    ///   children lie inside the table, no cycle, every element reached
+    ///   exactly once, each child naming its parent (see [`check_forest`]);
+    /// - a child lies on its parent's triangle, one level deeper;
+    /// - corners, areas and radiosities are finite (checked with the
+    ///   channels), areas not negative.
+    fn check_elements(path: &Path, elements: &[Element]) -> Result<()> {
+        let invalid = |message: String| Err(Error::invalid(path, None, message));
+        let roots = elements.iter().position(|e| e.parent != NONE).unwrap_or(elements.len());
+        for (i, e) in elements.iter().enumerate() {
+            if i < roots && (e.triangle as usize != i || e.level != 0) {
+                return invalid(format!("element {i}: a root must lie on triangle {i} at level 0, not triangle {} level {}", e.triangle, e.level));
+            }
+            if e.area < 0.0 {
+                return invalid(format!("element {i}: field area is {}", e.area));
+            }
+        }
+        let children = |i: usize| if elements[i].is_leaf() { (NONE, 0) } else { (elements[i].first_child, 4) };
+        check_forest(path, "element", elements.len(), 0..roots, children, |i| elements[i].parent)?;
+        for (i, e) in elements.iter().enumerate().skip(roots) {
+            let parent = &elements[e.parent as usize];
+            if e.triangle != parent.triangle || parent.level.checked_add(1) != Some(e.level) {
+                return invalid(format!(
+                    "element {i}: on triangle {} at level {}, but its parent element {} is on triangle {} at level {} (fields triangle, level)",
+                    e.triangle, e.level, e.parent, parent.triangle, parent.level
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The invariants of link `i`, checked on read: both ends name an
+    /// element (of `elements`) or a cluster (of `clusters`) that exists,
+    /// and the occluder distance is not NaN (+inf: no occluder; the other
+    /// numbers are checked finite with their channels).
+    fn check_link(path: &Path, i: usize, link: &Link, elements: usize, clusters: usize) -> Result<()> {
+        for (end, node) in [("receiver", link.receiver), ("sender", link.sender)] {
+            let (kind, index, count) = match node {
+                Node::Element(e) => ("element", e, elements),
+                Node::Cluster(c) => ("cluster", c, clusters),
+            };
+            if index as usize >= count {
+                return Err(Error::invalid(path, None, format!("link {i}: field {end} names {kind} {index}, but the solution has {count}")));
+            }
+        }
+        match link.occluder_distance.is_nan() {
+            true => Err(Error::invalid(path, None, format!("link {i}: field occluder_distance is NaN"))),
+            false => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::header::Provenance;
+
+    fn element(triangle: u32, parent: u32, first_child: u32, level: u32) -> Element {
+        Element { triangle, parent, first_child, level, corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], area: 0.5, radiosity: [1.0; 3] }
+    }
+
+    /// Two input triangles; the second split into elements 2..6.
+    fn solution() -> Solution {
+        let mut elements = vec![element(0, NONE, NONE, 0), element(1, NONE, 2, 0)];
+        elements.extend((0..4).map(|_| element(1, 1, NONE, 1)));
+        let link = Link {
+            receiver: Node::Element(2),
+            sender: Node::Cluster(0),
+            form_factor: 0.25,
+            visibility: 1.0,
+            unoccluded_irradiance: [0.5; 3],
+            occluder_distance: f32::INFINITY,
+        };
+        Solution {
+            header: Solution::header(Provenance::in_memory("test")),
+            elements,
+            clusters: vec![ClusterRadiosity { area: 1.0, radiosity: [2.0; 3] }],
+            links: vec![link],
+        }
+    }
+
+    /// The outcome of writing `solution` with the writer and reading it
+    /// back; an error message must name the file.
+    fn round_trip(name: &str, solution: &Solution) -> Result<Solution, String> {
+        let path = std::env::temp_dir().join(format!("solution-{name}-{}.exr", std::process::id()));
+        solution.write(&path).unwrap();
+        let back = Solution::read(&path).map(|(s, _)| s).map_err(|e| e.to_string());
+        std::fs::remove_file(&path).unwrap();
+        if let Err(message) = &back {
+            assert!(message.starts_with(&path.display().to_string()), "{message}");
+        }
+        back
+    }
+
+    #[test]
+    fn a_valid_solution_round_trips() {
+        assert_eq!(round_trip("valid", &solution()).unwrap(), solution());
+    }
+
+    #[test]
+    fn a_cyclic_element_tree_is_refused() {
+        let mut cyclic = solution();
+        cyclic.elements[3].first_child = 0;
+        let message = round_trip("cycle", &cyclic).unwrap_err();
+        assert!(message.ends_with("element 0: reached twice from the root, through element 3 (a cycle or a shared child; field first_child)"), "{message}");
+    }
+
+    #[test]
+    fn children_past_the_end_and_children_on_another_triangle_are_refused() {
+        let mut past = solution();
+        past.elements[1].first_child = 4;
+        let message = round_trip("past", &past).unwrap_err();
+        assert!(message.ends_with("element 1: children 4..8 run past the end of the table of 6 (field first_child)"), "{message}");
+        let mut moved = solution();
+        moved.elements[4].triangle = 0;
+        let message = round_trip("moved", &moved).unwrap_err();
+        assert!(message.ends_with("element 4: on triangle 0 at level 1, but its parent element 1 is on triangle 1 at level 0 (fields triangle, level)"), "{message}");
+    }
+
+    #[test]
+    fn a_link_to_a_missing_element_or_cluster_is_refused() {
+        let mut missing = solution();
+        missing.links[0].receiver = Node::Element(6);
+        let message = round_trip("element", &missing).unwrap_err();
+        assert!(message.ends_with("link 0: field receiver names element 6, but the solution has 6"), "{message}");
+        missing.links[0].receiver = Node::Element(5);
+        missing.links[0].sender = Node::Cluster(1);
+        let message = round_trip("cluster", &missing).unwrap_err();
+        assert!(message.ends_with("link 0: field sender names cluster 1, but the solution has 1"), "{message}");
     }
 }
