@@ -1,5 +1,9 @@
 //! Atomic file writes: write beside the target, flush, then rename, so a
 //! killed stage never leaves a half-written file that `make` would trust.
+//!
+//! [`Staged`] is the first half alone: a complete file beside its target,
+//! put in place by [`Staged::commit`]. A stage with several outputs stages
+//! them all and commits them together (see [`crate::stage::Outputs`]).
 
 use crate::error::{Error, Result};
 use std::fs::File;
@@ -14,6 +18,78 @@ fn temporary_beside(target: &Path) -> PathBuf {
     target.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
+/// A file written completely beside its target, not yet in place. Dropped
+/// without [`Staged::commit`] (an error, a panic), it removes its temporary
+/// file, so every error path that unwinds leaves nothing behind.
+#[derive(Debug)]
+pub struct Staged {
+    temporary: PathBuf,
+    target: PathBuf,
+    committed: bool,
+}
+
+impl Staged {
+    /// Writes the whole content of `target` into a temporary file beside it
+    /// through `fill`, flushed and synced; `target` itself is untouched. On
+    /// any error (a full disk, a file-size limit, `fill` failing) the
+    /// temporary file is removed again.
+    pub fn write<F>(target: &Path, fill: F) -> Result<Staged>
+    where
+        F: FnOnce(&mut BufWriter<File>) -> Result<()>,
+    {
+        let staged = Staged { temporary: temporary_beside(target), target: target.to_path_buf(), committed: false };
+        let file = File::create(&staged.temporary).map_err(|e| Error::io(target, e))?;
+        let mut writer = BufWriter::new(file);
+        fill(&mut writer)?;
+        let file = writer.into_inner().map_err(|e| Error::io(target, e.into_error()))?;
+        file.sync_all().map_err(|e| Error::io(target, e))?;
+        Ok(staged)
+    }
+
+    /// Stages `target` through `write`, which writes a complete file at the
+    /// path it is given (the temporary one; writers such as
+    /// [`crate::exr_io::write_exr`] write there atomically themselves). An
+    /// error names `target`, not the temporary file, and removes the
+    /// temporary file.
+    pub fn written_by(target: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<Staged> {
+        let staged = Staged { temporary: temporary_beside(target), target: target.to_path_buf(), committed: false };
+        write(&staged.temporary).map_err(|e| renamed(e, &staged.temporary, target))?;
+        Ok(staged)
+    }
+
+    /// The file's final path.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Puts the file in place: renames it over its target (atomic on one
+    /// file system). On failure the temporary file is removed.
+    pub fn commit(mut self) -> Result<()> {
+        std::fs::rename(&self.temporary, &self.target).map_err(|e| Error::io(&self.target, e))?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.temporary);
+        }
+    }
+}
+
+/// `error` with the path `from` it names replaced by `to`.
+fn renamed(error: Error, from: &Path, to: &Path) -> Error {
+    let swap = |path: PathBuf| if path == from { to.to_path_buf() } else { path };
+    match error {
+        Error::Io { path, source } => Error::Io { path: swap(path), source },
+        Error::Parse { path, line, message } => Error::Parse { path: swap(path), line, message },
+        Error::Schema { path, what } => Error::Schema { path: swap(path), what },
+        Error::Invalid { path, line, message } => Error::Invalid { path: swap(path), line, message },
+    }
+}
+
 /// Writes `target` atomically: `fill` writes the whole content into a
 /// temporary file beside it, which is renamed over `target` only when `fill`
 /// and the flush succeeded. On any error the temporary file is removed and
@@ -22,19 +98,7 @@ pub fn write_atomically<F>(target: &Path, fill: F) -> Result<()>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<()>,
 {
-    let temporary = temporary_beside(target);
-    let outcome = (|| {
-        let file = File::create(&temporary).map_err(|e| Error::io(target, e))?;
-        let mut writer = BufWriter::new(file);
-        fill(&mut writer)?;
-        let file = writer.into_inner().map_err(|e| Error::io(target, e.into_error()))?;
-        file.sync_all().map_err(|e| Error::io(target, e))?;
-        std::fs::rename(&temporary, target).map_err(|e| Error::io(target, e))
-    })();
-    if outcome.is_err() {
-        let _ = std::fs::remove_file(&temporary);
-    }
-    outcome
+    Staged::write(target, fill)?.commit()
 }
 
 /// Writes `bytes` to `target` atomically.
@@ -46,10 +110,22 @@ pub fn write_bytes_atomically(target: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::*;
 
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("atomic-test-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        names
+    }
+
     #[test]
     fn failed_fill_leaves_no_file_and_keeps_the_old_one() {
-        let dir = std::env::temp_dir().join(format!("atomic-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("fill");
         let target = dir.join("out.txt");
         write_bytes_atomically(&target, b"old").unwrap();
         let failed = write_atomically(&target, |w| {
@@ -58,8 +134,23 @@ mod tests {
         });
         assert!(failed.is_err());
         assert_eq!(std::fs::read(&target).unwrap(), b"old");
-        let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
-        assert_eq!(leftovers.len(), 1, "temporary file left behind");
+        assert_eq!(names(&dir), ["out.txt"], "temporary file left behind");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_staged_file_is_invisible_until_committed_and_gone_if_dropped() {
+        let dir = scratch("staged");
+        let target = dir.join("out.txt");
+        write_bytes_atomically(&target, b"old").unwrap();
+        let staged = Staged::write(&target, |w| w.write_all(b"new").map_err(|e| Error::io(&target, e))).unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"old");
+        assert_eq!(names(&dir).len(), 2);
+        drop(staged);
+        assert_eq!(names(&dir), ["out.txt"]);
+        Staged::write(&target, |w| w.write_all(b"new").map_err(|e| Error::io(&target, e))).unwrap().commit().unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        assert_eq!(names(&dir), ["out.txt"]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -2,6 +2,7 @@
 //! files, `--print-params`, reports, progress bars and exit codes
 //! (0 ok, 1 a negative answer, 2 error).
 
+use crate::atomic::Staged;
 use crate::error::{Error, Result};
 use crate::header::{Input, Provenance};
 use crate::report::Report;
@@ -40,14 +41,29 @@ pub struct Run {
 }
 
 impl Run {
-    /// Starts the clock for `stage` at crate `version`.
+    /// Starts the clock for `stage` at crate `version`, and makes a write
+    /// over a file-size limit (`ulimit -f`) an error instead of a kill:
+    /// SIGXFSZ, whose default action ends the process before any cleanup,
+    /// gets a handler that does nothing, so the write returns EFBIG and the
+    /// run ends in its normal error path, which removes its temporary files.
     pub fn start(stage: &'static str, version: &'static str) -> Self {
+        // Failing to install the handler only keeps the default action.
+        let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, std::sync::Arc::default());
         Run { stage, version, started: Instant::now(), inputs: Vec::new() }
     }
 
-    /// Records an input file.
-    pub fn input(&mut self, input: Input) {
+    /// Records an input file, refusing one that does not belong with the
+    /// inputs recorded before it: where one of two inputs was made from an
+    /// output of the stage that made the other, it must have been made from
+    /// that very file (see [`made_from_another`]). So a clusters file made
+    /// from another mesh than the one given, or a solution made from
+    /// another run's manifest, is refused naming both files.
+    pub fn input(&mut self, input: Input) -> Result<()> {
+        for earlier in &self.inputs {
+            made_from_another(&input, earlier).or_else(|| made_from_another(earlier, &input)).map_or(Ok(()), Err)?;
+        }
         self.inputs.push(input);
+        Ok(())
     }
 
     /// The provenance of this run's outputs, with `params` as effective
@@ -132,15 +148,54 @@ pub fn bad_parameter(message: impl Into<String>) -> Error {
     Error::invalid(Path::new("parameters"), None, message)
 }
 
+/// The error for `derived` if it records inputs made by the stage that
+/// made `source`, none of which is `source` itself (by SHA-256): the two
+/// files come from different runs. `None` where they may belong together,
+/// or where either carries no provenance (a foreign file, a photometric
+/// file) and nothing can be told.
+fn made_from_another(derived: &Input, source: &Input) -> Option<Error> {
+    let (made, source_made) = (derived.made_by.as_deref()?, source.made_by.as_deref()?);
+    let stage = &source_made.stage;
+    let siblings: Vec<&Input> = made.inputs.iter().filter(|i| i.made_by.as_ref().is_some_and(|m| &m.stage == stage)).collect();
+    if siblings.is_empty() || siblings.iter().any(|i| i.sha256 == source.sha256) {
+        return None;
+    }
+    let recorded: Vec<String> = siblings.iter().map(|i| format!("{} (SHA-256 {:.12})", i.path, i.sha256)).collect();
+    Some(Error::invalid(
+        Path::new(&derived.path),
+        None,
+        format!(
+            "does not belong with {} (SHA-256 {:.12}): it was made from {} of another {stage} run; remake it from the given files",
+            source.path,
+            source.sha256,
+            recorded.join(" and ")
+        ),
+    ))
+}
+
 /// Reads the prepared scene a stage starts from: `mesh.exr` and
 /// `manifest.ron`, checked against each other, both recorded as inputs of
-/// `run`.
+/// `run`. The two must be outputs of one mesh-prep run (equal provenance):
+/// a kill between mesh-prep's renames, or a copy of one file from another
+/// output directory, leaves a pair whose indices may still fit but whose
+/// materials and objects do not, which is refused naming both files.
 pub fn read_prepared(run: &mut Run, mesh: &Path, manifest: &Path) -> Result<(crate::mesh::Mesh, crate::mesh::Manifest)> {
     let (mesh_value, mesh_input) = crate::mesh::Mesh::read(mesh)?;
     let loaded = crate::ron_io::read_ron::<crate::mesh::Manifest>(manifest)?;
+    if mesh_value.header.provenance != loaded.value.header.provenance {
+        return Err(Error::invalid(
+            mesh,
+            None,
+            format!(
+                "does not belong with {}: they come from different {} runs (their provenance differs); rerun it to write both",
+                manifest.display(),
+                loaded.value.header.provenance.stage
+            ),
+        ));
+    }
     loaded.value.check_mesh(mesh, &mesh_value)?;
-    run.input(mesh_input);
-    run.input(loaded.input);
+    run.input(mesh_input)?;
+    run.input(loaded.input)?;
     Ok((mesh_value, loaded.value))
 }
 
@@ -157,13 +212,23 @@ pub fn check_writable(path: &Path) -> Result<()> {
     std::fs::remove_file(&probe).map_err(|e| Error::io(path, e))
 }
 
-/// The outputs of one run, all or none: every file written through it is
-/// removed again unless [`Outputs::keep`] is called, so a run that fails
-/// half-way through its writes leaves no partial output for `make`.
+/// The environment variable that makes [`Outputs::keep`] abort the process
+/// (no cleanup, as a kill) after putting this many outputs in place: a
+/// test-only hook for the kill tests, which stop a stage between two of
+/// its renames. Unset in normal runs.
+pub const ABORT_AFTER_COMMITS: &str = "PIPELINE_TEST_ABORT_AFTER_COMMITS";
+
+/// The outputs of one run, one unit: each is written completely beside its
+/// target first ([`Outputs::write`]), and only when all are written does
+/// [`Outputs::keep`] rename them into place, in the order written. A run
+/// that fails, or panics, before that leaves every old output as it was
+/// and no temporary file; a kill while writing leaves the old outputs (and
+/// at worst a hidden `.NAME.PID.tmp` file); a kill between two renames
+/// leaves a mixed set, which the next stage refuses because the outputs'
+/// provenance differs (see [`read_prepared`]).
 #[derive(Default)]
 pub struct Outputs {
-    written: Vec<std::path::PathBuf>,
-    kept: bool,
+    staged: Vec<Staged>,
 }
 
 impl Outputs {
@@ -172,25 +237,114 @@ impl Outputs {
         Self::default()
     }
 
-    /// Writes one output (atomically, through `write`) and remembers it.
+    /// Writes one output through `write`, which writes a complete file at
+    /// the path it is given (a temporary one beside `path`), and keeps it
+    /// there until [`Outputs::keep`].
     pub fn write(&mut self, path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-        write(path)?;
-        self.written.push(path.to_path_buf());
+        self.staged.push(Staged::written_by(path, write)?);
         Ok(())
     }
 
-    /// The run succeeded: keep everything written.
-    pub fn keep(mut self) {
-        self.kept = true;
+    /// The run succeeded: puts every output in place. Should a rename fail,
+    /// the outputs already renamed are removed again, so that `make` sees
+    /// none of this run's outputs, and the error names the file.
+    pub fn keep(self) -> Result<()> {
+        let abort_after = std::env::var(ABORT_AFTER_COMMITS).ok().and_then(|n| n.parse::<usize>().ok());
+        let mut placed: Vec<std::path::PathBuf> = Vec::new();
+        for staged in self.staged {
+            if abort_after == Some(placed.len()) {
+                std::process::abort();
+            }
+            let target = staged.target().to_path_buf();
+            if let Err(e) = staged.commit() {
+                for path in &placed {
+                    let _ = std::fs::remove_file(path);
+                }
+                return Err(e);
+            }
+            placed.push(target);
+        }
+        Ok(())
     }
 }
 
-impl Drop for Outputs {
-    fn drop(&mut self) {
-        if !self.kept {
-            for path in &self.written {
-                let _ = std::fs::remove_file(path);
-            }
-        }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn made_by(stage: &str, inputs: Vec<Input>) -> Option<Box<Provenance>> {
+        Some(Box::new(Provenance { stage: stage.into(), inputs, ..Provenance::in_memory(stage) }))
+    }
+
+    fn input(path: &str, sha256: &str, made: Option<Box<Provenance>>) -> Input {
+        Input { path: path.into(), sha256: sha256.into(), made_by: made }
+    }
+
+    #[test]
+    fn an_input_made_from_another_run_is_refused_naming_both_files() {
+        let mesh = |path: &str, sha: &str| input(path, sha, made_by("mesh-prep", vec![]));
+        let clusters = |from: Input| input("out/clusters.exr", "c1", made_by("cluster", vec![from, input("scene.ron", "s", None)]));
+        let mut run = Run::start("test", "0");
+        run.input(mesh("out/mesh.exr", "aaaa")).unwrap();
+        let message = run.input(clusters(mesh("old/mesh.exr", "bbbb"))).unwrap_err().to_string();
+        assert_eq!(
+            message,
+            "out/clusters.exr: does not belong with out/mesh.exr (SHA-256 aaaa): it was made from old/mesh.exr (SHA-256 bbbb) of another mesh-prep run; remake it from the given files"
+        );
+        // In the other order, the same refusal; made from the given file, accepted.
+        let mut run = Run::start("test", "0");
+        run.input(clusters(mesh("old/mesh.exr", "bbbb"))).unwrap();
+        assert!(run.input(mesh("out/mesh.exr", "aaaa")).unwrap_err().to_string().starts_with("out/clusters.exr: does not belong with out/mesh.exr"));
+        let mut run = Run::start("test", "0");
+        run.input(mesh("out/mesh.exr", "aaaa")).unwrap();
+        run.input(clusters(mesh("elsewhere/mesh.exr", "aaaa"))).unwrap();
+        // Files without provenance (foreign, photometric) tell nothing.
+        run.input(input("lamp.ldt", "dddd", None)).unwrap();
+    }
+
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("stage-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn listing(dir: &Path) -> Vec<(String, String)> {
+        let mut files: Vec<(String, String)> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| {
+                let path = e.unwrap().path();
+                (path.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read_to_string(&path).unwrap())
+            })
+            .collect();
+        files.sort();
+        files
+    }
+
+    #[test]
+    fn outputs_appear_together_on_keep_and_not_at_all_on_failure() {
+        let dir = scratch("outputs");
+        let (a, b) = (dir.join("a.txt"), dir.join("b.txt"));
+        let write = |outputs: &mut Outputs, path: &Path, text: &'static str| outputs.write(path, |p| crate::atomic::write_bytes_atomically(p, text.as_bytes()));
+        let old = vec![("a.txt".to_string(), "old a".to_string()), ("b.txt".to_string(), "old b".to_string())];
+        let mut outputs = Outputs::new();
+        write(&mut outputs, &a, "old a").unwrap();
+        write(&mut outputs, &b, "old b").unwrap();
+        outputs.keep().unwrap();
+        assert_eq!(listing(&dir), old);
+        // A run that fails after its first output: the old pair, no temporary.
+        let mut outputs = Outputs::new();
+        write(&mut outputs, &a, "new a").unwrap();
+        let failed = outputs.write(&b, |p| Err(Error::invalid(p, None, "disk full")));
+        assert_eq!(failed.unwrap_err().to_string(), format!("{}: disk full", b.display()), "the error names the output, not its temporary");
+        drop(outputs);
+        assert_eq!(listing(&dir), old);
+        let mut outputs = Outputs::new();
+        write(&mut outputs, &a, "new a").unwrap();
+        write(&mut outputs, &b, "new b").unwrap();
+        assert_eq!(listing(&dir).len(), 4, "both staged beside the old pair");
+        outputs.keep().unwrap();
+        assert_eq!(listing(&dir), vec![("a.txt".to_string(), "new a".to_string()), ("b.txt".to_string(), "new b".to_string())]);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

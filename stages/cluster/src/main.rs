@@ -75,7 +75,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         }
         outputs.write(report, |p| run.write_report(p, &params, counters, vec![], notes))?;
     }
-    outputs.keep();
+    outputs.keep()?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -104,7 +104,7 @@ fn read_image(path: &Path, run: &mut Run, notes: &mut Vec<String>) -> schemas::R
         eprintln!("compare: note: {note}");
         notes.push(note);
     }
-    run.input(record);
+    run.input(record)?;
     Ok(image)
 }
 
@@ -128,7 +128,7 @@ fn compare_files(args: &Args, params: &Params, run: &mut Run, a: &Path, b: &Path
     let manifest = match args.manifest.as_deref() {
         Some(path) => {
             let loaded = schemas::ron_io::read_ron::<Manifest>(path)?;
-            run.input(loaded.input);
+            run.input(loaded.input)?;
             Some(loaded.value)
         }
         None => None,
@@ -201,9 +201,9 @@ fn compare_solution_files(
     if params.exclusions().any() || args.manifest.is_some() {
         return Err(bad_parameter("--exclude-emitters, --exclude-edges and --manifest apply to images only; the inputs are solutions"));
     }
-    run.input(record_a);
+    run.input(record_a)?;
     let (solution_b, record_b) = Solution::read(b)?;
-    run.input(record_b);
+    run.input(record_b)?;
     let result = compare::compare_solutions(&solution_a, &solution_b, params).map_err(|e| named(e, a, b))?;
     Ok(Outcome {
         counters: result.counters(),

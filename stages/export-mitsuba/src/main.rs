@@ -131,7 +131,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ];
             outputs.write(report, |p| run.write_report(p, &params, counters, exported.skipped.clone(), notes))?;
         }
-        outputs.keep();
+        outputs.keep()?;
         Ok(())
     })();
     if outcome.is_err() && created_folder {

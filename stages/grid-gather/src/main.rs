@@ -264,12 +264,12 @@ fn run(args: &Args) -> Result<ExitCode> {
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let (solution, input) = Solution::read(solution_path)?;
-    run.input(input);
+    run.input(input)?;
 
     let clusters = match &args.clusters {
         Some(path) => {
             let (c, input) = Clusters::read(path, mesh.triangles.len())?;
-            run.input(input);
+            run.input(input)?;
             Some(c)
         }
         None => None,
@@ -277,7 +277,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     let threshold = match &args.threshold {
         Some(path) => {
             let (t, input) = read_threshold(path)?;
-            run.input(input);
+            run.input(input)?;
             Some(t)
         }
         None => None,
@@ -306,7 +306,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     if let Some(report) = &args.stage.report {
         outputs.write(report, |p| run.write_report(p, &params, rendered.counters, rendered.skipped, Vec::new()))?;
     }
-    outputs.keep();
+    outputs.keep()?;
     Ok(ExitCode::SUCCESS)
 }
 

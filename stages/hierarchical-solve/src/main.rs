@@ -128,7 +128,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let clusters = match &args.clusters {
         Some(path) => {
             let (clusters, input) = Clusters::read(path, mesh.triangles.len())?;
-            run.input(input);
+            run.input(input)?;
             Some(clusters)
         }
         None => None,
@@ -199,7 +199,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         }
         outputs.write(report, |p| run.write_report(p, &params, counters, skipped, notes.clone()))?;
     }
-    outputs.keep();
+    outputs.keep()?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -80,7 +80,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     check_outputs(&[Some(input)], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
     let bytes = read_bytes(input)?;
-    run.input(Input::new(input, &bytes, None));
+    run.input(Input::new(input, &bytes, None))?;
     let decoded = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .map_err(|e| Error::parse(input, None, format!("not a readable PNG: {e}")))?
         .to_rgb8();
@@ -95,7 +95,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     if let Some(report) = &args.stage.report {
         outputs.write(report, |p| run.write_report(p, &params, counters, Vec::new(), Vec::new()))?;
     }
-    outputs.keep();
+    outputs.keep()?;
     Ok(ExitCode::SUCCESS)
 }
 

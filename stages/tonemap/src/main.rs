@@ -62,7 +62,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     if let Some(note) = origin.foreign_note(input, &record) {
         eprintln!("tonemap: note: {note}");
     }
-    run.input(record);
+    run.input(record)?;
     let mapped = tonemap::tonemap(&image, &params).map_err(|e| Error::invalid(input, None, e.to_string()))?;
     let png = schemas::png::encode_png(mapped.width, mapped.height, &mapped.pixels)
         .map_err(|e| Error::invalid(output, None, e))?;
