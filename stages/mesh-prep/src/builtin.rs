@@ -7,7 +7,7 @@
 //! tessellated), `plants-100k`, `sphere-20k`, `box-100k` (see
 //! [`crate::procedural`]).
 
-use crate::obj::TextSource;
+use crate::text::TextSource;
 use crate::procedural;
 use schemas::Error;
 use std::path::{Path, PathBuf};
@@ -77,13 +77,20 @@ impl Builtin {
     }
 }
 
-impl TextSource for Builtin {
-    fn read(&self, path: &Path) -> Result<String, Error> {
+impl Builtin {
+    /// The text of the built-in file `path` names, if there is one.
+    fn file(&self, path: &Path) -> Option<&str> {
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        self.files
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, text)| text.clone())
-            .ok_or_else(|| Error::io(path, std::io::ErrorKind::NotFound.into()))
+        self.files.iter().find(|(n, _)| *n == name).map(|(_, text)| text.as_str())
+    }
+}
+
+impl TextSource for Builtin {
+    fn read_bytes(&self, path: &Path) -> Result<Vec<u8>, Error> {
+        self.file(path).map(|t| t.as_bytes().to_vec()).ok_or_else(|| Error::io(path, std::io::ErrorKind::NotFound.into()))
+    }
+
+    fn exists(&self, path: &Path) -> bool {
+        self.file(path).is_some()
     }
 }

@@ -2,21 +2,26 @@
 //!
 //! Reads `scene.ron` ([`scene::Scene`]: OBJ/MTL files, camera, lights,
 //! material overrides) or a built-in scene ([`builtin::Builtin`]),
-//! triangulates, places and recentres the geometry, welds duplicate
+//! reads and validates the photometric files of its luminaires
+//! ([`photometry`]), triangulates, places and recentres the geometry, welds duplicate
 //! vertices, drops degenerate and duplicate triangles, and lists the effects
 //! the scene calls for. The binary writes the result as `mesh.exr` and
 //! `manifest.ron` (see the `schemas` crate).
 
 pub mod builtin;
+pub mod lighting;
 pub mod material;
+pub mod mtl;
 pub mod obj;
+pub mod photometry;
 pub mod prepare;
 pub mod procedural;
 pub mod scene;
+pub mod text;
 
 pub use prepare::{prepare, Params, Prepared};
 
-use obj::TextSource;
+use text::TextSource;
 use schemas::header::Input;
 use schemas::Error;
 use std::cell::RefCell;
@@ -32,9 +37,10 @@ pub fn prepare_builtin(name: &str, made_by: &str) -> Result<(schemas::mesh::Mesh
     Ok(prepared.into_artifacts(schemas::header::Provenance::in_memory(made_by)))
 }
 
-/// Reads and parses the scene file at `path` through `source`.
+/// Reads and parses the scene file at `path` through `source` (UTF-8,
+/// strictly).
 pub fn read_scene(source: &dyn TextSource, path: &Path) -> Result<scene::Scene, Error> {
-    let text = source.read(path)?;
+    let text = text::read_utf8(source, path)?;
     schemas::ron_io::parse_ron(path, &text)
 }
 
@@ -58,9 +64,13 @@ impl<'a> Recording<'a> {
 }
 
 impl TextSource for Recording<'_> {
-    fn read(&self, path: &Path) -> Result<String, Error> {
-        let text = self.inner.read(path)?;
-        self.inputs.borrow_mut().push(Input::new(path, text.as_bytes(), None));
-        Ok(text)
+    fn read_bytes(&self, path: &Path) -> Result<Vec<u8>, Error> {
+        let bytes = self.inner.read_bytes(path)?;
+        self.inputs.borrow_mut().push(Input::new(path, &bytes, None));
+        Ok(bytes)
+    }
+
+    fn exists(&self, path: &Path) -> bool {
+        self.inner.exists(path)
     }
 }

@@ -30,6 +30,11 @@ struct Args {
     /// Output: the manifest (RON: camera, materials, effects, statistics).
     #[arg(long, required_unless_present = "print_params")]
     manifest: Option<PathBuf>,
+    /// Output: a dependency file in make syntax: the mesh and manifest
+    /// depend on every file this run read (scene, OBJ, MTL, textures,
+    /// photometric files), for the Makefile to include.
+    #[arg(long, value_name = "MESH.d")]
+    depfile: Option<PathBuf>,
     #[command(flatten)]
     stage: StageArgs,
     /// Weld vertices closer than this times the scene's diagonal.
@@ -55,7 +60,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(mesh_path), Some(manifest_path)) = (args.mesh, args.manifest) else {
         unreachable!("clap requires --mesh and --manifest without --print-params")
     };
-    for path in [Some(&mesh_path), Some(&manifest_path), args.stage.report.as_ref()].into_iter().flatten() {
+    for path in [Some(&mesh_path), Some(&manifest_path), args.stage.report.as_ref(), args.depfile.as_ref()].into_iter().flatten() {
         check_writable(path)?;
     }
     let mut run = Run::start("mesh-prep", env!("CARGO_PKG_VERSION"));
@@ -68,10 +73,19 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let scene = read_scene(&recording, &scene_path)?;
     let prepared = prepare(&scene, &scene_path, &recording, &params)?;
     for input in recording.into_inputs() {
-        run.input(input);
+        run.input(input)?;
     }
     let statistics = prepared.statistics.clone();
-    let (mesh, manifest) = prepared.into_artifacts(run.provenance(&params));
+    let warnings = prepared.warnings.clone();
+    let provenance = run.provenance(&params);
+    // A built-in scene's files are inside the binary, which the Makefile
+    // already lists.
+    let read: Vec<&str> = if args.builtin.is_some() { Vec::new() } else { provenance.inputs.iter().map(|i| i.path.as_str()).collect() };
+    let depfile_text = depfile(&[&mesh_path, &manifest_path], &read);
+    let (mesh, manifest) = prepared.into_artifacts(provenance);
+    for warning in &warnings {
+        eprintln!("mesh-prep: warning: {warning}");
+    }
     eprintln!(
         "mesh-prep: {} triangles, {} vertices ({} degenerate and {} duplicate triangles dropped, {} vertices welded)",
         statistics.triangles, statistics.vertices, statistics.degenerate_dropped, statistics.duplicates_dropped, statistics.vertices_welded
@@ -88,10 +102,49 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("duplicates_dropped".to_string(), statistics.duplicates_dropped as f64),
             ("vertices_welded".to_string(), statistics.vertices_welded as f64),
         ]);
-        outputs.write(report, |p| run.write_report(p, &params, counters, vec![], vec![]))?;
+        outputs.write(report, |p| run.write_report(p, &params, counters, vec![], warnings))?;
     }
-    outputs.keep();
+    if let Some(path) = &args.depfile {
+        outputs.write(path, |p| std::fs::write(p, &depfile_text).map_err(|e| schemas::Error::io(path, e)))?;
+    }
+    outputs.keep()?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// A make rule saying that `targets` depend on the files `read`, and an
+/// empty rule for each of those (as `gcc -MP` writes), so that a deleted
+/// input makes `make` rerun mesh-prep, which then names it, instead of
+/// stopping with "no rule to make target".
+fn depfile(targets: &[&std::path::Path], read: &[&str]) -> String {
+    let mut seen = std::collections::BTreeSet::new();
+    let prerequisites: Vec<String> = read.iter().filter(|p| seen.insert(**p)).map(|p| make_escape(p)).collect();
+    let targets: Vec<String> = targets.iter().map(|t| make_escape(&t.display().to_string())).collect();
+    let mut text = format!("# Written by mesh-prep: the files its outputs were made from.\n{}:", targets.join(" "));
+    for p in &prerequisites {
+        text += &format!(" \\\n  {p}");
+    }
+    text += "\n";
+    for p in &prerequisites {
+        text += &format!("\n{p}:\n");
+    }
+    text
+}
+
+/// `path` as a word of a make rule: spaces, tabs and `#` escaped with a
+/// backslash, `$` doubled.
+fn make_escape(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    for c in path.chars() {
+        match c {
+            ' ' | '\t' | '#' | ':' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '$' => out.push_str("$$"),
+            _ => out.push(c),
+        }
+    }
+    out
 }
 
 fn main() -> ExitCode {

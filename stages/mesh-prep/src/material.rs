@@ -1,6 +1,7 @@
 //! Materials: MTL values, read the way path tracers read them, plus the
 //! scene's overrides, checked for physical plausibility.
 
+use crate::mtl::MtlMaterial;
 use crate::scene::MaterialOverride;
 use schemas::mesh::Material;
 use std::f64::consts::PI;
@@ -33,13 +34,11 @@ pub fn default_material() -> Material {
 ///   4, 6, 7, 9); without `Tf` those models transmit `1 - d`.
 /// - `map_Kd`, `map_d` and `norm`/`bump` name the diffuse texture, alpha mask
 ///   and normal map.
-pub fn from_mtl(m: &tobj::Material) -> Material {
+pub fn from_mtl(m: &MtlMaterial) -> Material {
     let illum = m.illumination_model.unwrap_or(2);
     let rgb = |v: Option<[f64; 3]>| v.unwrap_or([0.0; 3]);
-    let transmitted = match m.unknown_param.get("Tf").and_then(|t| parse_rgb(t)) {
-        Some(tf) => tf,
-        None => [1.0 - m.dissolve.unwrap_or(1.0); 3],
-    };
+    let transmitted = m.transmission_filter.unwrap_or([1.0 - m.dissolve.unwrap_or(1.0); 3]);
+    let name = |t: &Option<crate::mtl::TextureRef>| t.as_ref().map(|t| t.name.clone());
     Material {
         name: m.name.clone(),
         diffuse: m.diffuse.unwrap_or([0.5; 3]),
@@ -47,18 +46,9 @@ pub fn from_mtl(m: &tobj::Material) -> Material {
         specular_reflectance: if (3..=7).contains(&illum) { rgb(m.specular) } else { [0.0; 3] },
         specular_transmittance: if matches!(illum, 4 | 6 | 7 | 9) { transmitted } else { [0.0; 3] },
         diffuse_transmittance: [0.0; 3],
-        diffuse_map: m.diffuse_texture.clone(),
-        alpha_map: m.dissolve_texture.clone(),
-        normal_map: m.normal_texture.clone(),
-    }
-}
-
-fn parse_rgb(text: &str) -> Option<[f64; 3]> {
-    let v: Vec<f64> = text.split_whitespace().map(str::parse).collect::<Result<_, _>>().ok()?;
-    match v.as_slice() {
-        [g] => Some([*g; 3]),
-        [r, g, b] => Some([*r, *g, *b]),
-        _ => None,
+        diffuse_map: name(&m.diffuse_texture),
+        alpha_map: name(&m.dissolve_texture),
+        normal_map: name(&m.normal_texture),
     }
 }
 
@@ -120,7 +110,7 @@ mod tests {
 
     #[test]
     fn mtl_emission_is_radiance_and_exitance_is_pi_times_it() {
-        let mtl = tobj::Material { name: "light".into(), emissive: Some([17.0, 12.0, 4.0]), ..Default::default() };
+        let mtl = MtlMaterial { name: "light".into(), emissive: Some([17.0, 12.0, 4.0]), ..Default::default() };
         let m = from_mtl(&mtl);
         assert_eq!(m.emission, [17.0 * PI, 12.0 * PI, 4.0 * PI]);
         assert_eq!(m.specular_reflectance, [0.0; 3], "illum 2 highlight is not a mirror");

@@ -1,26 +1,24 @@
-//! Reading Wavefront OBJ/MTL through tobj, with a line-checking pass first:
-//! tobj reports *what* failed but not *where*, and accepts `nan` as a
-//! coordinate; the pass finds the offending line so the error can name it.
+//! Wavefront OBJ, read by hand, as found in the wild: every error names the
+//! file and line, no input can make a third-party parser panic, and the
+//! freedoms exporters take are accepted: several libraries on one `mtllib`
+//! line, library and material names with spaces, Latin-1 bytes (see
+//! [`crate::text::read_text`]), lines continued with a backslash.
+//!
+//! Read statements (others, like `vt`, `vn`, `l`, `p`, `s`, are ignored):
+//! `v x y z` (finite; a fourth value or a colour after them is ignored),
+//! `f a b c ...` (position indices, 1-based or negative, each with optional
+//! `/vt/vn`; a polygon is triangulated as a fan from its first corner),
+//! `o`/`g name` (a new object), `usemtl name`, `mtllib names`. An object is
+//! split where its material changes, as tobj did, so the objects and their
+//! order are what earlier versions wrote.
 
+use crate::mtl::{parse_mtl, split_keyword, MtlMaterial};
+use crate::text::{read_text, statements};
 use schemas::Error;
-use std::io::BufReader;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// Where OBJ and MTL text comes from: the file system, or text built into
-/// the binary (the default scene).
-pub trait TextSource {
-    /// The text of `path`, or an error naming it.
-    fn read(&self, path: &Path) -> Result<String, Error>;
-}
-
-/// The file system.
-pub struct Files;
-
-impl TextSource for Files {
-    fn read(&self, path: &Path) -> Result<String, Error> {
-        std::fs::read_to_string(path).map_err(|e| Error::io(path, e))
-    }
-}
+pub use crate::text::{Files, TextSource};
 
 /// One OBJ object (`o`/`g` group with one material), triangulated.
 #[derive(Debug, Clone)]
@@ -29,116 +27,152 @@ pub struct ObjObject {
     pub name: String,
     /// Index into [`ObjFile::materials`], if the object has one.
     pub material: Option<usize>,
-    /// Positions, file units.
-    pub positions: Vec<[f64; 3]>,
-    /// Triangles as indices into `positions`, OBJ winding.
+    /// Triangles as position indices into [`ObjFile::positions`], OBJ
+    /// winding.
     pub triangles: Vec<[usize; 3]>,
+    /// Line of each triangle's face statement.
+    pub lines: Vec<usize>,
 }
 
 /// An OBJ file and the materials of its MTL libraries.
 #[derive(Debug, Clone)]
 pub struct ObjFile {
+    /// The file.
+    pub path: PathBuf,
+    /// Vertex positions, file units.
+    pub positions: Vec<[f64; 3]>,
     /// Objects in file order.
     pub objects: Vec<ObjObject>,
     /// Materials in library order.
-    pub materials: Vec<tobj::Material>,
+    pub materials: Vec<MtlMaterial>,
+    /// What the reader noticed and the user should hear of (Latin-1 text,
+    /// `usemtl` naming no material), one line each, naming file and line.
+    pub notes: Vec<String>,
 }
 
-/// Reads and triangulates the OBJ at `path` and its MTL libraries.
+/// Reads and triangulates the OBJ at `path` and its MTL libraries (paths
+/// relative to the OBJ's folder), through `source`.
 pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> {
-    let text = source.read(path)?;
-    check_lines(path, &text)?;
-    let options = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+    let mut notes = Vec::new();
+    let text = read_text(source, path, &mut notes)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let failed_library = std::cell::RefCell::new(None::<Error>);
-    let loaded = tobj::load_obj_buf(&mut BufReader::new(text.as_bytes()), &options, |library| {
-        let library_path: PathBuf = base.join(library);
-        match source.read(&library_path) {
-            Ok(mtl) => tobj::load_mtl_buf(&mut BufReader::new(mtl.as_bytes())).map_err(|e| {
-                failed_library.replace(Some(Error::parse(&library_path, None, format!("malformed MTL: {e}"))));
-                e
-            }),
-            Err(e) => {
-                failed_library.replace(Some(e));
-                Err(tobj::LoadError::OpenFileFailed)
-            }
-        }
-    });
-    let (models, materials) = loaded.map_err(|e| Error::parse(path, None, format!("malformed OBJ: {e}")))?;
-    if let Some(e) = failed_library.into_inner() {
-        return Err(e);
-    }
-    let materials = materials.map_err(|e| Error::parse(path, None, format!("cannot load its materials: {e}")))?;
-    let objects = models
-        .into_iter()
-        .map(|m| ObjObject {
-            name: m.name,
-            material: m.mesh.material_id,
-            positions: m.mesh.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect(),
-            triangles: m.mesh.indices.chunks_exact(3).map(|t| [t[0] as usize, t[1] as usize, t[2] as usize]).collect(),
-        })
-        .collect();
-    Ok(ObjFile { objects, materials })
-}
-
-/// Checks the lines tobj would accept silently or reject without a line
-/// number: vertex coordinates must be finite numbers, face indices must
-/// name vertices defined before them.
-fn check_lines(path: &Path, text: &str) -> Result<(), Error> {
-    let mut vertices: i64 = 0;
-    for (number, line) in text.lines().enumerate() {
-        let line_no = Some(number + 1);
-        let line = line.split('#').next().unwrap_or("");
-        let mut fields = line.split_whitespace();
-        match fields.next() {
-            Some("v") => {
-                let coordinates: Vec<&str> = fields.take(3).collect();
-                if coordinates.len() < 3 {
-                    return Err(Error::parse(path, line_no, "vertex needs three coordinates"));
-                }
-                for c in coordinates {
-                    let value: f64 = c.parse().map_err(|_| Error::parse(path, line_no, format!("vertex coordinate '{c}' is not a number")))?;
-                    if !value.is_finite() {
-                        return Err(Error::invalid(path, line_no, format!("vertex coordinate '{c}' is not finite")));
-                    }
-                }
-                vertices += 1;
-            }
-            Some("f") => {
-                let corners: Vec<&str> = fields.collect();
+    let mut file = ObjFile { path: path.to_path_buf(), positions: Vec::new(), objects: Vec::new(), materials: Vec::new(), notes };
+    let mut by_name: HashMap<String, usize> = HashMap::new();
+    let mut current = ObjObject { name: "unnamed_object".into(), material: None, triangles: Vec::new(), lines: Vec::new() };
+    for (line, statement) in statements(&text) {
+        let error = |message: String| Error::parse(path, Some(line), message);
+        let (keyword, rest) = split_keyword(&statement);
+        match keyword {
+            "v" => file.positions.push(vertex(rest).map_err(error)?),
+            "f" => {
+                let corners = rest.split_whitespace().map(|c| corner(c, file.positions.len())).collect::<Result<Vec<usize>, String>>().map_err(error)?;
                 if corners.len() < 3 {
-                    return Err(Error::parse(path, line_no, "face needs at least three vertices"));
+                    return Err(error("face needs at least three vertices".into()));
                 }
-                for corner in corners {
-                    let index = corner.split('/').next().unwrap_or("");
-                    let i: i64 = index.parse().map_err(|_| Error::parse(path, line_no, format!("face vertex '{corner}' is not an index")))?;
-                    let resolved = if i > 0 { i - 1 } else { vertices + i };
-                    if i == 0 || resolved < 0 || resolved >= vertices {
-                        return Err(Error::parse(path, line_no, format!("face vertex {i} does not exist ({vertices} vertices defined so far)")));
+                for k in 1..corners.len() - 1 {
+                    current.triangles.push([corners[0], corners[k], corners[k + 1]]);
+                    current.lines.push(line);
+                }
+            }
+            "o" | "g" => {
+                let name = if rest.is_empty() { "unnamed_object" } else { rest };
+                let next = ObjObject { name: name.into(), material: current.material, triangles: Vec::new(), lines: Vec::new() };
+                finish(&mut file.objects, &mut current, next);
+            }
+            "usemtl" => {
+                if rest.is_empty() {
+                    return Err(error("usemtl needs a material name".into()));
+                }
+                let material = by_name.get(rest).copied();
+                if material.is_none() {
+                    file.notes.push(format!("{}:{line}: usemtl '{rest}' names no material of its libraries; the default grey is used", path.display()));
+                }
+                if material != current.material {
+                    let next = ObjObject { name: current.name.clone(), material, triangles: Vec::new(), lines: Vec::new() };
+                    finish(&mut file.objects, &mut current, next);
+                }
+            }
+            "mtllib" => {
+                for library in libraries(source, &base, rest).map_err(error)? {
+                    let mtl = read_text(source, &library, &mut file.notes)?;
+                    for material in parse_mtl(&library, &mtl, &mut file.notes)? {
+                        by_name.insert(material.name.clone(), file.materials.len());
+                        file.materials.push(material);
                     }
                 }
             }
             _ => {}
         }
     }
-    Ok(())
+    file.objects.push(current);
+    Ok(file)
+}
+
+/// Ends `current` (kept if it has faces) and starts `next`.
+fn finish(objects: &mut Vec<ObjObject>, current: &mut ObjObject, next: ObjObject) {
+    let done = std::mem::replace(current, next);
+    if !done.triangles.is_empty() {
+        objects.push(done);
+    }
+}
+
+/// The libraries a `mtllib` line names. The format separates names by
+/// spaces, but exporters also write one name with spaces in it: the split
+/// names are used if they all exist, else the whole rest of the line if it
+/// exists; otherwise the error names the first missing one.
+fn libraries(source: &dyn TextSource, base: &Path, rest: &str) -> Result<Vec<PathBuf>, String> {
+    if rest.is_empty() {
+        return Err("mtllib needs a file name".into());
+    }
+    let split: Vec<PathBuf> = rest.split_whitespace().map(|name| base.join(name)).collect();
+    let missing = split.iter().find(|p| !source.exists(p));
+    match missing {
+        None => Ok(split),
+        Some(_) if source.exists(&base.join(rest)) => Ok(vec![base.join(rest)]),
+        Some(first) => {
+            let whole = if split.len() > 1 { format!(" (nor does '{}')", base.join(rest).display()) } else { String::new() };
+            Err(format!("material library '{}' does not exist{whole}", first.display()))
+        }
+    }
+}
+
+/// The three finite coordinates of a `v` statement.
+fn vertex(rest: &str) -> Result<[f64; 3], String> {
+    let mut coordinates = [0.0f64; 3];
+    let mut words = rest.split_whitespace();
+    for c in &mut coordinates {
+        let word = words.next().ok_or("vertex needs three coordinates")?;
+        *c = word.parse().map_err(|_| format!("vertex coordinate '{word}' is not a number"))?;
+        if !c.is_finite() {
+            return Err(format!("vertex coordinate '{word}' is not finite"));
+        }
+    }
+    Ok(coordinates)
+}
+
+/// The 0-based position index of a face corner `v`, `v/vt`, `v//vn` or
+/// `v/vt/vn`, given `defined` positions so far (negative indices count
+/// back from the last).
+fn corner(text: &str, defined: usize) -> Result<usize, String> {
+    let index = text.split('/').next().unwrap_or("");
+    let i: i64 = index.parse().map_err(|_| format!("face vertex '{text}' is not an index"))?;
+    let resolved = if i > 0 { i - 1 } else { defined as i64 + i };
+    if i == 0 || resolved < 0 || resolved >= defined as i64 {
+        return Err(format!("face vertex {i} does not exist ({defined} vertices defined so far)"));
+    }
+    Ok(resolved as usize)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::text::Memory;
 
-    struct Memory(Vec<(&'static str, &'static str)>);
-    impl TextSource for Memory {
-        fn read(&self, path: &Path) -> Result<String, Error> {
-            let key = path.to_string_lossy();
-            self.0.iter().find(|(p, _)| *p == key).map(|(_, t)| t.to_string()).ok_or_else(|| Error::io(path, std::io::ErrorKind::NotFound.into()))
-        }
+    fn error_of(obj: &str) -> String {
+        read_obj(&Memory::text(&[("s/a.obj", obj)]), Path::new("s/a.obj")).unwrap_err().to_string()
     }
 
-    fn error_of(obj: &'static str) -> String {
-        read_obj(&Memory(vec![("s/a.obj", obj)]), Path::new("s/a.obj")).unwrap_err().to_string()
-    }
+    const TRIANGLE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
     #[test]
     fn bad_lines_are_named() {
@@ -146,23 +180,73 @@ mod tests {
         assert_eq!(error_of("v 0 0 0\nv 1 0 x\n"), "s/a.obj:2: vertex coordinate 'x' is not a number");
         assert_eq!(error_of("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"), "s/a.obj:4: face vertex 4 does not exist (3 vertices defined so far)");
         assert_eq!(error_of("v 0 0 0\nf 1 1\n"), "s/a.obj:2: face needs at least three vertices");
+        assert_eq!(error_of("v 0 0\n"), "s/a.obj:1: vertex needs three coordinates");
+        assert_eq!(error_of(&format!("{TRIANGLE}usemtl\n")), "s/a.obj:5: usemtl needs a material name");
     }
 
     #[test]
-    fn missing_material_library_is_named() {
-        let message = error_of("mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-        assert!(message.starts_with("s/gone.mtl:"), "{message}");
+    fn missing_material_library_is_named_with_its_line() {
+        assert_eq!(error_of("mtllib gone.mtl\nv 0 0 0\n"), "s/a.obj:1: material library 's/gone.mtl' does not exist");
+        assert_eq!(error_of("\nmtllib a.mtl b.mtl\n"), "s/a.obj:2: material library 's/a.mtl' does not exist (nor does 's/a.mtl b.mtl')");
     }
 
     #[test]
     fn quads_are_triangulated_with_materials() {
-        let source = Memory(vec![
-            ("s/a.obj", "mtllib m.mtl\no quad\nusemtl red\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf -4 -3 -2 -1\n"),
+        let source = Memory::text(&[
+            ("s/a.obj", "mtllib m.mtl\no quad\nusemtl red\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf -4/1 -3/2/1 -2//3 -1\n"),
             ("s/m.mtl", "newmtl red\nKd 0.5 0.1 0.1\nKe 1 2 3\n"),
         ]);
         let obj = read_obj(&source, Path::new("s/a.obj")).unwrap();
         assert_eq!(obj.objects.len(), 1);
-        assert_eq!(obj.objects[0].triangles.len(), 2);
+        assert_eq!(obj.objects[0].triangles, [[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(obj.objects[0].lines, [8, 8]);
         assert_eq!(obj.materials[0].emissive, Some([1.0, 2.0, 3.0]));
+        assert!(obj.notes.is_empty(), "{:?}", obj.notes);
+    }
+
+    /// Issue 11: one-value colours made tobj panic (exit 101).
+    #[test]
+    fn one_value_colours_are_grey() {
+        let source = Memory::text(&[("a.obj", &format!("mtllib m.mtl\nusemtl grey\n{TRIANGLE}")), ("m.mtl", "newmtl grey\nKd 0.5\nKs 0\n")]);
+        let obj = read_obj(&source, Path::new("a.obj")).unwrap();
+        assert_eq!(obj.materials[0].diffuse, Some([0.5; 3]));
+        assert_eq!(obj.objects[0].material, Some(0));
+    }
+
+    /// Issue 11: several libraries on one line, and a library whose name
+    /// has a space, were not found.
+    #[test]
+    fn several_libraries_and_names_with_spaces() {
+        let source = Memory::text(&[
+            ("s/a.obj", &format!("mtllib one.mtl two.mtl\nmtllib my materials.mtl\nusemtl b\n{TRIANGLE}usemtl c\nf 3 2 1\n")),
+            ("s/one.mtl", "newmtl a\nKd 0.1\n"),
+            ("s/two.mtl", "newmtl b\nKd 0.2\n"),
+            ("s/my materials.mtl", "newmtl c\nKd 0.3\n"),
+        ]);
+        let obj = read_obj(&source, Path::new("s/a.obj")).unwrap();
+        let names: Vec<&str> = obj.materials.iter().map(|m| m.name.as_str()).collect();
+        assert_eq!(names, ["a", "b", "c"]);
+        let materials: Vec<Option<usize>> = obj.objects.iter().map(|o| o.material).collect();
+        assert_eq!(materials, [Some(1), Some(2)]);
+    }
+
+    /// Issue 11: a Latin-1 comment made the OBJ unreadable.
+    #[test]
+    fn latin1_comments_and_names_are_read_with_a_note() {
+        let obj = b"# Export\xe9 par Blender\nmtllib m.mtl\nusemtl caf\xe9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec();
+        let source = Memory(vec![("a.obj".into(), obj), ("m.mtl".into(), b"newmtl caf\xe9\nKd 0.5\n".to_vec())]);
+        let file = read_obj(&source, Path::new("a.obj")).unwrap();
+        assert_eq!(file.materials[0].name, "caf\u{e9}");
+        assert_eq!(file.objects[0].material, Some(0), "the Latin-1 name in the OBJ matches the one in the MTL");
+        assert_eq!(file.notes, ["a.obj:1: not UTF-8; read as Latin-1", "m.mtl:1: not UTF-8; read as Latin-1"]);
+    }
+
+    #[test]
+    fn unknown_material_is_noted_and_objects_split_where_it_changes() {
+        let source = Memory::text(&[("a.obj", &format!("o box\n{TRIANGLE}usemtl nothing\nf 1 3 2\no empty\no last\nf 2 1 3\n"))]);
+        let file = read_obj(&source, Path::new("a.obj")).unwrap();
+        let names: Vec<&str> = file.objects.iter().map(|o| o.name.as_str()).collect();
+        assert_eq!(names, ["box", "last"], "a material change to the same (absent) material does not split; empty objects vanish");
+        assert_eq!(file.notes, ["a.obj:6: usemtl 'nothing' names no material of its libraries; the default grey is used"]);
     }
 }

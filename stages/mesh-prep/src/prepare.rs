@@ -2,7 +2,9 @@
 //! resolve materials, recentre, weld, drop degenerate and duplicate
 //! triangles, and list the effects the scene calls for.
 
+use crate::lighting::{self, Emitter};
 use crate::material::{self, default_material};
+use crate::mtl::MtlMaterial;
 use crate::obj::{read_obj, TextSource};
 use crate::scene::{Light, MeshFile, Scene};
 use glam::DVec3;
@@ -11,8 +13,8 @@ use radiometry::geometry::TriangleGeometry;
 use schemas::mesh::{Camera, Effects, GoniometricLight, Material, MeshStatistics, Triangle};
 use schemas::Error;
 use serde::{Deserialize, Serialize};
-use std::collections::{HashMap, HashSet};
-use std::path::Path;
+use std::collections::{BTreeMap, HashMap, HashSet};
+use std::path::{Path, PathBuf};
 
 /// Knobs of mesh preparation.
 ///
@@ -60,6 +62,9 @@ pub struct Prepared {
     pub effects: Effects,
     /// What preparation did.
     pub statistics: MeshStatistics,
+    /// What the user should hear of, one line each (non-UTF-8 text, unknown
+    /// materials, missing textures, emitters that light nothing).
+    pub warnings: Vec<String>,
 }
 
 impl Prepared {
@@ -81,6 +86,10 @@ impl Prepared {
     }
 }
 
+/// Largest world coordinate accepted, m: far beyond any scene, and far
+/// inside single precision (3.4e38), which the mesh is stored in.
+const MAX_COORDINATE: f64 = 1e30;
+
 /// A triangle before welding: world corners, material, object.
 struct RawTriangle {
     corners: [DVec3; 3],
@@ -88,13 +97,37 @@ struct RawTriangle {
     object: u32,
 }
 
+/// Where an object or material comes from: the file and line that define
+/// it, for messages that name it.
+#[derive(Clone, Debug)]
+struct Origin {
+    file: PathBuf,
+    line: Option<usize>,
+}
+
+impl Origin {
+    fn error(&self, message: impl Into<String>) -> Error {
+        Error::invalid(&self.file, self.line, message)
+    }
+
+    fn at(&self) -> String {
+        match self.line {
+            Some(line) => format!("{}:{line}", self.file.display()),
+            None => self.file.display().to_string(),
+        }
+    }
+}
+
 /// Prepares `scene`, read from `scene_path` (OBJ paths are relative to its
 /// directory), reading files through `source`.
 pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params: &Params) -> Result<Prepared, Error> {
     let base = scene_path.parent().unwrap_or(Path::new(""));
     let mut materials = Vec::new();
+    let mut material_origins = Vec::new();
     let mut objects = Vec::new();
+    let mut object_origins = Vec::new();
     let mut raw = Vec::new();
+    let mut warnings = Vec::new();
     let mut default_index = None;
     for mesh in &scene.meshes {
         let MeshFile::Obj { file, scale, translate } = mesh;
@@ -103,20 +136,35 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
             return Err(Error::invalid(scene_path, None, format!("mesh '{file}': scale must be positive and translate finite")));
         }
         let obj = read_obj(source, &path)?;
+        warnings.extend(obj.notes.iter().cloned());
+        record_textures(source, &obj.materials, &mut warnings)?;
         let offset = materials.len() as u32;
         materials.extend(obj.materials.iter().map(material::from_mtl));
+        material_origins.extend(obj.materials.iter().map(|m| Origin { file: m.file.clone(), line: Some(m.line) }));
         for object in &obj.objects {
             let material = match object.material {
                 Some(m) => offset + m as u32,
                 None => *default_index.get_or_insert_with(|| {
                     materials.push(default_material());
+                    material_origins.push(Origin { file: path.clone(), line: None });
                     materials.len() as u32 - 1
                 }),
             };
             let object_index = objects.len() as u32;
             objects.push(object.name.clone());
-            let world = |i: usize| DVec3::from(object.positions[i]) * *scale + DVec3::from(*translate);
-            raw.extend(object.triangles.iter().map(|t| RawTriangle { corners: t.map(world), material, object: object_index }));
+            object_origins.push(Origin { file: path.clone(), line: object.lines.first().copied() });
+            for (t, line) in object.triangles.iter().zip(&object.lines) {
+                let corners = t.map(|i| DVec3::from(obj.positions[i]) * *scale + DVec3::from(*translate));
+                if let Some(c) = corners.iter().find(|c| !(c.abs().max_element() <= MAX_COORDINATE)) {
+                    let what = format!(
+                        "object '{}': a corner lies at {:?} once placed (its mesh entry's scale and translate): not a finite position within {MAX_COORDINATE:e} m",
+                        object.name,
+                        c.to_array()
+                    );
+                    return Err(Error::invalid(&path, Some(*line), what));
+                }
+                raw.push(RawTriangle { corners, material, object: object_index });
+            }
         }
     }
     let mut goniometric_lights = Vec::new();
@@ -124,37 +172,42 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
         match light {
             Light::Area { corner, edge_u, edge_v, emission } => {
                 let (c, u, v) = (DVec3::from(*corner), DVec3::from(*edge_u), DVec3::from(*edge_v));
-                materials.push(Material { name: format!("area_light_{k}"), diffuse: [0.0; 3], emission: *emission, ..default_material() });
-                objects.push(format!("area_light_{k}"));
+                let name = format!("area_light_{k}");
+                let refuse = |what: String| Error::invalid(scene_path, None, format!("light {k} (Area, '{name}'): {what}"));
+                for (field, value) in [("corner", c), ("edge_u", u), ("edge_v", v)] {
+                    if !value.is_finite() {
+                        return Err(refuse(format!("{field} {:?} is not finite", value.to_array())));
+                    }
+                }
+                if u.cross(v).length() == 0.0 {
+                    return Err(refuse("edge_u and edge_v span no area (zero or parallel edges)".into()));
+                }
+                materials.push(Material { name: name.clone(), diffuse: [0.0; 3], emission: *emission, ..default_material() });
+                material_origins.push(Origin { file: scene_path.to_path_buf(), line: None });
+                objects.push(name);
+                object_origins.push(Origin { file: scene_path.to_path_buf(), line: None });
                 let (material, object) = (materials.len() as u32 - 1, objects.len() as u32 - 1);
                 raw.push(RawTriangle { corners: [c, c + u, c + u + v], material, object });
                 raw.push(RawTriangle { corners: [c, c + u + v, c + v], material, object });
             }
             Light::Goniometric { file, position, nadir, scale } => {
-                let nadir = DVec3::from(*nadir).try_normalize().ok_or_else(|| {
-                    Error::invalid(scene_path, None, format!("light {k}: nadir direction is zero"))
-                })?;
-                goniometric_lights.push(GoniometricLight {
-                    file: base.join(file).display().to_string(),
-                    position: *position,
-                    nadir: nadir.to_array(),
-                    scale: *scale,
-                });
+                goniometric_lights.push(crate::photometry::read_light(source, scene_path, base, k, file, *position, *nadir, *scale)?);
             }
         }
     }
     for (name, o) in &scene.materials {
         let mut found = false;
-        for m in materials.iter_mut().filter(|m| &m.name == name) {
+        for (m, origin) in materials.iter_mut().zip(&mut material_origins).filter(|(m, _)| &m.name == name) {
             material::apply(m, o);
+            *origin = Origin { file: scene_path.to_path_buf(), line: None };
             found = true;
         }
         if !found {
             return Err(Error::invalid(scene_path, None, format!("material override '{name}' names no material of the scene")));
         }
     }
-    if let Some(problem) = materials.iter().find_map(material::check) {
-        return Err(Error::invalid(scene_path, None, problem));
+    if let Some((problem, origin)) = materials.iter().zip(&material_origins).find_map(|(m, o)| Some((material::check(m)?, o))) {
+        return Err(origin.error(problem));
     }
     if raw.is_empty() {
         return Err(Error::invalid(scene_path, None, "the scene has no triangles"));
@@ -163,6 +216,8 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
     let Some(built) = built else {
         return Err(Error::invalid(scene_path, None, "every triangle of the scene is degenerate"));
     };
+    let emitters = emitters(&raw, &built.triangles, &materials, &objects, &object_origins)?;
+    warnings.extend(lighting::check_emitters(&built.positions, &built.triangles, &emitters));
     let origin = built.origin;
     let to_mesh = |p: [f64; 3]| (DVec3::from(p) - origin).to_array();
     let camera = Camera { eye: to_mesh(scene.camera.eye), target: to_mesh(scene.camera.target), ..scene.camera.clone() };
@@ -200,7 +255,51 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
         goniometric_lights,
         effects,
         statistics,
+        warnings,
     })
+}
+
+/// The emitters of the scene, one per object and emitting material, with
+/// their kept triangles; an error naming the emitter if one has no area
+/// left (every triangle degenerate), which would otherwise vanish into the
+/// count of degenerate triangles.
+fn emitters(raw: &[RawTriangle], kept: &[Triangle], materials: &[Material], objects: &[String], origins: &[Origin]) -> Result<Vec<Emitter>, Error> {
+    let emits = |m: u32| materials[m as usize].emission.iter().any(|&e| e > 0.0);
+    let mut groups: BTreeMap<(u32, u32), (usize, Vec<u32>)> = BTreeMap::new();
+    for t in raw.iter().filter(|t| emits(t.material)) {
+        groups.entry((t.object, t.material)).or_default().0 += 1;
+    }
+    for (i, t) in kept.iter().enumerate().filter(|(_, t)| emits(t.material)) {
+        groups.entry((t.object, t.material)).or_default().1.push(i as u32);
+    }
+    let mut out = Vec::with_capacity(groups.len());
+    for ((object, material), (input, triangles)) in groups {
+        let origin = &origins[object as usize];
+        let label = format!("emitter '{}' (material '{}', {})", objects[object as usize], materials[material as usize].name, origin.at());
+        if triangles.is_empty() {
+            return Err(origin.error(format!("{label} has zero area: all {input} of its triangles are degenerate")));
+        }
+        out.push(Emitter { label, triangles });
+    }
+    Ok(out)
+}
+
+/// Reads (and so records, for the provenance and the dependency file)
+/// every texture the materials name, relative to their library's folder;
+/// a texture that does not exist gets a warning, as no stage reads
+/// textures yet.
+fn record_textures(source: &dyn TextSource, materials: &[MtlMaterial], warnings: &mut Vec<String>) -> Result<(), Error> {
+    for m in materials {
+        for texture in [&m.diffuse_texture, &m.dissolve_texture, &m.normal_texture].into_iter().flatten() {
+            let path = m.file.parent().unwrap_or(Path::new("")).join(&texture.name);
+            if source.exists(&path) {
+                source.read_bytes(&path)?;
+            } else {
+                warnings.push(format!("{}:{}: texture '{}' does not exist", m.file.display(), texture.line, path.display()));
+            }
+        }
+    }
+    Ok(())
 }
 
 struct Built {
@@ -290,5 +389,99 @@ fn effects_of(triangles: &[Triangle], materials: &[Material], lights: &[Goniomet
         normal_maps: any(&|m| m.normal_map.is_some()),
         textures: any(&|m| m.diffuse_map.is_some()),
         fine_clustered_geometry: triangles.len() > params.fine_geometry_triangles,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::text::Memory;
+
+    /// A closed 1 m box, walls facing in (or out, `inward` false), one
+    /// material; `skip` leaves out the faces whose statements contain it.
+    fn room(inward: bool, skip: Option<&str>) -> String {
+        let faces = ["1 2 3 4", "5 8 7 6", "1 5 6 2", "4 3 7 8", "1 4 8 5", "2 6 7 3"];
+        let mut obj = String::from("mtllib m.mtl\nusemtl wall\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n");
+        for f in faces.iter().filter(|f| Some(**f) != skip) {
+            let order: Vec<&str> = if inward { f.split(' ').collect() } else { f.split(' ').rev().collect() };
+            obj += &format!("f {}\n", order.join(" "));
+        }
+        obj
+    }
+
+    /// Prepares `obj` (with a grey MTL and an emitting one) under a scene
+    /// whose `lights` list is given as RON.
+    fn prepare_with(obj: &str, lights: &str) -> Result<Prepared, Error> {
+        let scene = format!(
+            "Scene(meshes: [Obj(file: \"a.obj\")], camera: Camera(eye: (0.5, 0.5, 0.05), target: (0.5, 0.5, 1.0), up: (0.0, 1.0, 0.0), vertical_fov_deg: 60.0, width: 8, height: 8), lights: [{lights}])"
+        );
+        let source = Memory::text(&[("s/scene.ron", &scene), ("s/a.obj", obj), ("s/m.mtl", "newmtl wall\nKd 0.5\n\nnewmtl glow\nKd 0\nKe 10\n")]);
+        let path = Path::new("s/scene.ron");
+        prepare(&crate::read_scene(&source, path)?, path, &source, &Params::default())
+    }
+
+    const DOWN: &str = "Area(corner: (0.4, 0.995, 0.4), edge_u: (0.2, 0.0, 0.0), edge_v: (0.0, 0.0, 0.2), emission: (10.0, 10.0, 10.0))";
+    const UP: &str = "Area(corner: (0.4, 0.995, 0.4), edge_u: (0.0, 0.0, 0.2), edge_v: (0.2, 0.0, 0.0), emission: (10.0, 10.0, 10.0))";
+
+    #[test]
+    fn a_light_that_lights_the_room_gets_no_word() {
+        let prepared = prepare_with(&room(true, None), DOWN).unwrap();
+        assert!(prepared.warnings.is_empty(), "{:?}", prepared.warnings);
+    }
+
+    /// Issue 11: a light wound the wrong way under a ceiling lit the room
+    /// 44x darker through the gap, with no word.
+    #[test]
+    fn a_light_wound_into_the_ceiling_is_named() {
+        let warnings = prepare_with(&room(true, None), UP).unwrap().warnings;
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        let w = &warnings[0];
+        assert!(w.starts_with("emitter 'area_light_0' (material 'area_light_0', s/scene.ron): half the rays from its front hit a surface within 0.0"), "{w}");
+        assert!(w.contains("is it wound the wrong way?"), "{w}");
+        // The back sees the floor and the walls, 0.5 to 1.5 m away.
+        let back: f64 = w.split("travel over ").nth(1).and_then(|r| r.split(' ').next()).and_then(|x| x.parse().ok()).unwrap();
+        assert!((0.5..1.5).contains(&back), "{w}");
+    }
+
+    #[test]
+    fn a_light_shining_into_back_faces_is_named() {
+        let warnings = prepare_with(&room(false, None), DOWN).unwrap().warnings;
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(warnings[0].contains(": 100% of the rays from its front hit the back of a surface; is it wound the wrong way?"), "{}", warnings[0]);
+    }
+
+    #[test]
+    fn a_light_facing_out_of_an_open_box_is_named() {
+        let open_top = room(true, Some("4 3 7 8"));
+        let warnings = prepare_with(&open_top, UP).unwrap().warnings;
+        assert_eq!(warnings, ["emitter 'area_light_0' (material 'area_light_0', s/scene.ron) faces away from every surface: all 256 rays from its front leave the scene"]);
+        let sideways = "Area(corner: (0.5, 0.3, 0.3), edge_u: (0.0, 0.3, 0.0), edge_v: (0.0, 0.0, 0.3), emission: (1.0, 1.0, 1.0))";
+        let warnings = prepare_with(&open_top, sideways).unwrap().warnings;
+        assert!(warnings.is_empty(), "a light facing a wall of the open box lights it: {warnings:?}");
+    }
+
+    #[test]
+    fn zero_area_and_non_finite_lights_are_errors_naming_them() {
+        let error = |lights: &str| prepare_with(&room(true, None), lights).err().map(|e| e.to_string());
+        let flat = "Area(corner: (0.4, 0.9, 0.4), edge_u: (0.2, 0.0, 0.0), edge_v: (0.4, 0.0, 0.0), emission: (1.0, 1.0, 1.0))";
+        assert_eq!(error(flat).as_deref(), Some("s/scene.ron: light 0 (Area, 'area_light_0'): edge_u and edge_v span no area (zero or parallel edges)"));
+        let nan = format!("{DOWN}, Area(corner: (0.4, NaN, 0.4), edge_u: (0.2, 0.0, 0.0), edge_v: (0.0, 0.0, 0.2), emission: (1.0, 1.0, 1.0))");
+        assert_eq!(error(&nan).as_deref(), Some("s/scene.ron: light 1 (Area, 'area_light_1'): corner [0.4, NaN, 0.4] is not finite"));
+        let tiny = "Area(corner: (0.4, 0.9, 0.4), edge_u: (1e-9, 0.0, 0.0), edge_v: (0.0, 0.0, 1e-9), emission: (1.0, 1.0, 1.0))";
+        assert_eq!(error(tiny).as_deref(), Some("s/scene.ron: emitter 'area_light_0' (material 'area_light_0', s/scene.ron) has zero area: all 2 of its triangles are degenerate"));
+        let lamp = format!("{}o lamp\nusemtl glow\nv 0.2 0.5 0.5\nv 0.4 0.5 0.5\nv 0.6 0.5 0.5\nf -3 -2 -1\n", room(true, None));
+        let message = prepare_with(&lamp, "").err().map(|e| e.to_string());
+        assert_eq!(message.as_deref(), Some("s/a.obj:22: emitter 'lamp' (material 'glow', s/a.obj:22) has zero area: all 1 of its triangles are degenerate"));
+    }
+
+    #[test]
+    fn a_corner_beyond_single_precision_when_scaled_is_named_by_line() {
+        let source = Memory::text(&[
+            ("scene.ron", "Scene(meshes: [Obj(file: \"a.obj\", scale: 1e35)], camera: Camera(eye: (0.0, 0.0, -1.0), target: (0.0, 0.0, 0.0), up: (0.0, 1.0, 0.0), vertical_fov_deg: 60.0, width: 8, height: 8))"),
+            ("a.obj", "o big\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+        ]);
+        let path = Path::new("scene.ron");
+        let error = prepare(&crate::read_scene(&source, path).unwrap(), path, &source, &Params::default()).unwrap_err();
+        assert_eq!(error.to_string(), "a.obj:5: object 'big': a corner lies at [1e35, 0.0, 0.0] once placed (its mesh entry's scale and translate): not a finite position within 1e30 m");
     }
 }

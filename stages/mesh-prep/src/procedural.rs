@@ -287,7 +287,7 @@ mod tests {
         let out = tessellate(obj, 2);
         assert_eq!(out.lines().filter(|l| l.starts_with("f ")).count(), 32);
         assert!(out.starts_with("mtllib m.mtl\no q\nusemtl a\n"));
-        // Quads count twice after tobj's triangulation: 16 quads (2 m^2) + 16 triangles (0.5 m^2).
+        // Quads count twice after the OBJ reader's triangulation: 16 quads (2 m^2) + 16 triangles (0.5 m^2).
         let mut area = 0.0;
         let v: Vec<[f64; 3]> = out.lines().filter(|l| l.starts_with("v ")).map(|l| {
             let p: Vec<f64> = l.split_whitespace().skip(1).map(|x| x.parse().unwrap()).collect();

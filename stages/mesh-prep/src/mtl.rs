@@ -1,0 +1,223 @@
+//! Wavefront MTL material libraries, read by hand: the format is a few
+//! statements, and real files use its freedoms (a colour given as one grey
+//! value, `Ks 0`; texture options before a file name; names with spaces)
+//! that crate parsers reject or panic on. Every error names the file and
+//! line.
+//!
+//! Read statements (others, like `Ka`, `Ns`, `Ni`, are ignored):
+//!
+//! | statement | meaning |
+//! |---|---|
+//! | `newmtl name` | starts a material (the whole rest of the line is the name) |
+//! | `Kd`, `Ks`, `Ke`, `Tf` | a colour: `r g b`, or one value `g` meaning `g g g` |
+//! | `d` | dissolve (opacity), one value (`d -halo f` reads `f`) |
+//! | `illum` | illumination model, an integer 0 to 10 |
+//! | `map_Kd`, `map_d`, `norm`, `bump`, `map_Bump` | a texture: options (`-o u v w`, `-bm f`, ...), then the file name (the rest of the line) |
+
+use schemas::Error;
+use std::path::{Path, PathBuf};
+
+/// A texture a material names.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextureRef {
+    /// The file name as the MTL writes it (relative to the MTL's folder).
+    pub name: String,
+    /// Line of the statement that names it.
+    pub line: usize,
+}
+
+/// One `newmtl` entry.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MtlMaterial {
+    /// Material name.
+    pub name: String,
+    /// The library it comes from.
+    pub file: PathBuf,
+    /// Line of its `newmtl`.
+    pub line: usize,
+    /// `Kd`: diffuse reflectance.
+    pub diffuse: Option<[f64; 3]>,
+    /// `Ks`: specular reflectance.
+    pub specular: Option<[f64; 3]>,
+    /// `Ke`: emission (radiance, as path tracers read it).
+    pub emissive: Option<[f64; 3]>,
+    /// `Tf`: transmission filter.
+    pub transmission_filter: Option<[f64; 3]>,
+    /// `d`: dissolve (1 opaque).
+    pub dissolve: Option<f64>,
+    /// `illum`: illumination model.
+    pub illumination_model: Option<u32>,
+    /// `map_Kd`.
+    pub diffuse_texture: Option<TextureRef>,
+    /// `map_d`.
+    pub dissolve_texture: Option<TextureRef>,
+    /// `norm`, `bump` or `map_Bump`.
+    pub normal_texture: Option<TextureRef>,
+}
+
+/// Texture options and how many values each takes (`-o`, `-s`, `-t` take
+/// one to three numbers: as many as follow).
+const TEXTURE_OPTIONS: &[(&str, usize)] = &[
+    ("-blendu", 1),
+    ("-blendv", 1),
+    ("-bm", 1),
+    ("-boost", 1),
+    ("-cc", 1),
+    ("-clamp", 1),
+    ("-imfchan", 1),
+    ("-mm", 2),
+    ("-texres", 1),
+    ("-type", 1),
+    ("-o", 3),
+    ("-s", 3),
+    ("-t", 3),
+];
+
+/// Parses the MTL library `text` read from `path`. `notes` receives a line
+/// for each statement that is ignored although it looks meant (a colour
+/// before any `newmtl`).
+pub fn parse_mtl(path: &Path, text: &str, notes: &mut Vec<String>) -> Result<Vec<MtlMaterial>, Error> {
+    let mut materials: Vec<MtlMaterial> = Vec::new();
+    for (line, statement) in crate::text::statements(text) {
+        let error = |message: String| Error::parse(path, Some(line), message);
+        let (keyword, rest) = split_keyword(&statement);
+        if keyword == "newmtl" {
+            if rest.is_empty() {
+                return Err(error("newmtl needs a material name".into()));
+            }
+            materials.push(MtlMaterial { name: rest.to_string(), file: path.to_path_buf(), line, ..Default::default() });
+            continue;
+        }
+        let known = matches!(keyword, "Kd" | "Ks" | "Ke" | "Tf" | "d" | "illum" | "map_Kd" | "map_d" | "norm" | "bump" | "map_Bump" | "map_bump");
+        let Some(current) = materials.last_mut() else {
+            if known {
+                notes.push(format!("{}:{line}: '{keyword}' before any newmtl is ignored", path.display()));
+            }
+            continue;
+        };
+        match keyword {
+            "Kd" => current.diffuse = Some(colour(keyword, rest).map_err(error)?),
+            "Ks" => current.specular = Some(colour(keyword, rest).map_err(error)?),
+            "Ke" => current.emissive = Some(colour(keyword, rest).map_err(error)?),
+            "Tf" => current.transmission_filter = Some(colour(keyword, rest).map_err(error)?),
+            "d" => {
+                let value = rest.split_whitespace().last().ok_or_else(|| error("d needs a value".into()))?;
+                current.dissolve = Some(number(keyword, value).map_err(error)?);
+            }
+            "illum" => {
+                let model = rest.parse::<u32>().ok().filter(|m| *m <= 10);
+                current.illumination_model = Some(model.ok_or_else(|| error(format!("illum '{rest}' is not an illumination model (0 to 10)")))?);
+            }
+            "map_Kd" => current.diffuse_texture = Some(texture(keyword, rest, line).map_err(error)?),
+            "map_d" => current.dissolve_texture = Some(texture(keyword, rest, line).map_err(error)?),
+            "norm" | "bump" | "map_Bump" | "map_bump" => current.normal_texture = Some(texture(keyword, rest, line).map_err(error)?),
+            _ => {}
+        }
+    }
+    Ok(materials)
+}
+
+/// The first word of a statement and the trimmed rest of it.
+pub fn split_keyword(statement: &str) -> (&str, &str) {
+    match statement.split_once(char::is_whitespace) {
+        Some((keyword, rest)) => (keyword, rest.trim()),
+        None => (statement, ""),
+    }
+}
+
+/// A finite number.
+fn number(keyword: &str, text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("{keyword}: '{text}' is not finite")),
+        Err(_) => Err(format!("{keyword}: '{text}' is not a number")),
+    }
+}
+
+/// A colour: three numbers, or one meaning grey.
+fn colour(keyword: &str, rest: &str) -> Result<[f64; 3], String> {
+    let words: Vec<&str> = rest.split_whitespace().collect();
+    if matches!(words.first(), Some(&("spectral" | "xyz"))) {
+        return Err(format!("{keyword}: {} colours are not supported; give r g b", words[0]));
+    }
+    let values = words.iter().map(|w| number(keyword, w)).collect::<Result<Vec<f64>, String>>()?;
+    match values.as_slice() {
+        [g] => Ok([*g; 3]),
+        [r, g, b] => Ok([*r, *g, *b]),
+        _ => Err(format!("{keyword} needs one value (grey) or three (r g b), found {}", values.len())),
+    }
+}
+
+/// A texture statement: options, then the file name (the rest of the line).
+fn texture(keyword: &str, rest: &str, line: usize) -> Result<TextureRef, String> {
+    let mut remaining = rest;
+    loop {
+        let (word, after) = split_keyword(remaining);
+        let Some(&(_, arity)) = TEXTURE_OPTIONS.iter().find(|(name, _)| *name == word) else {
+            break;
+        };
+        remaining = after;
+        for taken in 0..arity {
+            let (value, after) = split_keyword(remaining);
+            // -o, -s and -t take up to three numbers: stop at the first word
+            // that is not one.
+            if arity == 3 && taken > 0 && value.parse::<f64>().is_err() {
+                break;
+            }
+            if value.is_empty() {
+                return Err(format!("{keyword}: option {word} needs a value"));
+            }
+            remaining = after;
+        }
+    }
+    if remaining.is_empty() {
+        return Err(format!("{keyword} needs a file name"));
+    }
+    Ok(TextureRef { name: remaining.to_string(), line })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Vec<MtlMaterial>, String> {
+        parse_mtl(Path::new("m.mtl"), text, &mut Vec::new()).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn one_value_is_grey_and_three_are_rgb() {
+        let m = parse("newmtl a\nKd 0.5\nKs 0\nKe 1 2 3\n").unwrap();
+        assert_eq!(m[0].diffuse, Some([0.5; 3]));
+        assert_eq!(m[0].specular, Some([0.0; 3]));
+        assert_eq!(m[0].emissive, Some([1.0, 2.0, 3.0]));
+        assert_eq!(m[0].line, 1);
+    }
+
+    #[test]
+    fn bad_colours_are_named_by_line() {
+        assert_eq!(parse("newmtl a\nKd 0.5 0.5\n").unwrap_err(), "m.mtl:2: Kd needs one value (grey) or three (r g b), found 2");
+        assert_eq!(parse("newmtl a\n\nKe 1 nan 1\n").unwrap_err(), "m.mtl:3: Ke: 'nan' is not finite");
+        assert_eq!(parse("newmtl a\nKd\n").unwrap_err(), "m.mtl:2: Kd needs one value (grey) or three (r g b), found 0");
+        assert_eq!(parse("newmtl a\nKd spectral x.rfl\n").unwrap_err(), "m.mtl:2: Kd: spectral colours are not supported; give r g b");
+        assert_eq!(parse("newmtl a\nillum 2.5\n").unwrap_err(), "m.mtl:2: illum '2.5' is not an illumination model (0 to 10)");
+        assert_eq!(parse("newmtl\n").unwrap_err(), "m.mtl:1: newmtl needs a material name");
+    }
+
+    #[test]
+    fn names_with_spaces_and_texture_options() {
+        let m = parse("newmtl Brushed Steel 2\nmap_Kd -o 0.5 0.5 -bm 1.0 textures/steel plate.png\nbump -bm 0.3 n.png\nd -halo 0.8\n").unwrap();
+        assert_eq!(m[0].name, "Brushed Steel 2");
+        assert_eq!(m[0].diffuse_texture, Some(TextureRef { name: "textures/steel plate.png".into(), line: 2 }));
+        assert_eq!(m[0].normal_texture.as_ref().map(|t| t.name.as_str()), Some("n.png"));
+        assert_eq!(m[0].dissolve, Some(0.8));
+        assert_eq!(parse("newmtl a\nmap_Kd -clamp on\n").unwrap_err(), "m.mtl:2: map_Kd needs a file name");
+    }
+
+    #[test]
+    fn colour_before_newmtl_is_noted_not_applied() {
+        let mut notes = Vec::new();
+        let m = parse_mtl(Path::new("m.mtl"), "Kd 1 0 0\nnewmtl a\n", &mut notes).unwrap();
+        assert_eq!(m[0].diffuse, None);
+        assert_eq!(notes, ["m.mtl:1: 'Kd' before any newmtl is ignored"]);
+    }
+}
