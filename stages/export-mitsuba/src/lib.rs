@@ -263,7 +263,7 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
     for light in &manifest.goniometric_lights {
         skipped.push(format!(
             "goniometric light {:?} at {:?} not exported (Mitsuba 3 has no goniometric emitter)",
-            light.file, light.position
+            light.label, light.position
         ));
     }
 

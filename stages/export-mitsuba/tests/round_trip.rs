@@ -229,7 +229,17 @@ fn what_mitsuba_cannot_render_exactly_is_listed() {
     for (i, t) in mesh.triangles.iter_mut().take(4).enumerate() {
         t.material = first + i as u32;
     }
-    manifest.goniometric_lights.push(GoniometricLight { file: "lamp.ies".into(), position: [0.0; 3], nadir: [0.0, -1.0, 0.0], scale: 1.0 });
+    manifest.goniometric_lights.push(GoniometricLight {
+        label: "lamp.ies".into(),
+        position: [0.0; 3],
+        nadir: [0.0, -1.0, 0.0],
+        c0: [1.0, 0.0, 0.0],
+        scale: 1.0,
+        c_angles_deg: vec![0.0],
+        gamma_angles_deg: vec![0.0, 180.0],
+        intensity_cd: vec![1.0, 1.0],
+        flux_lm: 4.0 * std::f64::consts::PI,
+    });
     let exported = export(&mesh, &manifest, &Params::default(), "scene", "");
     let skipped = exported.skipped.join("\n");
     assert_eq!(exported.skipped.len(), 3, "{skipped}");

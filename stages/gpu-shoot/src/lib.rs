@@ -10,7 +10,8 @@
 //! texel of the atlas test its depth against them and gather the
 //! disc-approximation form factor (Eq. 2.2 / 4.1) times the shot power,
 //! scaled by its reflectance (Eq. 4.2-4.3). Goniometric lights
-//! ([`photometry`]: EULUMDAT and IES) shoot first, as point sources with
+//! ([`Luminaire`]: the manifest's tables, read from EULUMDAT and IES files
+//! by mesh-prep) shoot first, as point sources with
 //! intensity `I_max LDT(C, gamma)` (Eq. 3.4) over a full cube of faces.
 //!
 //! The result is written as the lightmap atlas with its region table
@@ -35,12 +36,13 @@
 pub mod atlas;
 pub mod gpu;
 pub mod output;
-pub mod photometry;
 pub mod reference;
 pub mod testing;
 
 use atlas::Atlas;
 use glam::DVec3;
+use radiometry::geometry::frame_with_normal;
+pub use radiometry::photometry::Luminaire;
 use gpu::{Gpu, GpuGroup, GpuParams, GpuSample, GpuTexel, GpuTri, Setup};
 use schemas::lightmap::Shot;
 use schemas::mesh::{Manifest, Mesh};
@@ -138,56 +140,19 @@ impl Params {
     }
 }
 
-/// A goniometric point light ready to shoot.
-#[derive(Clone, Debug)]
-pub struct PointLight {
-    /// The normalised distribution.
-    pub ldt: photometry::Ldt,
-    /// Position, mesh frame, m.
-    pub position: [f64; 3],
-    /// Nadir direction (unit).
-    pub nadir: [f64; 3],
-    /// Multiplier on the file's intensities.
-    pub scale: f64,
-}
-
-impl PointLight {
-    /// Radiant intensity at the distribution's maximum, W/sr:
-    /// `scale x I_max / 683` (004 Eq. 2.12).
-    pub fn i_max_w_per_sr(&self) -> f64 {
-        self.scale * self.ldt.i_max / photometry::K_M
-    }
-
-    /// The light's frame `(r0, u0, n0)`: `n0` the nadir; `r0`, the C0
-    /// direction, is the mesh-frame x axis made perpendicular to the nadir
-    /// (the z axis when the nadir is nearly along x): the manifest gives
-    /// no C0 direction, so this fixed choice keeps a scene reproducible.
-    pub fn frame(&self) -> [DVec3; 3] {
-        frame_with_normal(DVec3::from(self.nadir).normalize())
-    }
-
-    /// Radiant flux, W (the same in R, G, B).
-    pub fn flux(&self) -> f64 {
-        self.scale * self.ldt.flux() / photometry::K_M
-    }
-
-    /// The LDT as the shader reads it: `[nc, ng, C angles, gamma angles, values]`.
-    pub fn table(&self) -> Vec<f32> {
-        let l = &self.ldt;
-        let mut t = vec![l.c_angles.len() as f32, l.gamma_angles.len() as f32];
-        t.extend(l.c_angles.iter().map(|&x| x as f32));
-        t.extend(l.gamma_angles.iter().map(|&x| x as f32));
-        t.extend(l.values.iter().map(|&x| x as f32));
-        t
-    }
-}
-
-/// A frame `(t, b, n)` with `n` given: `t` is the x axis (or z when `n` is
-/// nearly along x) made perpendicular to `n`, `b = n x t`.
-pub fn frame_with_normal(n: DVec3) -> [DVec3; 3] {
-    let seed = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Z };
-    let t = (seed - n * seed.dot(n)).normalize();
-    [t, n.cross(t), n]
+/// The light distribution texture of a luminaire as the shader reads it
+/// (004 Sec. 2.3.2): `[nc, ng, C angles, gamma angles, values]`, the values
+/// the table's intensities over its largest, so the shot's power carries
+/// `I_max` in W/sr ([`Luminaire::i_max`]) and the texture stays in [0, 1].
+pub fn light_table(light: &Luminaire) -> Vec<f32> {
+    let d = &light.distribution;
+    let i_max = d.i_max();
+    let norm = if i_max > 0.0 { i_max } else { 1.0 };
+    let mut t = vec![d.c_angles.len() as f32, d.gamma_angles.len() as f32];
+    t.extend(d.c_angles.iter().map(|&x| x as f32));
+    t.extend(d.gamma_angles.iter().map(|&x| x as f32));
+    t.extend(d.intensity.iter().map(|&x| (x / norm) as f32));
+    t
 }
 
 /// The work a solve did.
@@ -242,7 +207,7 @@ pub fn solve(
     queue: &wgpu::Queue,
     mesh: &Mesh,
     manifest: &Manifest,
-    lights: &[PointLight],
+    lights: &[Luminaire],
     params: &Params,
     on_shot: &mut dyn FnMut(&Shot),
 ) -> Result<Solved, String> {
@@ -310,8 +275,8 @@ pub fn solve(
         hi = hi.max(p);
     }
     for l in lights {
-        lo = lo.min(DVec3::from(l.position));
-        hi = hi.max(DVec3::from(l.position));
+        lo = lo.min(l.position);
+        hi = hi.max(l.position);
     }
     let diagonal = (hi - lo).length().max(1e-6);
     let hemicube = params.visibility == Visibility::Hemicube;
@@ -324,7 +289,7 @@ pub fn solve(
     let batch = (layer_budget / 6).max(1);
     let layers = if hemicube { batch * 6 } else { (layer_budget / 6 * 6).max(6) };
     let batch_area = if hemicube { batch } else { layers };
-    let ldt_capacity = lights.iter().map(|l| l.table().len()).max().unwrap_or(4);
+    let ldt_capacity = lights.iter().map(|l| light_table(l).len()).max().unwrap_or(4);
     let gpu = Gpu::new(
         device,
         &Setup {
@@ -351,7 +316,7 @@ pub fn solve(
             *e += material(t).emission[c] * tri.area as f64;
         }
     }
-    let light_flux: Vec<f64> = lights.iter().map(PointLight::flux).collect();
+    let light_flux: Vec<f64> = lights.iter().map(Luminaire::flux).collect();
     for f in &light_flux {
         for e in emitted.iter_mut() {
             *e += f;
@@ -392,9 +357,9 @@ pub fn solve(
         if shots.len() >= params.max_shots {
             break;
         }
-        let [r0, u0, n0] = light.frame();
-        let i = light.i_max_w_per_sr() as f32;
-        let p = light.position;
+        let [r0, u0, n0] = light.frame;
+        let i = light.i_max() as f32;
+        let p = light.position.to_array();
         let sample = GpuSample {
             position_area: [p[0] as f32, p[1] as f32, p[2] as f32, 0.0],
             t: f4(r0.to_array()),
@@ -402,7 +367,7 @@ pub fn solve(
             n: f4(n0.to_array()),
             power: [i, i, i, 1.0],
         };
-        gpu.upload_samples(queue, &[sample], Some(&light.table()));
+        gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
         let p = GpuParams { shooter: u32::MAX, sample_first: 0, sample_count: 1, layers_per_sample: 6, mode: 0, ..base };
         gpu.shoot_batch(device, queue, &p, false);
         work.layers += 6;

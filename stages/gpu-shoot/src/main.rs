@@ -1,11 +1,11 @@
 //! `gpu-shoot`: see the library's documentation and `--help`.
 
 use clap::Parser;
-use gpu_shoot::{gpu, output, photometry, solve, Params, PointLight, Visibility};
+use gpu_shoot::{gpu, output, solve, Luminaire, Params, Visibility};
 use schemas::header::Schema;
 use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
-use schemas::ron_io::{read_bytes, write_ron};
+use schemas::ron_io::write_ron;
 use schemas::solution::Solution;
 use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
@@ -15,7 +15,7 @@ use std::process::ExitCode;
 /// Progressive radiosity on the GPU (paper 004): per-triangle float
 /// lightmaps, shooter selection by GPU reduction, hemicube or stereographic
 /// visibility, disc-approximation form factors, ambient overshooting,
-/// goniometric lights (.ldt/.ies). Writes the lightmap atlas (EXR), a
+/// goniometric lights (the manifest's tables, from .ldt/.ies files). Writes the lightmap atlas (EXR), a
 /// solution.exr that grid-gather previews, and a convergence record.
 /// Runs on any Vulkan adapter, Mesa's lavapipe included.
 #[derive(Parser, Debug)]
@@ -158,15 +158,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     }
     let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
-    let mut lights = Vec::new();
-    for light in &manifest.goniometric_lights {
-        let path = Path::new(&light.file);
-        let bytes = read_bytes(path)?;
-        let text = String::from_utf8_lossy(&bytes);
-        let distribution = photometry::parse(path, &text)?;
-        run.input(schemas::header::Input::new(path, &bytes, None));
-        lights.push(PointLight { ldt: photometry::Ldt::new(&distribution), position: light.position, nadir: light.nadir, scale: light.scale });
-    }
+    let lights = Luminaire::all(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
     let (device, queue, info) = gpu::acquire().map_err(|m| schemas::Error::invalid(Path::new("gpu"), None, m))?;
     let adapter = gpu::describe(&info);
     let bar = progress(1000, "converged");

@@ -1,10 +1,10 @@
 //! CPU references of the GPU kernels, in f64, for the tests that tie each
 //! kernel to its definition: the residual reduction per triangle and the
-//! receiver pass (disc-approximation form factor, 004 Eq. 2.2 / 4.1, and
-//! the point-light lookup, Eq. 3.4) with visibility supplied by the caller.
+//! receiver pass (disc-approximation form factor, 004 Eq. 2.2 / 4.1; the
+//! point-light lookup, Eq. 3.4, is `radiometry::photometry::Luminaire`'s)
+//! with visibility supplied by the caller.
 
 use crate::atlas::Atlas;
-use crate::photometry::{angles, Ldt};
 use glam::DVec3;
 
 /// Residual power of triangle `t`: `sum_k dB_k A_k` over its covered
@@ -37,22 +37,6 @@ pub fn disc_form_factor(receiver: DVec3, receiver_normal: DVec3, sender: DVec3, 
         return 0.0;
     }
     a_s * cos_s * cos_r / (std::f64::consts::PI * d2 + a_s)
-}
-
-/// Irradiance at a receiving point from a point light of intensity
-/// `i_max LDT(C, gamma)` W/sr at `light`, frame `(r0, u0, n0)` (004 Eq.
-/// 3.4 with the receiver's cosine): `I cos_r / d^2`.
-pub fn light_irradiance(receiver: DVec3, receiver_normal: DVec3, light: DVec3, frame: [DVec3; 3], ldt: &Ldt, i_max: f64) -> f64 {
-    let v = receiver - light;
-    let d2 = v.length_squared();
-    let d = d2.sqrt();
-    let cos_r = -receiver_normal.dot(v) / d;
-    if cos_r <= 0.0 {
-        return 0.0;
-    }
-    let w = v / d;
-    let (c, gamma) = angles(w.to_array(), frame[2].to_array(), frame[0].to_array(), frame[1].to_array());
-    i_max * ldt.lookup(c, gamma) * cos_r / d2
 }
 
 /// The corners of the patch a covered texel stands for, mesh frame:

@@ -3,9 +3,9 @@
 //! references. Without an adapter they skip loudly, but fail under CI.
 
 use glam::DVec3;
-use gpu_shoot::photometry::{Distribution, Ldt};
+use radiometry::photometry::{Distribution, Luminaire, K_M};
 use gpu_shoot::testing::{closed_box, manifest, material, quads};
-use gpu_shoot::{gpu, reference, solve, Params, PointLight, Solved, Visibility};
+use gpu_shoot::{gpu, reference, solve, Params, Solved, Visibility};
 use schemas::mesh::{Manifest, Mesh};
 use std::f64::consts::PI;
 
@@ -20,9 +20,14 @@ fn device() -> Option<(wgpu::Device, wgpu::Queue)> {
     }
 }
 
-fn run(mesh: &Mesh, manifest: &Manifest, lights: &[PointLight], params: &Params) -> Option<Solved> {
+fn run(mesh: &Mesh, manifest: &Manifest, lights: &[Luminaire], params: &Params) -> Option<Solved> {
     let (device, queue) = device()?;
     Some(solve(&device, &queue, mesh, manifest, lights, params, &mut |_| {}).unwrap())
+}
+
+/// A light of table `d` (cd, scale 1) at `position`, nadir down, C0 along x.
+fn point_light(d: Distribution, position: [f64; 3]) -> Luminaire {
+    Luminaire { distribution: d, position: DVec3::from(position), frame: [DVec3::X, DVec3::Z, -DVec3::Y], w_per_sr_per_cd: 1.0 / K_M }
 }
 
 /// Howell B-3 point to a parallel rectangle with one corner above it.
@@ -135,14 +140,14 @@ fn constant_intensity_light_gives_i_cos_over_d_squared() {
     let rho = 0.5;
     let mesh = quads(&[(DVec3::new(-1.0, 0.0, -1.0), DVec3::Z * 2.0, DVec3::X * 2.0, 0, 0)]);
     let m = manifest(1, vec![material([rho; 3], [0.0; 3])]);
-    let d = Distribution { c_angles: vec![0.0], gamma_angles: vec![0.0, 90.0, 180.0], intensity: vec![vec![683.0; 3]] };
-    let light = PointLight { ldt: Ldt::new(&d), position: [0.2, 0.7, -0.1], nadir: [0.0, -1.0, 0.0], scale: 1.0 };
+    let d = Distribution { c_angles: vec![0.0], gamma_angles: vec![0.0, 90.0, 180.0], intensity: vec![K_M; 3] };
+    let light = point_light(d, [0.2, 0.7, -0.1]);
     let params = Params { texels: 4000.0, max_shots: 1, convergence: 1.0, resolution: 256, ..Params::default() };
     let Some(solved) = run(&mesh, &m, std::slice::from_ref(&light), &params) else { return };
     let mut worst = 0.0f64;
     for (k, t) in solved.atlas.texels.iter().enumerate() {
         let p = DVec3::from(t.position.map(f64::from));
-        let v = p - DVec3::from(light.position);
+        let v = p - light.position;
         let cos = -v.y / v.length();
         let exact = rho * 1.0 * cos / v.length_squared();
         worst = worst.max((solved.radiosity[k][1] as f64 - exact).abs() / exact);
@@ -154,19 +159,19 @@ fn constant_intensity_light_gives_i_cos_over_d_squared() {
 #[test]
 fn asymmetric_ldt_and_ies_lights_match_the_cpu_lookup_on_the_gpu() {
     for file in ["lidrs_example_prolicht_E30-0019.ldt", "lidrs_iesna2002_example_typec_tilt_include.ies"] {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);
-    let d = gpu_shoot::photometry::parse(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mesh-prep/tests/data/photometry").join(file);
+    let d = mesh_prep::photometry::parse(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
     let rho = 0.5;
     let mesh = quads(&[(DVec3::new(-1.0, 0.0, -1.0), DVec3::Z * 2.0, DVec3::X * 2.0, 0, 0)]);
     let m = manifest(1, vec![material([rho; 3], [0.0; 3])]);
-    let light = PointLight { ldt: Ldt::new(&d), position: [0.1, 0.6, 0.05], nadir: [0.0, -1.0, 0.0], scale: 1.0 };
+    let light = point_light(d, [0.1, 0.6, 0.05]);
     let params = Params { texels: 3000.0, max_shots: 1, convergence: 1.0, resolution: 256, ..Params::default() };
     let Some(solved) = run(&mesh, &m, std::slice::from_ref(&light), &params) else { return };
-    let (frame, i_max) = (light.frame(), light.i_max_w_per_sr());
+    let i_max = light.i_max();
     let mut worst = 0.0f64;
     for (k, t) in solved.atlas.texels.iter().enumerate() {
         let p = DVec3::from(t.position.map(f64::from));
-        let exact = rho * reference::light_irradiance(p, DVec3::Y, DVec3::from(light.position), frame, &light.ldt, i_max);
+        let exact = rho * light.irradiance(p, DVec3::Y);
         if exact > 1e-3 * rho * i_max / 0.36 {
             worst = worst.max((solved.radiosity[k][0] as f64 - exact).abs() / exact);
         }

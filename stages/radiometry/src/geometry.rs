@@ -55,6 +55,16 @@ impl TriangleGeometry {
     }
 }
 
+/// A right-handed orthonormal frame `[t, b, n]` with `n` given (unit):
+/// `t` is the mesh-frame x axis made perpendicular to `n` (the z axis when
+/// `n` is nearly along x), `b = n x t`. A fixed rule, so a frame derived
+/// from a normal alone is reproducible.
+pub fn frame_with_normal(n: DVec3) -> [DVec3; 3] {
+    let seed = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Z };
+    let t = (seed - n * seed.dot(n)).normalize();
+    [t, n.cross(t), n]
+}
+
 /// The geometry of every triangle of `mesh`.
 pub fn mesh_triangles(mesh: &Mesh) -> Vec<TriangleGeometry> {
     let p = |i: u32| {

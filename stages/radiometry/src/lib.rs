@@ -7,6 +7,8 @@
 //! - [`subdivision`]: the 1:4 element subdivision rule and point location.
 //! - [`geometry`]: triangle corners, normals and areas in f64.
 //! - [`rays`]: ray casting over obvhs's CWBVH.
+//! - [`photometry`]: goniometric point lights: the type C distribution,
+//!   its Catmull-Rom lookup and flux, irradiance from a luminaire.
 //! - [`camera`]: pinhole camera rays.
 //! - [`color`]: luminance.
 //!
@@ -16,6 +18,7 @@ pub mod camera;
 pub mod color;
 pub mod form_factor;
 pub mod geometry;
+pub mod photometry;
 pub mod rays;
 pub mod sampling;
 pub mod subdivision;
