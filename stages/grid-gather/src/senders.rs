@@ -21,7 +21,7 @@
 //! take a third coordinate, radical inverse in base 3, to pick the triangle.
 
 use glam::DVec3;
-use radiometry::form_factor::point_to_polygon;
+use radiometry::form_factor::point_to_one_sided_polygon;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::sampling::{square_to_triangle, Stream};
 use schemas::cluster::Clusters;
@@ -356,7 +356,7 @@ impl<'a> Senders<'a> {
 
     /// Form factor from a differential area at `p` with unit normal
     /// `normal` to the sender: Lambert's closed form (002 Eq. 3) for an
-    /// element; for a cluster the point-to-area kernel
+    /// element, 0 behind its plane (one-sided); for a cluster the point-to-area kernel
     /// `sum_k (A / K) cos+(theta_p) cos+(theta_k) / (pi r_k^2)` over its
     /// first [`CLUSTER_FACTOR_SAMPLES`] fixed samples (front faces only;
     /// the near singularity is cut at `r^2 >= A / K`, the area one sample
@@ -364,7 +364,7 @@ impl<'a> Senders<'a> {
     /// evaluations.
     pub fn form_factor(&self, node: Node, p: DVec3, normal: DVec3) -> (f64, u64) {
         match node {
-            Node::Element(e) => (point_to_polygon(p, normal, &self.element_corners(e)), 1),
+            Node::Element(e) => (point_to_one_sided_polygon(p, normal, &self.element_corners(e), self.triangles[self.solution.elements[e as usize].triangle as usize].normal), 1),
             Node::Cluster(_) => {
                 let area = self.area(node);
                 let k = CLUSTER_FACTOR_SAMPLES;

@@ -181,7 +181,7 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
     if receiver == sender || !in_front(&s.points, r.points[0], nr) || !in_front(&r.points, s.points[0], ns) {
         return None;
     }
-    let f = triangle_to_polygon(&r.points, nr, &s.points, quadrature_depth);
+    let f = triangle_to_polygon(&r.points, nr, &s.points, ns, quadrature_depth);
     (f.mean > 0.0).then_some(Link {
         receiver: Node::Element(receiver),
         sender: Node::Element(sender),

@@ -38,7 +38,7 @@
 
 use crate::elements::Hierarchy;
 use crate::nodes::key;
-use radiometry::form_factor::{point_kernel, point_to_polygon, WeightedVisibility};
+use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon, WeightedVisibility};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use schemas::solution::Node;
@@ -76,7 +76,7 @@ pub fn estimate(h: &Hierarchy, scene: Option<&SceneRays>, receiver: Node, sender
         // refines anyway.
         let pair = (sender_area * point_kernel(x.point, x.normal, y.point, y.normal) / PI).min(1.0);
         let value = match sender {
-            Node::Element(e) => point_to_polygon(x.point, x.normal, &h.elements[e as usize].points),
+            Node::Element(e) => point_to_one_sided_polygon(x.point, x.normal, &h.elements[e as usize].points, h.normal(e)),
             Node::Cluster(_) => pair,
         };
         sum += value;

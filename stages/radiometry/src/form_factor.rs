@@ -55,6 +55,28 @@ pub fn point_to_polygon(point: DVec3, normal: DVec3, polygon: &[DVec3]) -> f64 {
     (sum.abs() / (2.0 * PI)).min(1.0)
 }
 
+/// Lambert's factor to a one-sided polygon, one that emits and reflects
+/// only on the side its unit normal `front` points to:
+///
+/// ```text
+/// F = point_to_polygon(x)   where (x - v_0) . front > 0,   else 0
+/// ```
+///
+/// The kernel's sender cosine `front . (x - y) / r` has the sign of
+/// `(x - v_0) . front` for every `y` of a planar polygon, so a point behind
+/// the polygon's plane sees only its back, which sends nothing.
+/// [`point_to_polygon`] alone is two-sided in the sender (it clips only to
+/// the receiver's hemisphere): a receiver that straddles a tilted
+/// emitter's plane would be lit through the emitter's back (issue 10,
+/// item 6). The factor is continuous across the plane (it tends to 0 as the
+/// polygon is seen edge-on), so the cut adds no step.
+pub fn point_to_one_sided_polygon(point: DVec3, normal: DVec3, polygon: &[DVec3], front: DVec3) -> f64 {
+    if polygon.is_empty() || (point - polygon[0]).dot(front) <= 0.0 {
+        return 0.0;
+    }
+    point_to_polygon(point, normal, polygon)
+}
+
 /// The form-factor kernel between two points without its `1/pi` (1/m²):
 ///
 /// ```text
@@ -167,12 +189,13 @@ pub struct AreaFactor {
     pub max: f64,
 }
 
-/// The [`DUNAVANT_5`] estimate over `receiver`.
-fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3]) -> AreaFactor {
+/// The [`DUNAVANT_5`] estimate over `receiver` of the factor to the
+/// one-sided `sender`.
+fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &OneSided) -> AreaFactor {
     let mut estimate = AreaFactor { mean: 0.0, min: f64::INFINITY, max: 0.0 };
     for (b, w) in DUNAVANT_5 {
         let p = receiver[0] * b[0] + receiver[1] * b[1] + receiver[2] * b[2];
-        let f = point_to_polygon(p, normal, sender);
+        let f = point_to_one_sided_polygon(p, normal, sender.polygon, sender.front);
         estimate.mean += w * f;
         estimate.min = estimate.min.min(f);
         estimate.max = estimate.max.max(f);
@@ -180,16 +203,25 @@ fn rule(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3]) -> AreaFactor {
     estimate
 }
 
+/// A sender polygon and the unit normal of its one front side.
+#[derive(Clone, Copy)]
+struct OneSided<'a> {
+    polygon: &'a [DVec3],
+    front: DVec3,
+}
+
 /// Relative accuracy the adaptive receiver quadrature aims for.
 pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
 
-/// Area-averaged form factor from a receiver triangle to a sender polygon:
+/// Area-averaged form factor from a receiver triangle to a one-sided sender
+/// polygon (front side `sender_normal`):
 ///
 /// ```text
 /// F_rs = 1/A_r * integral over A_r of F_{dA->s} dA
 /// ```
 ///
-/// with the inner factor exact (002 Eq. 3) and the outer integral by
+/// with the inner factor exact (002 Eq. 3, zero behind the sender's plane:
+/// [`point_to_one_sided_polygon`]) and the outer integral by
 /// [`DUNAVANT_5`], with the spread of the point values (the refinement
 /// oracle's measure of how much the transport varies over the receiver).
 ///
@@ -203,11 +235,43 @@ pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
 /// This matters for energy balance: in a closed room with reflectance rho,
 /// a relative error d in the sum of a receiver's form factors becomes an
 /// error of about rho d / (1 - rho) in the mean radiosity.
-pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3], depth: u32) -> AreaFactor {
+///
+/// A receiver that straddles the sender's plane is integrated over its part
+/// in front only (clipped, then fanned into triangles weighted by area):
+/// the integrand is 0 behind, and a fixed rule across that kink misses the
+/// front part's light by tens of percent on a coarse leaf.
+pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3], sender_normal: DVec3, depth: u32) -> AreaFactor {
+    let sender = OneSided { polygon: sender, front: sender_normal };
+    let Some(origin) = sender.polygon.first().copied() else {
+        return AreaFactor { mean: 0.0, min: 0.0, max: 0.0 };
+    };
+    let height = |p: DVec3| (p - origin).dot(sender_normal);
+    if receiver.iter().all(|&p| height(p) > 0.0) {
+        return front_part(receiver, receiver_normal, &sender, depth);
+    }
+    let mut front = [DVec3::ZERO; MAX_CLIPPED];
+    let count = clip_to_upper_hemisphere(origin, sender_normal, receiver, &mut front);
+    let area = |t: &[DVec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).length();
+    let whole = area(receiver);
+    let mut result = AreaFactor { mean: 0.0, min: 0.0, max: 0.0 };
+    if whole <= 0.0 {
+        return result;
+    }
+    for k in 1..count.saturating_sub(1) {
+        let piece = [front[0], front[k], front[k + 1]];
+        let part = front_part(&piece, receiver_normal, &sender, depth);
+        result.mean += area(&piece) / whole * part.mean;
+        result.max = result.max.max(part.max);
+    }
+    result
+}
+
+/// [`triangle_to_polygon`] for a receiver wholly in front of the sender.
+fn front_part(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &OneSided, depth: u32) -> AreaFactor {
     let centroid = |p: &[DVec3]| p.iter().copied().sum::<DVec3>() / p.len() as f64;
     let size = |p: &[DVec3], c: DVec3| p.iter().map(|v| v.distance(c)).fold(0.0, f64::max);
-    let (cr, cs) = (centroid(receiver), centroid(sender));
-    let far = cr.distance(cs) > 3.0 * (size(receiver, cr) + size(sender, cs));
+    let (cr, cs) = (centroid(receiver), centroid(sender.polygon));
+    let far = cr.distance(cs) > 3.0 * (size(receiver, cr) + size(sender.polygon, cs));
     let coarse = rule(receiver, receiver_normal, sender);
     if far {
         coarse
@@ -216,7 +280,7 @@ pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender
     }
 }
 
-fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &[DVec3], coarse: AreaFactor, depth: u32) -> AreaFactor {
+fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &OneSided, coarse: AreaFactor, depth: u32) -> AreaFactor {
     if depth == 0 {
         return coarse;
     }
@@ -304,6 +368,39 @@ mod tests {
         assert!((f - point_to_polygon(DVec3::ZERO, DVec3::Z, &upper)).abs() < 1e-15);
     }
 
+    /// A floor point behind a tilted one-sided lamp's plane sees only its
+    /// back: 0, where the two-sided factor is not; in front the two agree.
+    #[test]
+    fn one_sided_polygon_sends_nothing_behind_its_plane() {
+        // Lamp centred 0.6 m above the floor, facing down and towards -y;
+        // its plane meets the floor at y = 0.8.
+        let (c, front) = (dvec3(0.0, 0.0, 0.6), dvec3(0.0, -0.6, -0.8));
+        let (u, v) = (DVec3::X * 0.25, dvec3(0.0, -0.8, 0.6) * 0.25);
+        let lamp = [c - u - v, c + u - v, c + u + v, c - u + v];
+        let behind = dvec3(0.0, 1.0, 0.0);
+        assert!(point_to_polygon(behind, DVec3::Z, &lamp) > 1e-3);
+        assert_eq!(point_to_one_sided_polygon(behind, DVec3::Z, &lamp, front), 0.0);
+        let ahead = dvec3(0.1, 0.2, 0.0);
+        assert_eq!(point_to_one_sided_polygon(ahead, DVec3::Z, &lamp, front), point_to_polygon(ahead, DVec3::Z, &lamp));
+        // A floor triangle straddling the plane gets only its front part,
+        // integrated as such (depth 0: no adaptive help across the kink).
+        let straddling = [dvec3(-0.1, 0.7, 0.0), dvec3(0.1, 0.7, 0.0), dvec3(0.0, 0.9, 0.0)];
+        let one = triangle_to_polygon(&straddling, DVec3::Z, &lamp, front, 0).mean;
+        let n = 400;
+        let mut sum = 0.0;
+        let mut count = 0;
+        for i in 0..n {
+            for j in 0..n - i {
+                let (a, b) = ((i as f64 + 1.0 / 3.0) / n as f64, (j as f64 + 1.0 / 3.0) / n as f64);
+                let p = straddling[0] * (1.0 - a - b) + straddling[1] * a + straddling[2] * b;
+                sum += if p.y < 0.8 { point_to_polygon(p, DVec3::Z, &lamp) } else { 0.0 };
+                count += 1;
+            }
+        }
+        let reference = sum / count as f64;
+        assert!((one - reference).abs() < 1e-3 * reference, "{one} vs {reference}");
+    }
+
     #[test]
     fn grazing_and_touching_configurations_stay_finite() {
         // Receiver point a hair away from a perpendicular wall it touches.
@@ -337,10 +434,10 @@ mod tests {
         let floor = [dvec3(0.0, 0.0, 0.0), dvec3(w, 0.0, 0.0), dvec3(w, l, 0.0), dvec3(0.0, l, 0.0)];
         let wall = [dvec3(0.0, 0.0, 0.0), dvec3(0.0, l, 0.0), dvec3(0.0, l, h), dvec3(0.0, 0.0, h)];
         let halves = [[floor[0], floor[1], floor[2]], [floor[0], floor[2], floor[3]]];
-        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall, 5).mean).sum();
+        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall, DVec3::X, 5).mean).sum();
         let exact = perpendicular_shared_edge(w, h, l);
         assert!(((f - exact) / exact).abs() < 1e-4, "{f} vs {exact}");
-        let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &wall).mean).sum();
+        let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &OneSided { polygon: &wall, front: DVec3::X }).mean).sum();
         assert!(((plain - exact) / exact).abs() > 1e-3, "the fixed rule alone would not do: {plain}");
     }
 
