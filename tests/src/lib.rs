@@ -42,6 +42,16 @@ pub fn run_ok(name: &str, args: &[&str]) -> Output {
     out
 }
 
+/// Runs stage `name` with `args`, expecting a refusal: exit code 2 and
+/// exactly one line on stderr, which it returns.
+pub fn refused(name: &str, args: &[&str]) -> String {
+    let out = run(name, args);
+    let stderr = String::from_utf8_lossy(&out.stderr).trim_end().to_string();
+    assert_eq!(out.status.code(), Some(2), "{name} {args:?} should exit 2; stderr: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{name}: one line expected, got:\n{stderr}");
+    stderr
+}
+
 /// Path as `&str` (test paths are UTF-8).
 pub fn s(path: &Path) -> &str {
     path.to_str().expect("UTF-8 path")
