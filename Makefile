@@ -10,19 +10,19 @@ SHELL := bash
 # --- scene -------------------------------------------------------------
 # SCENE=cornell (the default) and the sized procedural scenes (plants-100k,
 # sphere-5k, box-100k, cornell-box-2k, ...) are built into mesh-prep;
-# anything that names an existing file is a scene.ron path.
+# anything that names an existing file is a scene.ron path. The files a
+# scene reads (OBJ, MTL, textures, photometric files, wherever they lie)
+# are listed by mesh-prep itself in $(OUT)/mesh.d, which the pipelines
+# include: a change to any of them reruns mesh-prep and what follows.
 SCENE ?= cornell
 ifeq ($(SCENE),cornell)
   SCENE_ARGS := --builtin cornell-box
-  SCENE_FILES :=
   SCENE_NAME := cornell
 else ifneq ($(wildcard $(SCENE)),)
   SCENE_ARGS := $(SCENE)
-  SCENE_FILES := $(SCENE) $(wildcard $(dir $(SCENE))*.obj $(dir $(SCENE))*.mtl)
   SCENE_NAME := $(notdir $(patsubst %/,%,$(dir $(abspath $(SCENE)))))
 else
   SCENE_ARGS := --builtin $(SCENE)
-  SCENE_FILES :=
   SCENE_NAME := $(SCENE)
 endif
 OUT ?= out/$(SCENE_NAME)

@@ -10,9 +10,18 @@ $(eval $(call params_file,hierarchical-solve,--eps $(EPS) --min-area $(MIN_AREA)
 $(eval $(call params_file,grid-gather,--spp $(SPP) $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT))))
 $(eval $(call params_file,tonemap,--operator $(OPERATOR)))
 
-$(OUT)/mesh.exr $(OUT)/manifest.ron &: $(BIN)/mesh-prep $(OUT)/params/mesh-prep.ron $(SCENE_FILES) | $(OUT)
+# mesh-prep writes $(OUT)/mesh.d: the mesh and manifest depend on every
+# file it read (the scene file, each OBJ, MTL, texture and photometric
+# file). Before the first run there is none, and nothing to be stale.
+# $(OUT)/params/scene holds the scene argument, rewritten only when it
+# changes, so that naming another scene for the same OUT reruns it too.
+$(OUT)/params/scene: FORCE | $(OUT)/params
+	@echo "$(SCENE_ARGS)" > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
+
+$(OUT)/mesh.exr $(OUT)/manifest.ron &: $(BIN)/mesh-prep $(OUT)/params/mesh-prep.ron $(OUT)/params/scene | $(OUT)
 	$(BIN)/mesh-prep $(SCENE_ARGS) --params $(OUT)/params/mesh-prep.ron \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --report $(OUT)/mesh-prep.report.ron
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --report $(OUT)/mesh-prep.report.ron --depfile $(OUT)/mesh.d
+-include $(OUT)/mesh.d
 
 $(OUT)/clusters.exr: $(BIN)/cluster $(OUT)/params/cluster.ron $(OUT)/mesh.exr $(OUT)/manifest.ron
 	$(BIN)/cluster --params $(OUT)/params/cluster.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron -o $@ --report $(OUT)/cluster.report.ron

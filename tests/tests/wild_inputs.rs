@@ -1,0 +1,208 @@
+//! mesh-prep on files as they are found in the wild, the dependency file
+//! `make` includes, and the word it gives on lighting mistakes (issue 11,
+//! items 4, 7 and 8).
+
+use end_to_end::{refused, run_ok, s, scratch};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, SystemTime};
+
+/// The inside of a closed unit box (walls facing in), material `wall`
+/// from `library`.
+fn room_obj(library: &str) -> String {
+    format!(
+        "mtllib {library}\nusemtl wall\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n"
+    )
+}
+
+/// An Area light 5 mm under the box's ceiling, emitting down (or up, into
+/// the ceiling, wound the wrong way).
+fn ceiling_light(down: bool) -> &'static str {
+    if down {
+        "Area(corner: (0.4, 0.995, 0.4), edge_u: (0.2, 0.0, 0.0), edge_v: (0.0, 0.0, 0.2), emission: (10.0, 10.0, 10.0))"
+    } else {
+        "Area(corner: (0.4, 0.995, 0.4), edge_u: (0.0, 0.0, 0.2), edge_v: (0.2, 0.0, 0.0), emission: (10.0, 10.0, 10.0))"
+    }
+}
+
+/// Writes `files` (path relative to `dir`, bytes) and a scene.ron in
+/// `dir/scene` naming `obj` (relative to it) with `lights`; returns the
+/// scene's path.
+fn write_scene(dir: &Path, obj: &str, lights: &str, files: &[(&str, &[u8])]) -> PathBuf {
+    for (path, bytes) in files {
+        let path = dir.join(path);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, bytes).unwrap();
+    }
+    let scene = dir.join("scene/scene.ron");
+    std::fs::create_dir_all(scene.parent().unwrap()).unwrap();
+    let text = format!(
+        "Scene(meshes: [Obj(file: \"{obj}\")], camera: Camera(eye: (0.5, 0.5, 0.05), target: (0.5, 0.5, 1.0), up: (0.0, 1.0, 0.0), vertical_fov_deg: 60.0, width: 16, height: 16), lights: [{lights}])"
+    );
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
+/// mesh-prep's arguments for `scene` with every output in `dir/out`.
+fn prep_args(dir: &Path, scene: &Path) -> Vec<String> {
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    [s(scene), "--mesh", s(&out.join("mesh.exr")), "--manifest", s(&out.join("manifest.ron")), "--depfile", s(&out.join("mesh.d")), "--report", s(&out.join("report.ron"))]
+        .map(String::from)
+        .to_vec()
+}
+
+fn as_strs(args: &[String]) -> Vec<&str> {
+    args.iter().map(String::as_str).collect()
+}
+
+/// Runs mesh-prep on `scene` expecting success; returns its warnings.
+fn warnings_of(dir: &Path, scene: &Path) -> Vec<String> {
+    let out = run_ok("mesh-prep", &as_strs(&prep_args(dir, scene)));
+    String::from_utf8_lossy(&out.stderr).lines().filter(|l| l.starts_with("mesh-prep: warning: ")).map(|l| l["mesh-prep: warning: ".len()..].to_string()).collect()
+}
+
+/// Issue 11: `Kd 0.5` and `Ks 0` made tobj panic (exit 101).
+#[test]
+fn one_value_colours_are_grey() {
+    let dir = scratch("wild_one_value");
+    let scene = write_scene(&dir, "room.obj", ceiling_light(true), &[("scene/room.obj", room_obj("room.mtl").as_bytes()), ("scene/room.mtl", b"newmtl wall\nKd 0.5\nKs 0\n")]);
+    assert_eq!(warnings_of(&dir, &scene), Vec::<String>::new());
+    let manifest = std::fs::read_to_string(dir.join("out/manifest.ron")).unwrap();
+    assert!(manifest.contains("diffuse: (0.5, 0.5, 0.5)"), "{manifest}");
+}
+
+/// Issue 11: a Latin-1 comment made the OBJ unreadable, and a library
+/// name with spaces was not found.
+#[test]
+fn latin1_comments_and_library_names_with_spaces() {
+    let dir = scratch("wild_latin1");
+    let obj: Vec<u8> = [b"# export\xe9 par Blender\n".as_slice(), room_obj("base.mtl my walls.mtl").as_bytes()].concat();
+    let scene = write_scene(
+        &dir,
+        "room.obj",
+        ceiling_light(true),
+        &[("scene/room.obj", &obj), ("scene/base.mtl my walls.mtl", b"newmtl wall\nKd 0.25\n")],
+    );
+    let warnings = warnings_of(&dir, &scene);
+    assert_eq!(warnings, [format!("{}: not UTF-8; read as Latin-1", s(&dir.join("scene/room.obj:1")))]);
+    let manifest = std::fs::read_to_string(dir.join("out/manifest.ron")).unwrap();
+    assert!(manifest.contains("diffuse: (0.25, 0.25, 0.25)"), "the library with a space in its name was read: {manifest}");
+}
+
+#[test]
+fn a_bad_mtl_line_is_one_error_naming_file_and_line_and_nothing_is_written() {
+    let dir = scratch("wild_bad_mtl");
+    let scene = write_scene(&dir, "room.obj", ceiling_light(true), &[("scene/room.obj", room_obj("room.mtl").as_bytes()), ("scene/room.mtl", b"newmtl wall\n\nKd 0.5 0.5\n")]);
+    let line = refused("mesh-prep", &as_strs(&prep_args(&dir, &scene)));
+    assert_eq!(line, format!("mesh-prep: error: {}:3: Kd needs one value (grey) or three (r g b), found 2", s(&dir.join("scene/room.mtl"))));
+    for output in ["mesh.exr", "manifest.ron", "mesh.d", "report.ron"] {
+        assert!(!dir.join("out").join(output).exists(), "{output} written despite the error");
+    }
+}
+
+/// The depfile names every file read, wherever it lies, escaped for make.
+#[test]
+fn the_depfile_names_the_scene_obj_mtl_elsewhere_and_texture() {
+    let dir = scratch("wild_depfile");
+    let scene = write_scene(
+        &dir,
+        "room.obj",
+        ceiling_light(true),
+        &[("scene/room.obj", room_obj("../shared lib/walls.mtl").as_bytes()), ("shared lib/walls.mtl", b"newmtl wall\nKd 0.5\nmap_Kd -bm 1 tex$1.png\n"), ("shared lib/tex$1.png", b"png")],
+    );
+    assert_eq!(warnings_of(&dir, &scene), Vec::<String>::new());
+    let esc = |p: &Path| s(p).replace(' ', "\\ ").replace('$', "$$");
+    let (scene_dir, out) = (dir.join("scene"), dir.join("out"));
+    let read = [scene.clone(), scene_dir.join("room.obj"), scene_dir.join("../shared lib/walls.mtl"), scene_dir.join("../shared lib/tex$1.png")];
+    let mut expected = format!("# Written by mesh-prep: the files its outputs were made from.\n{} {}:", esc(&out.join("mesh.exr")), esc(&out.join("manifest.ron")));
+    for p in &read {
+        expected += &format!(" \\\n  {}", esc(p));
+    }
+    expected += "\n";
+    for p in &read {
+        expected += &format!("\n{}:\n", esc(p));
+    }
+    assert_eq!(std::fs::read_to_string(out.join("mesh.d")).unwrap(), expected);
+}
+
+/// `make` reruns mesh-prep when, and only when, a file it read changed:
+/// the MTL in another folder, or its texture.
+#[test]
+fn make_reruns_mesh_prep_exactly_when_a_file_it_read_changes() {
+    let dir = scratch("wild_make");
+    let scene = write_scene(
+        &dir,
+        "room.obj",
+        ceiling_light(true),
+        &[("scene/room.obj", room_obj("../lib/walls.mtl").as_bytes()), ("lib/walls.mtl", b"newmtl wall\nKd 0.5\nmap_Kd tex.png\n"), ("lib/tex.png", b"png")],
+    );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+    let out = dir.join("out");
+    let make = || {
+        // -o: the stage binaries count as old and are not rebuilt (the
+        // tests run on the ones `make test` built).
+        let result = std::process::Command::new("make")
+            .current_dir(root)
+            .args(["--no-print-directory", "-o", "target/release/mesh-prep", &format!("OUT={}", s(&out)), &format!("SCENE={}", s(&scene)), s(&out.join("mesh.exr"))])
+            .output()
+            .expect("make runs");
+        assert!(result.status.success(), "make failed: {}", String::from_utf8_lossy(&result.stderr));
+        String::from_utf8_lossy(&result.stdout).contains("--depfile")
+    };
+    // "Touch" without waiting for the clock: every file of the test goes
+    // two minutes back, then the touched one one minute forward of that.
+    let touch = |path: &str| {
+        let now = SystemTime::now();
+        set_times(&dir, now - Duration::from_secs(120));
+        std::fs::File::options().write(true).open(dir.join(path)).unwrap().set_modified(now - Duration::from_secs(60)).unwrap();
+    };
+    assert!(make(), "the first make runs mesh-prep");
+    assert!(!make(), "nothing changed: nothing reruns");
+    touch("lib/walls.mtl");
+    assert!(make(), "the MTL in another folder changed: mesh-prep reruns");
+    assert!(!make(), "nothing changed since");
+    touch("lib/tex.png");
+    assert!(make(), "the texture changed: mesh-prep reruns");
+}
+
+/// Sets the modification time of every file under `dir` to `time`.
+fn set_times(dir: &Path, time: SystemTime) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            set_times(&path, time);
+        } else {
+            std::fs::File::options().write(true).open(&path).unwrap().set_modified(time).unwrap();
+        }
+    }
+}
+
+/// Issue 11: a light wound into the ceiling gave a dark image with no
+/// word; now a warning names it, on stderr and in the report.
+#[test]
+fn a_light_wound_the_wrong_way_is_named_on_stderr_and_in_the_report() {
+    let dir = scratch("wild_wound");
+    let obj = room_obj("room.mtl");
+    let files: [(&str, &[u8]); 2] = [("scene/room.obj", obj.as_bytes()), ("scene/room.mtl", b"newmtl wall\nKd 0.5\n")];
+    let scene = write_scene(&dir, "room.obj", ceiling_light(true), &files);
+    assert_eq!(warnings_of(&dir, &scene), Vec::<String>::new(), "a light facing down into the room gets no word");
+    let scene = write_scene(&dir, "room.obj", ceiling_light(false), &files);
+    let warnings = warnings_of(&dir, &scene);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].starts_with(&format!("emitter 'area_light_0' (material 'area_light_0', {}): half the rays from its front hit a surface within 0.0", s(&scene))), "{}", warnings[0]);
+    assert!(warnings[0].ends_with("is it wound the wrong way? (it emits on the side its corners turn counter-clockwise around)"), "{}", warnings[0]);
+    let report = std::fs::read_to_string(dir.join("out/report.ron")).unwrap();
+    assert!(report.contains("is it wound the wrong way?"), "{report}");
+}
+
+/// Issue 11: a NaN light corner was reported as a camera error.
+#[test]
+fn a_nan_light_is_an_error_naming_the_light() {
+    let dir = scratch("wild_nan_light");
+    let nan = "Area(corner: (0.4, NaN, 0.4), edge_u: (0.2, 0.0, 0.0), edge_v: (0.0, 0.0, 0.2), emission: (10.0, 10.0, 10.0))";
+    let scene = write_scene(&dir, "room.obj", nan, &[("scene/room.obj", room_obj("room.mtl").as_bytes()), ("scene/room.mtl", b"newmtl wall\nKd 0.5\n")]);
+    let line = refused("mesh-prep", &as_strs(&prep_args(&dir, &scene)));
+    assert_eq!(line, format!("mesh-prep: error: {}: light 0 (Area, 'area_light_0'): corner [0.4, NaN, 0.4] is not finite", s(&scene)));
+    assert!(!dir.join("out/mesh.exr").exists());
+}
