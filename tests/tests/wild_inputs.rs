@@ -43,6 +43,16 @@ fn write_scene(dir: &Path, obj: &str, lights: &str, files: &[(&str, &[u8])]) -> 
     scene
 }
 
+/// The room of [`room_obj`] in `dir/scene`, its library `walls.mtl` in
+/// `dir/<library>` naming the texture `texture` beside it (after a texture
+/// option, as exporters write them).
+fn scene_with_library_elsewhere(dir: &Path, library: &str, texture: &str) -> PathBuf {
+    let obj = room_obj(&format!("../{library}/walls.mtl"));
+    let (mtl_path, texture_path) = (format!("{library}/walls.mtl"), format!("{library}/{texture}"));
+    let mtl = format!("newmtl wall\nKd 0.5\nmap_Kd -bm 1 {texture}\n");
+    write_scene(dir, "room.obj", ceiling_light(true), &[("scene/room.obj", obj.as_bytes()), (&mtl_path, mtl.as_bytes()), (&texture_path, b"png")])
+}
+
 /// mesh-prep's arguments for `scene` with every output in `dir/out`.
 fn prep_args(dir: &Path, scene: &Path) -> Vec<String> {
     let out = dir.join("out");
@@ -105,12 +115,7 @@ fn a_bad_mtl_line_is_one_error_naming_file_and_line_and_nothing_is_written() {
 #[test]
 fn the_depfile_names_the_scene_obj_mtl_elsewhere_and_texture() {
     let dir = scratch("wild_depfile");
-    let scene = write_scene(
-        &dir,
-        "room.obj",
-        ceiling_light(true),
-        &[("scene/room.obj", room_obj("../shared lib/walls.mtl").as_bytes()), ("shared lib/walls.mtl", b"newmtl wall\nKd 0.5\nmap_Kd -bm 1 tex$1.png\n"), ("shared lib/tex$1.png", b"png")],
-    );
+    let scene = scene_with_library_elsewhere(&dir, "shared lib", "tex$1.png");
     assert_eq!(warnings_of(&dir, &scene), Vec::<String>::new());
     let esc = |p: &Path| s(p).replace(' ', "\\ ").replace('$', "$$");
     let (scene_dir, out) = (dir.join("scene"), dir.join("out"));
@@ -131,12 +136,7 @@ fn the_depfile_names_the_scene_obj_mtl_elsewhere_and_texture() {
 #[test]
 fn make_reruns_mesh_prep_exactly_when_a_file_it_read_changes() {
     let dir = scratch("wild_make");
-    let scene = write_scene(
-        &dir,
-        "room.obj",
-        ceiling_light(true),
-        &[("scene/room.obj", room_obj("../lib/walls.mtl").as_bytes()), ("lib/walls.mtl", b"newmtl wall\nKd 0.5\nmap_Kd tex.png\n"), ("lib/tex.png", b"png")],
-    );
+    let scene = scene_with_library_elsewhere(&dir, "lib", "tex.png");
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
     let out = dir.join("out");
     let make = || {
