@@ -45,12 +45,15 @@ fn write_scene(dir: &Path, obj: &str, lights: &str, files: &[(&str, &[u8])]) -> 
 
 /// The room of [`room_obj`] in `dir/scene`, its library `walls.mtl` in
 /// `dir/<library>` naming the texture `texture` beside it (after a texture
-/// option, as exporters write them).
+/// option, as exporters write them), lit by the ceiling light and a
+/// luminaire whose EULUMDAT file is `dir/<library>/lamp.ldt`.
 fn scene_with_library_elsewhere(dir: &Path, library: &str, texture: &str) -> PathBuf {
     let obj = room_obj(&format!("../{library}/walls.mtl"));
-    let (mtl_path, texture_path) = (format!("{library}/walls.mtl"), format!("{library}/{texture}"));
+    let (mtl_path, texture_path, ldt_path) = (format!("{library}/walls.mtl"), format!("{library}/{texture}"), format!("{library}/lamp.ldt"));
     let mtl = format!("newmtl wall\nKd 0.5\nmap_Kd -bm 1 {texture}\n");
-    write_scene(dir, "room.obj", ceiling_light(true), &[("scene/room.obj", obj.as_bytes()), (&mtl_path, mtl.as_bytes()), (&texture_path, b"png")])
+    let ldt = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../stages/mesh-prep/tests/data/photometry/lidrs_example_prolicht_E30-0019.ldt")).unwrap();
+    let lights = format!("{}, Goniometric(file: \"../{library}/lamp.ldt\", position: (0.5, 0.8, 0.5))", ceiling_light(true));
+    write_scene(dir, "room.obj", &lights, &[("scene/room.obj", obj.as_bytes()), (&mtl_path, mtl.as_bytes()), (&texture_path, b"png"), (&ldt_path, &ldt)])
 }
 
 /// mesh-prep's arguments for `scene` with every output in `dir/out`.
@@ -113,13 +116,14 @@ fn a_bad_mtl_line_is_one_error_naming_file_and_line_and_nothing_is_written() {
 
 /// The depfile names every file read, wherever it lies, escaped for make.
 #[test]
-fn the_depfile_names_the_scene_obj_mtl_elsewhere_and_texture() {
+fn the_depfile_names_the_scene_obj_mtl_elsewhere_texture_and_luminaire() {
     let dir = scratch("wild_depfile");
     let scene = scene_with_library_elsewhere(&dir, "shared lib", "tex$1.png");
     assert_eq!(warnings_of(&dir, &scene), Vec::<String>::new());
     let esc = |p: &Path| s(p).replace(' ', "\\ ").replace('$', "$$");
     let (scene_dir, out) = (dir.join("scene"), dir.join("out"));
-    let read = [scene.clone(), scene_dir.join("room.obj"), scene_dir.join("../shared lib/walls.mtl"), scene_dir.join("../shared lib/tex$1.png")];
+    let read = ["room.obj", "../shared lib/walls.mtl", "../shared lib/tex$1.png", "../shared lib/lamp.ldt"].map(|p| scene_dir.join(p));
+    let read: Vec<PathBuf> = std::iter::once(scene.clone()).chain(read).collect();
     let mut expected = format!("# Written by mesh-prep: the files its outputs were made from.\n{} {}:", esc(&out.join("mesh.exr")), esc(&out.join("manifest.ron")));
     for p in &read {
         expected += &format!(" \\\n  {}", esc(p));
@@ -132,7 +136,7 @@ fn the_depfile_names_the_scene_obj_mtl_elsewhere_and_texture() {
 }
 
 /// `make` reruns mesh-prep when, and only when, a file it read changed:
-/// the MTL in another folder, or its texture.
+/// the MTL in another folder, its texture, or a luminaire's EULUMDAT file.
 #[test]
 fn make_reruns_mesh_prep_exactly_when_a_file_it_read_changes() {
     let dir = scratch("wild_make");
@@ -164,6 +168,9 @@ fn make_reruns_mesh_prep_exactly_when_a_file_it_read_changes() {
     assert!(!make(), "nothing changed since");
     touch("lib/tex.png");
     assert!(make(), "the texture changed: mesh-prep reruns");
+    touch("lib/lamp.ldt");
+    assert!(make(), "the photometric file changed: mesh-prep reruns");
+    assert!(!make(), "nothing changed since");
 }
 
 /// Sets the modification time of every file under `dir` to `time`.
