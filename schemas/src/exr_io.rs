@@ -363,6 +363,7 @@ pub fn read_exr<S: Schema>(path: &Path) -> Result<(ExrArtifact, Input)> {
 /// schema is refused, never read as foreign.
 pub fn read_exr_or_foreign<S: Schema>(path: &Path) -> Result<(ExrFile, Input)> {
     let bytes = read_bytes(path)?;
+    check_declared_size(path, &bytes)?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -423,6 +424,42 @@ pub fn read_exr_or_foreign<S: Schema>(path: &Path) -> Result<(ExrFile, Input)> {
     }
     let input = Input::new(path, &bytes, Some(meta.header.provenance.clone()));
     Ok((ExrFile::Artifact(ExrArtifact { header: meta.header, layers }), input))
+}
+
+/// How many times its own size an EXR file may hold once decoded: deflate
+/// (ZIP, what this pipeline writes) tops out near 1032:1; the rest is room
+/// for the RLE and PIZ files of other programs.
+const MAX_EXPANSION: u128 = 4096;
+
+/// Decoded bytes any file may hold whatever its size, so that a small file
+/// of a constant image still reads.
+const EXPANSION_SLACK: u128 = 64 << 20;
+
+/// Refuses an EXR whose headers declare more pixel data than a file of its
+/// size can hold decoded, before the decoder allocates it: a corrupt size
+/// field would otherwise make it ask for gigabytes and abort the process.
+/// Counts every channel at full resolution, and four times the base level
+/// for mip and rip maps (their levels sum to less).
+fn check_declared_size(path: &Path, bytes: &[u8]) -> Result<()> {
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| Error::parse(path, None, format!("not a readable EXR file: {e}")))?;
+    let limit = bytes.len() as u128 * MAX_EXPANSION + EXPANSION_SLACK;
+    for header in meta.headers.iter() {
+        let (width, height) = (header.layer_size.width() as u128, header.layer_size.height() as u128);
+        let levels = match header.blocks {
+            exr::meta::BlockDescription::Tiles(tiles) if tiles.level_mode != exr::meta::attribute::LevelMode::Singular => 4,
+            _ => 1,
+        };
+        let per_pixel: u128 = header.channels.list.iter().map(|c| c.sample_type.bytes_per_sample() as u128).sum();
+        if width * height * per_pixel * levels > limit {
+            return Err(Error::invalid(
+                path,
+                None,
+                format!("EXR header declares {width}x{height} pixels of {} channels, more than a file of {} bytes can hold", header.channels.list.len(), bytes.len()),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A stored layer's name; the empty string for an unnamed one.
@@ -504,6 +541,25 @@ mod tests {
         assert_eq!(back, artifact);
         assert_eq!(input.sha256.len(), 64);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_header_declaring_more_pixels_than_the_file_holds_is_refused_before_decoding() {
+        let artifact = ExrArtifact {
+            header: Demo::header(provenance()),
+            layers: vec![Layer::table("rows", 3, vec![Channel::f32("x", "a value", vec![1.0, 2.0, 3.0])])],
+        };
+        let path = std::env::temp_dir().join(format!("exr-io-size-{}.exr", std::process::id()));
+        write_exr(&path, &artifact).unwrap();
+        // dataWindow: xMin, yMin, xMax, yMax as i32 after name, type and size.
+        let mut bytes = std::fs::read(&path).unwrap();
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        bytes[at + 8..at + 16].copy_from_slice(&[0xff, 0xff, 0x0f, 0x00, 0xff, 0xff, 0x0f, 0x00]);
+        std::fs::write(&path, &bytes).unwrap();
+        let message = read_exr::<Demo>(&path).unwrap_err().to_string();
+        std::fs::remove_file(&path).unwrap();
+        assert!(message.contains("EXR header declares 1048576x1048576 pixels of 1 channels, more than a file of"), "{message}");
     }
 
     #[test]

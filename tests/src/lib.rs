@@ -5,6 +5,7 @@
 //! The binaries are those of `cargo build --release`, which `make test`
 //! runs before the tests.
 
+pub mod artifacts;
 pub mod closed_form;
 pub mod fuzz;
 pub mod scenes;

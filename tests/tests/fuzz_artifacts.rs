@@ -1,0 +1,95 @@
+//! Fuzz targets for the pipeline's own artifacts (issue 11): every EXR
+//! kind (mesh, clusters, solution, lightmap, image) and `manifest.ron`,
+//! each mutated byte by byte from a valid file the `schemas` writers made,
+//! and read back by the reader every stage uses. Any answer is fine; a
+//! panic or a hang fails, naming the case (see `end_to_end::fuzz`). The
+//! hierarchy's own fields are fuzzed, with the solver walking it, in
+//! hierarchical-solve's tests.
+
+use end_to_end::artifacts::{closed_box, clusters_over, image, lightmap, solution};
+use end_to_end::fuzz::{fuzz, Kind};
+use schemas::cluster::Clusters;
+use schemas::image::HdrImage;
+use schemas::lightmap::Lightmap;
+use schemas::mesh::{Manifest, Mesh};
+use schemas::ron_io::{read_ron, write_ron};
+use schemas::solution::Solution;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// A fresh path for one case's file (cases run on threads of their own).
+fn case_path(extension: &str) -> PathBuf {
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!("fuzz-artifacts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(format!("{}.{extension}", NEXT.fetch_add(1, Ordering::Relaxed)))
+}
+
+/// The bytes of the file `write` writes.
+fn written(extension: &str, write: impl FnOnce(&Path) -> schemas::Result<()>) -> Vec<u8> {
+    let path = case_path(extension);
+    write(&path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    bytes
+}
+
+/// Fuzzes `read`, given the path of a file holding each mutant of `seed`.
+fn fuzz_file(target: &str, seed: &[u8], kind: Kind, extension: &'static str, read: fn(&Path)) {
+    fuzz(target, &[seed], kind, move |bytes| {
+        let path = case_path(extension);
+        std::fs::write(&path, bytes).unwrap();
+        read(&path);
+        let _ = std::fs::remove_file(&path);
+    });
+}
+
+#[test]
+fn fuzz_mesh_exr() {
+    let (mesh, _) = closed_box();
+    fuzz_file("mesh.exr", &written("exr", |p| mesh.write(p)), Kind::Binary, "exr", |path| {
+        if let Ok((mesh, _)) = Mesh::read(path) {
+            let _ = closed_box().1.check_mesh(path, &mesh);
+        }
+    });
+}
+
+#[test]
+fn fuzz_manifest_ron() {
+    let (_, manifest) = closed_box();
+    fuzz_file("manifest.ron", &written("ron", |p| write_ron(p, &manifest)), Kind::Text, "ron", |path| {
+        let _ = read_ron::<Manifest>(path);
+    });
+}
+
+#[test]
+fn fuzz_clusters_exr() {
+    let clusters = clusters_over(&closed_box().0);
+    fuzz_file("clusters.exr", &written("exr", |p| clusters.write(p)), Kind::Binary, "exr", |path| {
+        let _ = Clusters::read(path, 12);
+    });
+}
+
+#[test]
+fn fuzz_solution_exr() {
+    let solution = solution(&closed_box().0);
+    fuzz_file("solution.exr", &written("exr", |p| solution.write(p)), Kind::Binary, "exr", |path| {
+        let _ = Solution::read(path);
+    });
+}
+
+#[test]
+fn fuzz_lightmap_exr() {
+    let lightmap = lightmap(&closed_box().0);
+    fuzz_file("lightmap.exr", &written("exr", |p| lightmap.write(p)), Kind::Binary, "exr", |path| {
+        let _ = Lightmap::read(path);
+    });
+}
+
+#[test]
+fn fuzz_image_exr() {
+    let image = image();
+    fuzz_file("image.exr", &written("exr", |p| image.write(p)), Kind::Binary, "exr", |path| {
+        let _ = HdrImage::read_any(path);
+    });
+}
