@@ -4,11 +4,12 @@
 //! that crate parsers reject or panic on. Every error names the file and
 //! line.
 //!
-//! Read statements (others, like `Ka`, `Ns`, `Ni`, are ignored):
+//! Read statements, in any letter case (others, like `Ka`, `Ns`, `Ni`, are
+//! ignored; a `#` ends a line of numbers):
 //!
 //! | statement | meaning |
 //! |---|---|
-//! | `newmtl name` | starts a material (the whole rest of the line is the name) |
+//! | `newmtl name` | starts a material (the whole rest of the line is the name, `#` included) |
 //! | `Kd`, `Ks`, `Ke`, `Tf` | a colour: `r g b`, or one value `g` meaning `g g g` |
 //! | `d` | dissolve (opacity), one value (`d -halo f` reads `f`) |
 //! | `illum` | illumination model, an integer 0 to 10 |
@@ -78,50 +79,53 @@ const TEXTURE_OPTIONS: &[(&str, usize)] = &[
 /// before any `newmtl`).
 pub fn parse_mtl(path: &Path, text: &str, notes: &mut Vec<String>) -> Result<Vec<MtlMaterial>, Error> {
     let mut materials: Vec<MtlMaterial> = Vec::new();
-    for (line, statement) in crate::text::statements(text) {
+    for statement in crate::text::statements(text) {
+        let (line, keyword, rest) = (statement.line, statement.keyword.as_str(), statement.rest.as_str());
         let error = |message: String| Error::parse(path, Some(line), message);
-        let (keyword, rest) = split_keyword(&statement);
-        if keyword == "newmtl" {
+        // Keywords in any case: exporters write `map_kd` and `map_Bump`.
+        let lower = keyword.to_ascii_lowercase();
+        if lower == "newmtl" {
             if rest.is_empty() {
                 return Err(error("newmtl needs a material name".into()));
             }
             materials.push(MtlMaterial { name: rest.to_string(), file: path.to_path_buf(), line, ..Default::default() });
             continue;
         }
-        let known = matches!(keyword, "Kd" | "Ks" | "Ke" | "Tf" | "d" | "illum" | "map_Kd" | "map_d" | "norm" | "bump" | "map_Bump" | "map_bump");
+        let known = matches!(lower.as_str(), "kd" | "ks" | "ke" | "tf" | "d" | "illum" | "map_kd" | "map_d" | "norm" | "bump" | "map_bump");
         let Some(current) = materials.last_mut() else {
             if known {
                 notes.push(format!("{}:{line}: '{keyword}' before any newmtl is ignored", path.display()));
             }
             continue;
         };
-        match keyword {
-            "Kd" => current.diffuse = Some(colour(keyword, rest).map_err(error)?),
-            "Ks" => current.specular = Some(colour(keyword, rest).map_err(error)?),
-            "Ke" => current.emissive = Some(colour(keyword, rest).map_err(error)?),
-            "Tf" => current.transmission_filter = Some(colour(keyword, rest).map_err(error)?),
+        let arguments = statement.arguments();
+        match lower.as_str() {
+            "kd" => current.diffuse = Some(colour(keyword, arguments).map_err(error)?),
+            "ks" => current.specular = Some(colour(keyword, arguments).map_err(error)?),
+            "ke" => current.emissive = Some(colour(keyword, arguments).map_err(error)?),
+            "tf" => current.transmission_filter = Some(colour(keyword, arguments).map_err(error)?),
             "d" => {
-                let value = rest.split_whitespace().last().ok_or_else(|| error("d needs a value".into()))?;
+                let value = arguments.split_whitespace().last().ok_or_else(|| error("d needs a value".into()))?;
                 current.dissolve = Some(number(keyword, value).map_err(error)?);
             }
             "illum" => {
-                let model = rest.parse::<u32>().ok().filter(|m| *m <= 10);
-                current.illumination_model = Some(model.ok_or_else(|| error(format!("illum '{rest}' is not an illumination model (0 to 10)")))?);
+                let model = arguments.parse::<u32>().ok().filter(|m| *m <= 10);
+                current.illumination_model = Some(model.ok_or_else(|| error(format!("illum '{arguments}' is not an illumination model (0 to 10)")))?);
             }
-            "map_Kd" => current.diffuse_texture = Some(texture(keyword, rest, line).map_err(error)?),
+            "map_kd" => current.diffuse_texture = Some(texture(keyword, rest, line).map_err(error)?),
             "map_d" => current.dissolve_texture = Some(texture(keyword, rest, line).map_err(error)?),
-            "norm" | "bump" | "map_Bump" | "map_bump" => current.normal_texture = Some(texture(keyword, rest, line).map_err(error)?),
+            "norm" | "bump" | "map_bump" => current.normal_texture = Some(texture(keyword, rest, line).map_err(error)?),
             _ => {}
         }
     }
     Ok(materials)
 }
 
-/// The first word of a statement and the trimmed rest of it.
-pub fn split_keyword(statement: &str) -> (&str, &str) {
-    match statement.split_once(char::is_whitespace) {
+/// The first word of `text` and the trimmed rest of it.
+fn split_word(text: &str) -> (&str, &str) {
+    match text.split_once(char::is_whitespace) {
         Some((keyword, rest)) => (keyword, rest.trim()),
-        None => (statement, ""),
+        None => (text, ""),
     }
 }
 
@@ -152,13 +156,13 @@ fn colour(keyword: &str, rest: &str) -> Result<[f64; 3], String> {
 fn texture(keyword: &str, rest: &str, line: usize) -> Result<TextureRef, String> {
     let mut remaining = rest;
     loop {
-        let (word, after) = split_keyword(remaining);
+        let (word, after) = split_word(remaining);
         let Some(&(_, arity)) = TEXTURE_OPTIONS.iter().find(|(name, _)| *name == word) else {
             break;
         };
         remaining = after;
         for taken in 0..arity {
-            let (value, after) = split_keyword(remaining);
+            let (value, after) = split_word(remaining);
             // -o, -s and -t take up to three numbers: stop at the first word
             // that is not one.
             if arity == 3 && taken > 0 && value.parse::<f64>().is_err() {
@@ -186,7 +190,7 @@ mod tests {
 
     #[test]
     fn one_value_is_grey_and_three_are_rgb() {
-        let m = parse("newmtl a\nKd 0.5\nKs 0\nKe 1 2 3\n").unwrap();
+        let m = parse("newmtl a\nKd 0.5\nks 0 # none\nKe 1 2 3\n").unwrap();
         assert_eq!(m[0].diffuse, Some([0.5; 3]));
         assert_eq!(m[0].specular, Some([0.0; 3]));
         assert_eq!(m[0].emissive, Some([1.0, 2.0, 3.0]));
@@ -205,8 +209,8 @@ mod tests {
 
     #[test]
     fn names_with_spaces_and_texture_options() {
-        let m = parse("newmtl Brushed Steel 2\nmap_Kd -o 0.5 0.5 -bm 1.0 textures/steel plate.png\nbump -bm 0.3 n.png\nd -halo 0.8\n").unwrap();
-        assert_eq!(m[0].name, "Brushed Steel 2");
+        let m = parse("newmtl Brushed Steel #2\nmap_kd -o 0.5 0.5 -bm 1.0 textures/steel plate.png\nmap_Bump -bm 0.3 n.png\nd -halo 0.8\n").unwrap();
+        assert_eq!(m[0].name, "Brushed Steel #2");
         assert_eq!(m[0].diffuse_texture, Some(TextureRef { name: "textures/steel plate.png".into(), line: 2 }));
         assert_eq!(m[0].normal_texture.as_ref().map(|t| t.name.as_str()), Some("n.png"));
         assert_eq!(m[0].dissolve, Some(0.8));

@@ -10,12 +10,13 @@
 //! `/vt/vn`; a polygon is triangulated as a fan from its first corner),
 //! `o`/`g name` (a new object), `usemtl name`, `mtllib names`. An object is
 //! split where its material changes, as tobj did, so the objects and their
-//! order are what earlier versions wrote.
+//! order are what earlier versions wrote. A `#` starts a comment in a line
+//! of numbers; in a name it is part of the name (`usemtl Material #25`).
 
-use crate::mtl::{parse_mtl, split_keyword, MtlMaterial};
-use crate::text::{read_text, statements};
+use crate::mtl::{parse_mtl, MtlMaterial};
+use crate::text::{locate, read_text, statements};
 use schemas::Error;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 pub use crate::text::{Files, TextSource};
@@ -51,67 +52,81 @@ pub struct ObjFile {
 }
 
 /// Reads and triangulates the OBJ at `path` and its MTL libraries (paths
-/// relative to the OBJ's folder), through `source`.
+/// relative to the OBJ's folder, found as [`locate`] finds them), through
+/// `source`. `usemtl` names are resolved once the whole file is read, so a
+/// `mtllib` line after them still counts.
 pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> {
     let mut notes = Vec::new();
     let text = read_text(source, path, &mut notes)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mut file = ObjFile { path: path.to_path_buf(), positions: Vec::new(), objects: Vec::new(), materials: Vec::new(), notes };
-    let mut by_name: HashMap<String, usize> = HashMap::new();
-    let mut current = ObjObject { name: "unnamed_object".into(), material: None, triangles: Vec::new(), lines: Vec::new() };
-    for (line, statement) in statements(&text) {
+    let mut positions = Vec::new();
+    let mut materials: Vec<MtlMaterial> = Vec::new();
+    // Objects with the material name they use and the line that names it.
+    let mut objects: Vec<(ObjObject, Option<(String, usize)>)> = Vec::new();
+    let mut current = (ObjObject { name: "unnamed_object".into(), material: None, triangles: Vec::new(), lines: Vec::new() }, None);
+    for statement in statements(&text) {
+        let (line, rest) = (statement.line, statement.rest.as_str());
         let error = |message: String| Error::parse(path, Some(line), message);
-        let (keyword, rest) = split_keyword(&statement);
-        match keyword {
-            "v" => file.positions.push(vertex(rest).map_err(error)?),
+        match statement.keyword.as_str() {
+            "v" => positions.push(vertex(statement.arguments()).map_err(error)?),
             "f" => {
-                let corners = rest.split_whitespace().map(|c| corner(c, file.positions.len())).collect::<Result<Vec<usize>, String>>().map_err(error)?;
+                let corners = statement.arguments().split_whitespace().map(|c| corner(c, positions.len())).collect::<Result<Vec<usize>, String>>().map_err(error)?;
                 if corners.len() < 3 {
                     return Err(error("face needs at least three vertices".into()));
                 }
                 for k in 1..corners.len() - 1 {
-                    current.triangles.push([corners[0], corners[k], corners[k + 1]]);
-                    current.lines.push(line);
+                    current.0.triangles.push([corners[0], corners[k], corners[k + 1]]);
+                    current.0.lines.push(line);
                 }
             }
             "o" | "g" => {
                 let name = if rest.is_empty() { "unnamed_object" } else { rest };
-                let next = ObjObject { name: name.into(), material: current.material, triangles: Vec::new(), lines: Vec::new() };
-                finish(&mut file.objects, &mut current, next);
+                let next = (ObjObject { name: name.into(), material: None, triangles: Vec::new(), lines: Vec::new() }, current.1.clone());
+                finish(&mut objects, &mut current, next);
             }
             "usemtl" => {
                 if rest.is_empty() {
                     return Err(error("usemtl needs a material name".into()));
                 }
-                let material = by_name.get(rest).copied();
-                if material.is_none() {
-                    file.notes.push(format!("{}:{line}: usemtl '{rest}' names no material of its libraries; the default grey is used", path.display()));
-                }
-                if material != current.material {
-                    let next = ObjObject { name: current.name.clone(), material, triangles: Vec::new(), lines: Vec::new() };
-                    finish(&mut file.objects, &mut current, next);
+                if current.1.as_ref().map(|(name, _)| name.as_str()) != Some(rest) {
+                    let next = (ObjObject { name: current.0.name.clone(), material: None, triangles: Vec::new(), lines: Vec::new() }, Some((rest.to_string(), line)));
+                    finish(&mut objects, &mut current, next);
                 }
             }
             "mtllib" => {
                 for library in libraries(source, &base, rest).map_err(error)? {
-                    let mtl = read_text(source, &library, &mut file.notes)?;
-                    for material in parse_mtl(&library, &mtl, &mut file.notes)? {
-                        by_name.insert(material.name.clone(), file.materials.len());
-                        file.materials.push(material);
-                    }
+                    let mtl = read_text(source, &library, &mut notes)?;
+                    materials.extend(parse_mtl(&library, &mtl, &mut notes)?);
                 }
             }
             _ => {}
         }
     }
-    file.objects.push(current);
-    Ok(file)
+    objects.push(current);
+    // The last material of a name wins, as in every MTL reader.
+    let by_name: HashMap<&str, usize> = materials.iter().enumerate().map(|(i, m)| (m.name.as_str(), i)).collect();
+    let mut unknown = HashSet::new();
+    let mut resolved = Vec::with_capacity(objects.len());
+    for (mut object, used) in objects {
+        if let Some((name, line)) = used {
+            object.material = by_name.get(name.as_str()).copied();
+            if object.material.is_none() && unknown.insert(name.clone()) {
+                notes.push(format!("{}:{line}: usemtl '{name}' names no material of its libraries; the default grey is used", path.display()));
+            }
+        }
+        resolved.push(object);
+    }
+    Ok(ObjFile { path: path.to_path_buf(), positions, objects: resolved, materials, notes })
 }
 
+/// An object being read, with the material name it uses and the line that
+/// names it.
+type Pending = (ObjObject, Option<(String, usize)>);
+
 /// Ends `current` (kept if it has faces) and starts `next`.
-fn finish(objects: &mut Vec<ObjObject>, current: &mut ObjObject, next: ObjObject) {
+fn finish(objects: &mut Vec<Pending>, current: &mut Pending, next: Pending) {
     let done = std::mem::replace(current, next);
-    if !done.triangles.is_empty() {
+    if !done.0.triangles.is_empty() {
         objects.push(done);
     }
 }
@@ -124,16 +139,17 @@ fn libraries(source: &dyn TextSource, base: &Path, rest: &str) -> Result<Vec<Pat
     if rest.is_empty() {
         return Err("mtllib needs a file name".into());
     }
-    let split: Vec<PathBuf> = rest.split_whitespace().map(|name| base.join(name)).collect();
-    let missing = split.iter().find(|p| !source.exists(p));
-    match missing {
-        None => Ok(split),
-        Some(_) if source.exists(&base.join(rest)) => Ok(vec![base.join(rest)]),
-        Some(first) => {
-            let whole = if split.len() > 1 { format!(" (nor does '{}')", base.join(rest).display()) } else { String::new() };
-            Err(format!("material library '{}' does not exist{whole}", first.display()))
-        }
+    let split: Vec<&str> = rest.split_whitespace().collect();
+    let found: Vec<Option<PathBuf>> = split.iter().map(|name| locate(source, base, name)).collect();
+    if found.iter().all(Option::is_some) {
+        return Ok(found.into_iter().flatten().collect());
     }
+    if let Some(whole) = locate(source, base, rest) {
+        return Ok(vec![whole]);
+    }
+    let first = split.iter().zip(&found).find(|(_, f)| f.is_none()).map_or(rest, |(name, _)| name);
+    let whole = if split.len() > 1 { format!(" (nor does '{}')", base.join(rest).display()) } else { String::new() };
+    Err(format!("material library '{}' does not exist{whole}", base.join(first).display()))
 }
 
 /// The three finite coordinates of a `v` statement.
@@ -242,11 +258,20 @@ mod tests {
     }
 
     #[test]
-    fn unknown_material_is_noted_and_objects_split_where_it_changes() {
-        let source = Memory::text(&[("a.obj", &format!("o box\n{TRIANGLE}usemtl nothing\nf 1 3 2\no empty\no last\nf 2 1 3\n"))]);
-        let file = read_obj(&source, Path::new("a.obj")).unwrap();
+    fn unknown_material_is_noted_once_and_objects_split_where_usemtl_changes() {
+        let obj = format!("o box\n{TRIANGLE}usemtl nothing\nf 1 3 2\nusemtl nothing\no empty\no last\nf 2 1 3\nusemtl nothing\n");
+        let file = read_obj(&Memory::text(&[("a.obj", &obj)]), Path::new("a.obj")).unwrap();
         let names: Vec<&str> = file.objects.iter().map(|o| o.name.as_str()).collect();
-        assert_eq!(names, ["box", "last"], "a material change to the same (absent) material does not split; empty objects vanish");
+        assert_eq!(names, ["box", "box", "last"], "usemtl splits 'box'; the same name again does not; empty objects vanish");
+        assert_eq!(file.objects.iter().map(|o| o.material).collect::<Vec<_>>(), [None; 3]);
         assert_eq!(file.notes, ["a.obj:6: usemtl 'nothing' names no material of its libraries; the default grey is used"]);
+    }
+
+    #[test]
+    fn usemtl_before_its_mtllib_and_windows_paths_are_resolved() {
+        let source = Memory::text(&[("s/a.obj", &format!("usemtl red\n{TRIANGLE}mtllib lib\\m.mtl\n")), ("s/lib/m.mtl", "newmtl red\nKd 1 0 0\n")]);
+        let file = read_obj(&source, Path::new("s/a.obj")).unwrap();
+        assert_eq!(file.objects[0].material, Some(0));
+        assert_eq!(file.materials[0].file, Path::new("s/lib/m.mtl"));
     }
 }

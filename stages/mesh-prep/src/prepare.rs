@@ -6,6 +6,7 @@ use crate::lighting::{self, Emitter};
 use crate::material::{self, default_material};
 use crate::mtl::MtlMaterial;
 use crate::obj::{read_obj, TextSource};
+use crate::text::locate;
 use crate::scene::{Light, MeshFile, Scene};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
@@ -285,17 +286,18 @@ fn emitters(raw: &[RawTriangle], kept: &[Triangle], materials: &[Material], obje
 }
 
 /// Reads (and so records, for the provenance and the dependency file)
-/// every texture the materials name, relative to their library's folder;
-/// a texture that does not exist gets a warning, as no stage reads
-/// textures yet.
+/// every texture the materials name, relative to their library's folder
+/// (found as [`locate`] finds it); a texture that does not exist gets a
+/// warning, as no stage reads textures yet.
 fn record_textures(source: &dyn TextSource, materials: &[MtlMaterial], warnings: &mut Vec<String>) -> Result<(), Error> {
     for m in materials {
+        let base = m.file.parent().unwrap_or(Path::new(""));
         for texture in [&m.diffuse_texture, &m.dissolve_texture, &m.normal_texture].into_iter().flatten() {
-            let path = m.file.parent().unwrap_or(Path::new("")).join(&texture.name);
-            if source.exists(&path) {
-                source.read_bytes(&path)?;
-            } else {
-                warnings.push(format!("{}:{}: texture '{}' does not exist", m.file.display(), texture.line, path.display()));
+            match locate(source, base, &texture.name) {
+                Some(path) => {
+                    source.read_bytes(&path)?;
+                }
+                None => warnings.push(format!("{}:{}: texture '{}' does not exist", m.file.display(), texture.line, base.join(&texture.name).display())),
             }
         }
     }

@@ -37,11 +37,11 @@ impl TextSource for Files {
 /// (exporters write Latin-1 or Windows-1252 names and comments) are read as
 /// Latin-1, every byte one character, so no name is lost or merged with
 /// another; a note naming the file and the first such line is pushed to
-/// `notes`.
+/// `notes`. A leading UTF-8 byte-order mark is dropped.
 pub fn read_text<S: TextSource + ?Sized>(source: &S, path: &Path, notes: &mut Vec<String>) -> Result<String, Error> {
     let bytes = source.read_bytes(path)?;
     match String::from_utf8(bytes) {
-        Ok(text) => Ok(text),
+        Ok(text) => Ok(without_bom(text)),
         Err(e) => {
             let bytes = e.into_bytes();
             let valid = std::str::from_utf8(&bytes).map_or_else(|e| e.valid_up_to(), str::len);
@@ -57,20 +57,61 @@ pub fn read_text<S: TextSource + ?Sized>(source: &S, path: &Path, notes: &mut Ve
 /// that is not.
 pub fn read_utf8(source: &dyn TextSource, path: &Path) -> Result<String, Error> {
     let bytes = source.read_bytes(path)?;
-    String::from_utf8(bytes).map_err(|e| {
+    let text = String::from_utf8(bytes).map_err(|e| {
         let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()].iter().filter(|&&b| b == b'\n').count();
         Error::parse(path, Some(line), "not UTF-8 text")
-    })
+    })?;
+    Ok(without_bom(text))
 }
 
-/// The logical lines of OBJ and MTL text, numbered from 1: comments (from
-/// `#`) removed, a trailing backslash joining the next line (the line
-/// number is that of the first), `\r` dropped.
-pub fn statements(text: &str) -> Vec<(usize, String)> {
+/// `text` without the byte-order mark some Windows editors put first,
+/// which would otherwise glue itself to the first keyword.
+fn without_bom(text: String) -> String {
+    match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    }
+}
+
+/// One statement of OBJ or MTL text: a keyword and the rest of its line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Statement {
+    /// 1-based line number (of the first line, for a continued one).
+    pub line: usize,
+    /// The first word.
+    pub keyword: String,
+    /// The rest of the line, trimmed, comment included: names keep a `#`
+    /// (exporters write names like `Material #25`).
+    pub rest: String,
+}
+
+impl Statement {
+    /// The rest of the line up to a `#` comment, trimmed: the arguments of
+    /// a statement of numbers or indices (`v 1 2 3 # corner`).
+    pub fn arguments(&self) -> &str {
+        self.rest.split('#').next().unwrap_or("").trim()
+    }
+}
+
+/// The statements of OBJ and MTL text: comment lines (starting with `#`)
+/// and blank lines dropped, a trailing backslash joining the next line
+/// (except on a comment line), `\r` dropped.
+pub fn statements(text: &str) -> Vec<Statement> {
     let mut out = Vec::new();
     let mut pending: Option<(usize, String)> = None;
+    let mut finish = |line: usize, joined: &str| {
+        let code = joined.trim();
+        if !code.is_empty() && !code.starts_with('#') {
+            let (keyword, rest) = code.split_once(char::is_whitespace).unwrap_or((code, ""));
+            out.push(Statement { line, keyword: keyword.to_string(), rest: rest.trim().to_string() });
+        }
+    };
     for (index, raw) in text.split('\n').enumerate() {
         let line = raw.strip_suffix('\r').unwrap_or(raw);
+        if pending.is_none() && line.trim_start().starts_with('#') {
+            // A comment line never continues onto the next.
+            continue;
+        }
         let (number, mut joined) = pending.take().unwrap_or((index + 1, String::new()));
         match line.strip_suffix('\\') {
             Some(head) => {
@@ -80,20 +121,25 @@ pub fn statements(text: &str) -> Vec<(usize, String)> {
             }
             None => {
                 joined.push_str(line);
-                let code = joined.split('#').next().unwrap_or("").trim().to_string();
-                if !code.is_empty() {
-                    out.push((number, code));
-                }
+                finish(number, &joined);
             }
         }
     }
     if let Some((number, joined)) = pending {
-        let code = joined.split('#').next().unwrap_or("").trim().to_string();
-        if !code.is_empty() {
-            out.push((number, code));
-        }
+        finish(number, &joined);
     }
     out
+}
+
+/// Where a file name written in an OBJ or MTL file is, relative to the
+/// folder `base` of the file that names it: as written; else with
+/// backslashes read as folder separators (Windows exporters); else its last
+/// component alone, beside the file (an absolute path from the author's
+/// machine). `None` if none of these exists.
+pub fn locate(source: &dyn TextSource, base: &Path, name: &str) -> Option<std::path::PathBuf> {
+    let forward = name.replace('\\', "/");
+    let last = forward.rsplit('/').next().unwrap_or(&forward).to_string();
+    [name.to_string(), forward, last].into_iter().map(|n| base.join(n)).find(|p| source.exists(p))
 }
 
 /// Files in memory, by path: for tests and for callers that build a scene
@@ -135,8 +181,29 @@ mod tests {
     }
 
     #[test]
-    fn statements_drop_comments_and_join_continued_lines() {
-        let lines = statements("# header\nv 1 2 3 # end\r\nf 1 \\\n 2 3\n\n  \nusemtl a\\");
-        assert_eq!(lines, [(2, "v 1 2 3".to_string()), (3, "f 1   2 3".to_string()), (7, "usemtl a".to_string())]);
+    fn statements_drop_comment_lines_and_join_continued_lines() {
+        let lines = statements("# header\nv 1 2 3 # end\r\nf 1 \\\n 2 3\n\n  \n\tusemtl Material #25\\");
+        let seen: Vec<(usize, &str, &str)> = lines.iter().map(|s| (s.line, s.keyword.as_str(), s.rest.as_str())).collect();
+        assert_eq!(seen, [(2, "v", "1 2 3 # end"), (3, "f", "1   2 3"), (7, "usemtl", "Material #25")]);
+        assert_eq!(lines[0].arguments(), "1 2 3");
+        let continued_comment = statements("# C:\\dir\\\nv 0 0 0\n");
+        assert_eq!(continued_comment.len(), 1, "a comment line ending in a backslash does not swallow the next");
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_dropped() {
+        let source = Memory(vec![("a.obj".into(), b"\xef\xbb\xbfmtllib m.mtl\n".to_vec())]);
+        assert_eq!(read_text(&source, Path::new("a.obj"), &mut Vec::new()).unwrap(), "mtllib m.mtl\n");
+        assert_eq!(read_utf8(&source, Path::new("a.obj")).unwrap(), "mtllib m.mtl\n");
+    }
+
+    #[test]
+    fn names_are_located_as_written_with_forward_slashes_or_beside_the_file() {
+        let source = Memory::text(&[("m/a b.png", ""), ("m/tex/w.png", ""), ("m/c.png", "")]);
+        let at = |name: &str| locate(&source, Path::new("m"), name).map(|p| p.display().to_string());
+        assert_eq!(at("a b.png").as_deref(), Some("m/a b.png"));
+        assert_eq!(at("tex\\w.png").as_deref(), Some("m/tex/w.png"));
+        assert_eq!(at("C:\\Users\\me\\c.png").as_deref(), Some("m/c.png"));
+        assert_eq!(at("d.png"), None);
     }
 }
