@@ -15,6 +15,10 @@
 //!   every target, `FUZZ_SEED=<seed>` changes the master seed (default
 //!   [`DEFAULT_SEED`]). Case `k`'s mutant depends only on the seed, `k` and
 //!   the seed inputs, never on the other cases or on timing.
+//! - A case that aborts the whole process (a stack overflow, an allocation
+//!   the system refuses) cannot be caught: `FUZZ_TRACE=1` prints each case
+//!   number to stderr before it runs, so the last one printed is the
+//!   culprit (run with `--nocapture`).
 //! - [`Mutator`] is the mutation engine itself, for a harness of its own:
 //!   [`Mutator::for_case`] then [`Mutator::mutate`].
 //!
@@ -336,6 +340,12 @@ where
         Some(case) => Box::new(std::iter::once(case as usize)),
         None => Box::new(0..cases()),
     };
+    let trace = std::env::var_os("FUZZ_TRACE").is_some();
+    let numbers = numbers.inspect(move |case| {
+        if trace {
+            eprintln!("fuzz target {target}: case {case}");
+        }
+    });
     let failures = run_cases(seeds, kind, seed, numbers, CASE_TIMEOUT, parse);
     if failures.is_empty() {
         return;
