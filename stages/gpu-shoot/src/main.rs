@@ -217,7 +217,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         let notes = vec![format!("adapter: {adapter}")];
         outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects), notes))?;
     }
-    outputs.keep();
+    outputs.keep()?;
     Ok(ExitCode::SUCCESS)
 }
 
