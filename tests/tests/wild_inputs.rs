@@ -146,8 +146,13 @@ fn make_reruns_mesh_prep_exactly_when_a_file_it_read_changes() {
     let make = || {
         // -o: the stage binaries count as old and are not rebuilt (the
         // tests run on the ones `make test` built).
+        // Under `make test` the parent make's flags and variables would
+        // reach this one through the environment.
         let result = std::process::Command::new("make")
             .current_dir(root)
+            .env_remove("MAKEFLAGS")
+            .env_remove("MFLAGS")
+            .env_remove("MAKELEVEL")
             .args(["--no-print-directory", "-o", "target/release/mesh-prep", &format!("OUT={}", s(&out)), &format!("SCENE={}", s(&scene)), s(&out.join("mesh.exr"))])
             .output()
             .expect("make runs");
