@@ -4,11 +4,15 @@
 //! material overrides) or a built-in scene ([`builtin::Builtin`]),
 //! reads and validates the photometric files of its luminaires
 //! ([`photometry`]), triangulates, places and recentres the geometry, welds duplicate
-//! vertices, drops degenerate and duplicate triangles, and lists the effects
-//! the scene calls for. The binary writes the result as `mesh.exr` and
-//! `manifest.ron` (see the `schemas` crate).
+//! vertices, drops degenerate and duplicate triangles, checks that every
+//! emitter lights the scene ([`lighting`]), and lists the effects the scene
+//! calls for. The OBJ and MTL readers ([`obj`], [`mtl`], [`text`]) take
+//! files as exporters write them. The binary writes the result as
+//! `mesh.exr` and `manifest.ron` (see the `schemas` crate), and a make
+//! dependency file of every file it read ([`depfile`]).
 
 pub mod builtin;
+pub mod depfile;
 pub mod lighting;
 pub mod material;
 pub mod mtl;

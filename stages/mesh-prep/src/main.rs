@@ -81,7 +81,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     // A built-in scene's files are inside the binary, which the Makefile
     // already lists.
     let read: Vec<&str> = if args.builtin.is_some() { Vec::new() } else { provenance.inputs.iter().map(|i| i.path.as_str()).collect() };
-    let depfile_text = depfile(&[&mesh_path, &manifest_path], &read);
+    let depfile_text = mesh_prep::depfile::rule(&[&mesh_path.display().to_string(), &manifest_path.display().to_string()], &read);
     let (mesh, manifest) = prepared.into_artifacts(provenance);
     for warning in &warnings {
         eprintln!("mesh-prep: warning: {warning}");
@@ -109,42 +109,6 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     }
     outputs.keep()?;
     Ok(ExitCode::SUCCESS)
-}
-
-/// A make rule saying that `targets` depend on the files `read`, and an
-/// empty rule for each of those (as `gcc -MP` writes), so that a deleted
-/// input makes `make` rerun mesh-prep, which then names it, instead of
-/// stopping with "no rule to make target".
-fn depfile(targets: &[&std::path::Path], read: &[&str]) -> String {
-    let mut seen = std::collections::BTreeSet::new();
-    let prerequisites: Vec<String> = read.iter().filter(|p| seen.insert(**p)).map(|p| make_escape(p)).collect();
-    let targets: Vec<String> = targets.iter().map(|t| make_escape(&t.display().to_string())).collect();
-    let mut text = format!("# Written by mesh-prep: the files its outputs were made from.\n{}:", targets.join(" "));
-    for p in &prerequisites {
-        text += &format!(" \\\n  {p}");
-    }
-    text += "\n";
-    for p in &prerequisites {
-        text += &format!("\n{p}:\n");
-    }
-    text
-}
-
-/// `path` as a word of a make rule: spaces, tabs and `#` escaped with a
-/// backslash, `$` doubled.
-fn make_escape(path: &str) -> String {
-    let mut out = String::with_capacity(path.len());
-    for c in path.chars() {
-        match c {
-            ' ' | '\t' | '#' | ':' => {
-                out.push('\\');
-                out.push(c);
-            }
-            '$' => out.push_str("$$"),
-            _ => out.push(c),
-        }
-    }
-    out
 }
 
 fn main() -> ExitCode {
