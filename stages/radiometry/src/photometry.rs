@@ -21,6 +21,7 @@
 //! source, `I_e = I_v / 683`), the radiant intensity of a light is `I_e =
 //! scale x I_v / 683` W/sr, the same in R, G, B ([`Luminaire`]).
 
+use crate::form_factor::DUNAVANT_5;
 use crate::rays::SceneRays;
 use glam::DVec3;
 use schemas::mesh::GoniometricLight;
@@ -310,7 +311,7 @@ impl Luminaire {
     /// 1:4 recursively where it is near the light (its size over the
     /// light's distance to its centroid above `1/2`), down to `depth`
     /// levels (each level quarters the area), and each piece uses a
-    /// 7-point degree-5 rule (Dunavant 1985). Below the last level, a piece
+    /// 7-point degree-5 rule ([`DUNAVANT_5`], Dunavant 1985). Below the last level, a piece
     /// still near the light contributes its exact unoccluded solid angle
     /// (Van Oosterom and Strackee 1983) times the intensity towards its
     /// centroid and the visibility of its centroid: bounded, and exact for
@@ -351,7 +352,7 @@ impl Luminaire {
         let area = 0.5 * (c[1] - c[0]).cross(c[2] - c[0]).length();
         DUNAVANT_5
             .iter()
-            .map(|&(w, b)| {
+            .map(|&(b, w)| {
                 let p = c[0] * b[0] + c[1] * b[1] + c[2] * b[2];
                 let e = self.irradiance(p, n);
                 if e > 0.0 {
@@ -420,26 +421,6 @@ pub fn solid_angle(r: [DVec3; 3]) -> f64 {
     let denominator = l[0] * l[1] * l[2] + r[0].dot(r[1]) * l[2] + r[0].dot(r[2]) * l[1] + r[1].dot(r[2]) * l[0];
     2.0 * numerator.atan2(denominator)
 }
-
-/// Dunavant's 7-point rule, exact for polynomials of degree 5 on a
-/// triangle: `(weight, barycentric)`, weights summing to 1.
-const DUNAVANT_5: [(f64, [f64; 3]); 7] = {
-    const A1: f64 = 0.059_715_871_789_770;
-    const B1: f64 = 0.470_142_064_105_115;
-    const A2: f64 = 0.797_426_985_353_087;
-    const B2: f64 = 0.101_286_507_323_456;
-    const W1: f64 = 0.132_394_152_788_506;
-    const W2: f64 = 0.125_939_180_544_827;
-    [
-        (0.225, [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0]),
-        (W1, [A1, B1, B1]),
-        (W1, [B1, A1, B1]),
-        (W1, [B1, B1, A1]),
-        (W2, [A2, B2, B2]),
-        (W2, [B2, A2, B2]),
-        (W2, [B2, B2, A2]),
-    ]
-};
 
 #[cfg(test)]
 mod tests {

@@ -4,35 +4,10 @@
 //! tilt factors are not applied (lights are placed untilted). Absolute
 //! intensity = candela value x candela multiplier x ballast factor.
 
-use super::{count, err, full_sphere, number, scaled};
+use super::{err, full_sphere, Fields};
 use radiometry::photometry::Distribution;
 use schemas::Error;
 use std::path::Path;
-
-/// The whitespace-separated numbers after `TILT=`, with their lines.
-struct Tokens<'a> {
-    path: &'a Path,
-    tokens: Vec<(usize, &'a str)>,
-    next: usize,
-    last_line: usize,
-}
-
-impl Tokens<'_> {
-    fn number(&mut self, what: &str) -> Result<(usize, f64), Error> {
-        let (n, t) = *self.tokens.get(self.next).ok_or_else(|| err(self.path, self.last_line, format!("file ends before {what}")))?;
-        self.next += 1;
-        Ok((n, number(self.path, n, what, t)?))
-    }
-
-    fn count(&mut self, what: &str, range: std::ops::RangeInclusive<usize>) -> Result<(usize, usize), Error> {
-        let (n, v) = self.number(what)?;
-        Ok((n, count(self.path, n, what, v, range)?))
-    }
-
-    fn numbers(&mut self, k: usize, what: &str) -> Result<Vec<(usize, f64)>, Error> {
-        (0..k).map(|_| self.number(what)).collect()
-    }
-}
 
 /// Reads an IES file into a full-sphere table, cd.
 pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
@@ -40,7 +15,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
     let tilt = lines.iter().position(|(_, l)| l.trim_start().starts_with("TILT=")).ok_or_else(|| err(path, 1, "TILT: no 'TILT=' line"))?;
     let tilt_kind = lines[tilt].1.trim().trim_start_matches("TILT=").trim().to_string();
     let tokens = lines[tilt + 1..].iter().flat_map(|&(n, l)| l.split_whitespace().map(move |t| (n, t))).collect();
-    let mut t = Tokens { path, tokens, next: 0, last_line: lines.last().map_or(1, |l| l.0) };
+    let mut t = Fields::new(path, tokens, lines.last().map_or(1, |l| l.0));
     if tilt_kind == "INCLUDE" {
         t.number("lamp-to-luminaire geometry")?;
         let (_, pairs) = t.count("number of tilt angles", 0..=1000)?;
@@ -71,11 +46,9 @@ pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
     let horizontal: Vec<f64> = t.numbers(nh, "horizontal angle")?.into_iter().map(|x| x.1).collect();
     let mut planes = Vec::with_capacity(nh);
     for _ in 0..nh {
-        planes.push(t.numbers(nv, "candela value")?.into_iter().map(|(n, v)| scaled(path, n, "candela value", v, factor)).collect::<Result<Vec<f64>, Error>>()?);
+        planes.push(t.intensities(nv, "candela value", factor)?);
     }
-    if let Some(&(n, _)) = t.tokens.get(t.next) {
-        return Err(err(path, n, format!("{} numbers left over after the candela values: the angle counts ({nv} vertical, {nh} horizontal) do not match the data", t.tokens.len() - t.next)));
-    }
+    t.finish(&format!("the angle counts ({nv} vertical, {nh} horizontal)"))?;
     if nv < 2 {
         return Err(err(path, nv_line, "number of vertical angles = 1: a distribution needs at least 2"));
     }

@@ -4,44 +4,17 @@
 //! intensity is `value x (sum of the lamp sets' flux) / 1000 x conversion
 //! factor` (line 24).
 
-use super::{count, err, full_sphere, number, scaled};
+use super::{err, full_sphere, Fields};
 use radiometry::photometry::Distribution;
 use schemas::Error;
 use std::path::Path;
 
-/// Lines with their 1-based numbers, read one field at a time.
-struct Lines<'a> {
-    path: &'a Path,
-    lines: Vec<(usize, &'a str)>,
-    next: usize,
-}
-
-impl<'a> Lines<'a> {
-    fn line(&mut self, what: &str) -> Result<(usize, &'a str), Error> {
-        let found = self.lines.get(self.next).copied();
-        self.next += 1;
-        found.ok_or_else(|| err(self.path, self.lines.len().max(1), format!("file ends before {what}")))
-    }
-
-    fn number(&mut self, what: &str) -> Result<(usize, f64), Error> {
-        let (n, text) = self.line(what)?;
-        Ok((n, number(self.path, n, what, text)?))
-    }
-
-    fn count(&mut self, what: &str, range: std::ops::RangeInclusive<usize>) -> Result<(usize, usize), Error> {
-        let (n, v) = self.number(what)?;
-        Ok((n, count(self.path, n, what, v, range)?))
-    }
-
-    fn numbers(&mut self, k: usize, what: &str) -> Result<Vec<(usize, f64)>, Error> {
-        (0..k).map(|_| self.number(what)).collect()
-    }
-}
-
 /// Reads an EULUMDAT file into a full-sphere table, cd.
 pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
-    let mut l = Lines { path, lines: text.lines().enumerate().map(|(i, s)| (i + 1, s.trim_end_matches('\r'))).collect(), next: 0 };
-    l.line("company identification")?;
+    let lines: Vec<(usize, &str)> = text.lines().enumerate().map(|(i, s)| (i + 1, s.trim_end_matches('\r'))).collect();
+    let last = lines.len();
+    let mut l = Fields::new(path, lines, last);
+    l.text("company identification")?;
     l.count("Ityp (type indicator)", 0..=3)?;
     let (isym_line, isym) = l.count("Isym (symmetry indicator)", 0..=4)?;
     let (mc_line, mc) = l.count("Mc (number of C-planes)", 1..=721)?;
@@ -49,7 +22,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
     let (_, ng) = l.count("Ng (intensities per C-plane)", 2..=721)?;
     l.number("Dg (distance between gamma angles)")?;
     for what in ["measurement report number", "luminaire name", "luminaire number", "file name", "date/user"] {
-        l.line(what)?;
+        l.text(what)?;
     }
     for what in ["length of luminaire", "width of luminaire", "height of luminaire", "length of luminous area", "width of luminous area", "height of luminous area C0", "height of luminous area C90", "height of luminous area C180", "height of luminous area C270", "DFF (downward flux fraction)", "LORL (light output ratio)"] {
         l.number(what)?;
@@ -60,10 +33,10 @@ pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
     let mut flux = 0.0;
     for _ in 0..sets {
         l.number("number of lamps")?;
-        l.line("type of lamps")?;
+        l.text("type of lamps")?;
         flux += l.number("total luminous flux of lamps")?.1;
-        l.line("colour appearance / colour temperature of lamps")?;
-        l.line("colour rendering group / index")?;
+        l.text("colour appearance / colour temperature of lamps")?;
+        l.text("colour rendering group / index")?;
         l.number("wattage including ballast")?;
     }
     l.numbers(10, "direct ratios for room indices")?;
@@ -88,14 +61,9 @@ pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
     let gamma: Vec<f64> = l.numbers(ng, "gamma angle")?.into_iter().map(|x| x.1).collect();
     let mut planes = Vec::with_capacity(stored.len());
     for _ in &stored {
-        let plane = l.numbers(ng, "luminous intensity")?.into_iter().map(|(n, v)| scaled(path, n, "luminous intensity", v, factor)).collect::<Result<Vec<f64>, Error>>()?;
-        planes.push(plane);
+        planes.push(l.intensities(ng, "luminous intensity", factor)?);
     }
-    let rest = &l.lines[l.next.min(l.lines.len())..];
-    if let Some(&(n, _)) = rest.iter().find(|(_, s)| !s.trim().is_empty()) {
-        let left = rest.iter().filter(|(_, s)| !s.trim().is_empty()).count();
-        return Err(err(path, n, format!("{left} non-empty line(s) left over after the intensity table: Mc ({mc}), Ng ({ng}) or Isym ({isym}) do not match the data")));
-    }
+    l.finish(&format!("Mc ({mc}), Ng ({ng}) or Isym ({isym})"))?;
     // The full set of C-planes, each taken from its stored mirror image.
     let find = |c: f64| stored.iter().position(|&k| (c_all[k] - c).abs() < 1e-6);
     let mut intensity = Vec::with_capacity(mc);

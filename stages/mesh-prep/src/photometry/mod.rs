@@ -71,6 +71,59 @@ fn short(v: f64) -> String {
     }
 }
 
+/// The fields of a photometric file in order, each with its 1-based line:
+/// EULUMDAT has one field per line, IES one per whitespace-separated token
+/// after `TILT=`.
+struct Fields<'a> {
+    path: &'a Path,
+    items: Vec<(usize, &'a str)>,
+    next: usize,
+    /// Line an error at the end of the file names.
+    last_line: usize,
+}
+
+impl<'a> Fields<'a> {
+    fn new(path: &'a Path, items: Vec<(usize, &'a str)>, last_line: usize) -> Self {
+        Fields { path, items, next: 0, last_line: last_line.max(1) }
+    }
+
+    /// The next field as text.
+    fn text(&mut self, what: &str) -> Result<(usize, &'a str), Error> {
+        let found = self.items.get(self.next).copied().ok_or_else(|| err(self.path, self.last_line, format!("file ends before {what}")))?;
+        self.next += 1;
+        Ok(found)
+    }
+
+    fn number(&mut self, what: &str) -> Result<(usize, f64), Error> {
+        let (n, text) = self.text(what)?;
+        Ok((n, number(self.path, n, what, text)?))
+    }
+
+    fn count(&mut self, what: &str, range: std::ops::RangeInclusive<usize>) -> Result<(usize, usize), Error> {
+        let (n, v) = self.number(what)?;
+        Ok((n, count(self.path, n, what, v, range)?))
+    }
+
+    fn numbers(&mut self, k: usize, what: &str) -> Result<Vec<(usize, f64)>, Error> {
+        (0..k).map(|_| self.number(what)).collect()
+    }
+
+    /// `k` intensities, each times `factor` ([`scaled`]).
+    fn intensities(&mut self, k: usize, what: &str, factor: f64) -> Result<Vec<f64>, Error> {
+        self.numbers(k, what)?.into_iter().map(|(n, v)| scaled(self.path, n, what, v, factor)).collect()
+    }
+
+    /// The fields not read yet, not counting empty ones; error if any is
+    /// left: `counts` says which counts the data then contradicts.
+    fn finish(&self, counts: &str) -> Result<(), Error> {
+        let left: Vec<&(usize, &str)> = self.items[self.next.min(self.items.len())..].iter().filter(|(_, t)| !t.trim().is_empty()).collect();
+        match left.first() {
+            Some(&&(n, _)) => Err(err(self.path, n, format!("{} fields left over after the intensity table: {counts} do not match the data", left.len()))),
+            None => Ok(()),
+        }
+    }
+}
+
 /// The full-sphere table, or the table error at `line` (the line of the
 /// counts the angles were read with).
 fn full_sphere(path: &Path, line: usize, c: Vec<f64>, gamma: Vec<f64>, planes: Vec<Vec<f64>>) -> Result<Distribution, Error> {
