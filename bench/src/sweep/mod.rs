@@ -375,7 +375,7 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
             notes.push(format!("no closed form per element: {why}"));
             match &config.reference {
                 Some(path) => {
-                    record.input(Input::new(path, &read_bytes(path)?, None));
+                    record.input(Input::new(path, &read_bytes(path)?, None))?;
                     let name = path.file_name().map_or_else(|| s(path), |n| n.to_string_lossy().into_owned());
                     let label = format!("reference: {name} (foreign EXR)");
                     let flags = vec!["--exclude-emitters", "--exclude-edges", "2"];
