@@ -24,6 +24,9 @@ pub struct QuadScene {
     pub materials: Vec<TestMaterial>,
     /// Camera eye and target.
     pub camera: ([f64; 3], [f64; 3]),
+    /// Lights besides the emitting materials, as `scene.ron` entries, e.g.
+    /// `Goniometric(file: "lamp.ldt", position: (0.0, 0.0, 1.0), nadir: (0.0, 0.0, -1.0))`.
+    pub lights: Vec<String>,
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -71,8 +74,9 @@ impl QuadScene {
             writeln!(overrides, "    \"{}\": (emission: Some(({e:?}, {e:?}, {e:?}))),", m.name, e = m.emission).unwrap();
         }
         let (eye, target) = self.camera;
+        let lights: String = self.lights.iter().map(|l| format!("    {l},\n")).collect();
         let scene = format!(
-            "Scene(\n  meshes: [Obj(file: \"scene.obj\")],\n  camera: Camera(eye: {eye:?}, target: {target:?}, up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 64, height: 64),\n  materials: {{\n{overrides}  }},\n)\n",
+            "Scene(\n  meshes: [Obj(file: \"scene.obj\")],\n  camera: Camera(eye: {eye:?}, target: {target:?}, up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 64, height: 64),\n  lights: [\n{lights}  ],\n  materials: {{\n{overrides}  }},\n)\n",
             eye = (eye[0], eye[1], eye[2]),
             target = (target[0], target[1], target[2]),
         );
@@ -157,4 +161,19 @@ pub fn one_bounce(rho_a: f64, rho_b: f64, emission: f64) -> QuadScene {
     scene.quad("B", "lower", rectangle(2, 0.0, [1.0, 0.0], [2.0, 1.0]), [0.0, 0.0, 1.0]);
     scene.quad("A", "upper", rectangle(2, 0.5, [0.0, 0.0], [2.0, 1.0]), [0.0, 0.0, -1.0]);
     scene
+}
+
+/// An EULUMDAT file (`.ldt`) of a rotationally symmetric luminaire (Isym
+/// 1, one C-plane) with luminous intensity `intensity(gamma)` cd at gamma
+/// = 0, 5, ..., 180 degrees (one lamp set of 1000 lm and conversion factor
+/// 1, so the table's cd/klm are cd).
+pub fn rotational_ldt(intensity: &dyn Fn(f64) -> f64) -> String {
+    let mut lines: Vec<String> = ["test luminaire", "1", "1", "1", "0", "37", "5", "report", "luminaire", "number", "lamp.ldt", "date"].map(String::from).to_vec();
+    lines.extend(["100", "100", "10", "100", "100", "0", "0", "0", "0", "100", "100", "1", "0", "1"].map(String::from));
+    lines.extend(["1", "LED", "1000", "3000K", "80", "10"].map(String::from));
+    lines.extend((0..10).map(|_| "0.5".to_string()));
+    lines.push("0".into());
+    lines.extend((0..37).map(|g| format!("{}", 5 * g)));
+    lines.extend((0..37).map(|g| format!("{:.9}", intensity(5.0 * g as f64))));
+    lines.join("\n") + "\n"
 }

@@ -476,3 +476,131 @@ fn a_tilted_one_sided_lamp_lights_nothing_behind_its_plane() {
 fn a_tilted_one_sided_lamp_lights_nothing_behind_its_plane_with_clusters() {
     tilted_lamp(true);
 }
+
+#[test]
+#[ignore]
+fn debug_one_bounce() {
+    let (rho_a, emission) = (0.5, 1.0);
+    let extra: Vec<String> = std::env::var("DEBUG_ARGS").unwrap_or_default().split_whitespace().map(String::from).collect();
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    for (rho_b, args) in [(0.05, extra.clone()), (0.5, extra.clone())] {
+        let (solved, dir) = solve("debug_one_bounce", &one_bounce(rho_a, rho_b, emission), &args, false);
+        let (mesh, _) = Mesh::read(&dir.join("mesh.exr")).unwrap();
+        let origin = read_ron::<Manifest>(&dir.join("manifest.ron")).unwrap().value.world_from_mesh_translation;
+        let lamp = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let b_grid: Vec<[f64; 3]> = (0..50).flat_map(|i| (0..50).map(move |j| [1.0 + (i as f64 + 0.5) * 0.02, (j as f64 + 0.5) * 0.02, 0.0])).collect();
+        let first_b = one_bounce_reference_first(rho_a, rho_b, emission, &b_grid);
+        let mut b_leaves = Vec::new();
+        let (mut worst_a, mut n_a) = (0.0f64, 0);
+        for (object, _, b, i) in solved.leaves() {
+            let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
+            let c: [f64; 3] = std::array::from_fn(|a| (corners[0][a] + corners[1][a] + corners[2][a]) / 3.0);
+            if object == "A" {
+                let direct = {
+                    let h = 0.5; let cell = 0.02;
+                    let k = |x: &[f64; 3], y: &[f64; 3]| { let r2 = (x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + h * h; h * h / (std::f64::consts::PI * r2 * r2) * cell * cell };
+                    rho_a * emission * mean_over_triangle(&corners, 2, &|x| lambert_polygon(x, [0.0, 0.0, -1.0], &lamp)) + rho_a * b_grid.iter().zip(&first_b).map(|(y, b)| b * k(&c, y)).sum::<f64>()
+                };
+                let e = (b - direct) / direct;
+                if e.abs() > worst_a.abs() { worst_a = e; }
+                n_a += 1;
+            }
+            if object == "B" { b_leaves.push((b, corners, c)); }
+        }
+        let all: Vec<[f64; 3]> = b_leaves.iter().map(|l| l.2).collect();
+        let reference = one_bounce_reference(rho_a, rho_b, emission, &all);
+        let mut errs: Vec<(f64, [f64; 3])> = b_leaves.iter().zip(&reference).map(|((b, _, c), r)| ((b - r) / r, *c)).collect();
+        errs.sort_by(|a, b| b.0.abs().partial_cmp(&a.0.abs()).unwrap());
+        let mean: f64 = errs.iter().map(|e| e.0).sum::<f64>() / errs.len() as f64;
+        let rms = (errs.iter().map(|e| e.0 * e.0).sum::<f64>() / errs.len() as f64).sqrt();
+        let report = std::fs::read_to_string(dir.join("solve.report.ron")).unwrap_or_default();
+        let links = report.lines().find(|l| l.contains("\"links\"")).unwrap_or("").trim().to_string();
+        eprintln!("rho_b {rho_b} {args:?}: A leaves {n_a} worst {worst_a:.3e}; B leaves {} mean signed {mean:.3e} rms {rms:.3e} worst {:.3e} at {:?}; {links}", errs.len(), errs[0].0, errs[0].1);
+    }
+}
+
+/// A luminaire over a 2 x 2 m floor (reflectance 1/2, nothing else in the
+/// scene, so nothing interreflects): every floor leaf's radiosity must be
+/// `rho` times the luminaire's irradiance `I_e(gamma) cos(theta) / d^2`
+/// averaged over the leaf by an independent quadrature (256 sub-triangle
+/// centroids), within 1%. The luminaire is an EULUMDAT file of the smooth
+/// distribution `I_v = 500 (1 + cos gamma)` cd, placed 0.8 m up, off the
+/// floor's centre, nadir down; `I_e = I_v / 683` W/sr (004 Eq. 2.12).
+/// Returns the scene directory.
+fn luminaire_over_floor(test: &str, height: f64, intensity: &dyn Fn(f64) -> f64) -> (Solved, std::path::PathBuf, [f64; 3]) {
+    let mut scene = QuadScene { camera: ([0.0, -3.0, 2.0], [0.0, 0.0, 0.0]), ..Default::default() };
+    scene.material("floor", 0.5, 0.0);
+    scene.quad("floor", "floor", rectangle(2, 0.0, [-1.0, -1.0], [1.0, 1.0]), [0.0, 0.0, 1.0]);
+    let light = [0.13, -0.21, height];
+    scene.lights.push(format!("Goniometric(file: \"lamp.ldt\", position: ({:?}, {:?}, {:?}), nadir: (0.0, 0.0, -1.0))", light[0], light[1], light[2]));
+    let dir = scratch(test);
+    std::fs::write(dir.join("lamp.ldt"), end_to_end::scenes::rotational_ldt(intensity)).unwrap();
+    let scene_path = scene.write(&dir);
+    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
+    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let solution = solve_prepared(&dir, &[], None);
+    (load(&mesh, &manifest, &solution), dir, light)
+}
+
+#[test]
+fn luminaire_gives_every_floor_leaf_i_cos_over_d_squared() {
+    let rho = 0.5;
+    let intensity = |gamma: f64| 500.0 * (1.0 + gamma.to_radians().cos());
+    let (solved, dir, light) = luminaire_over_floor("luminaire_floor", 0.8, &intensity);
+    let (mesh, _) = Mesh::read(&dir.join("mesh.exr")).unwrap();
+    let manifest = read_ron::<Manifest>(&dir.join("manifest.ron")).unwrap().value;
+    let origin = manifest.world_from_mesh_translation;
+    let irradiance = |x: [f64; 3]| {
+        let d: [f64; 3] = std::array::from_fn(|a| x[a] - light[a]);
+        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let cos = -d[2] / r; // both the receiver's cosine and cos(gamma)
+        intensity(cos.acos().to_degrees()) / 683.0 * cos / (r * r)
+    };
+    let (mut checked, mut worst, mut sum_sq) = (0, 0.0f64, 0.0);
+    for (_, _, b, i) in solved.leaves() {
+        let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
+        let exact = rho * mean_over_triangle(&corners, 4, &irradiance);
+        let error = (b - exact) / exact;
+        worst = worst.max(error.abs());
+        sum_sq += error * error;
+        checked += 1;
+    }
+    eprintln!("luminaire over a floor: {checked} leaves, largest relative error {worst:.2e}, rms {:.2e}", (sum_sq / f64::from(checked)).sqrt());
+    assert!(checked >= 16, "only {checked} floor leaves: the direct light was not refined");
+    assert!(worst <= 0.01, "a floor leaf is {worst:.2e} off I cos(theta) / d^2");
+}
+
+/// A luminaire 2 cm above the floor (isotropic, 683 cd = 1 W/sr): the
+/// irradiance is singular at its foot, but its integral is the light's
+/// intensity times the solid angle the floor subtends, `Omega = 4 asin(a^2
+/// / (a^2 + h^2))` for a square of half-side `a` under its centre (here
+/// off-centre: the sum of four rectangles with a corner under the light).
+/// The floor's reflected power, `sum B A / rho`, must match within 1%, and
+/// no leaf may be non-finite or brighter than the bound `rho I / h^2`.
+#[test]
+fn luminaire_next_to_the_floor_delivers_its_solid_angle() {
+    let (rho, h) = (0.5, 0.02);
+    let (solved, _, light) = luminaire_over_floor("luminaire_near_floor", h, &|_| 683.0);
+    let (mut power, mut brightest) = (0.0, 0.0f64);
+    for (_, a, b, _) in solved.leaves() {
+        assert!(b.is_finite(), "a floor leaf is not finite");
+        brightest = brightest.max(b);
+        power += a * b / rho;
+    }
+    // Solid angle of the rectangle [0, x] x [0, y] at height h over its corner.
+    let corner = |x: f64, y: f64| (x * y / ((x * x + h * h) * (y * y + h * h)).sqrt()).asin();
+    let omega: f64 = [(1.0 - light[0], 1.0 - light[1]), (1.0 + light[0], 1.0 - light[1]), (1.0 - light[0], 1.0 + light[1]), (1.0 + light[0], 1.0 + light[1])].iter().map(|&(x, y)| corner(x, y)).sum();
+    eprintln!("luminaire 2 cm above the floor: floor power {power:.5} W vs I Omega = {omega:.5} W; brightest leaf {brightest:.3e} W/m2");
+    assert_close("power on the floor", power, omega, 0.01);
+    assert!(brightest <= rho / (h * h), "a leaf is brighter than the point bound: {brightest}");
+}
+
+fn one_bounce_reference_first(rho_a: f64, rho_b: f64, emission: f64, points: &[[f64; 3]]) -> Vec<f64> {
+    let h = 0.5;
+    let lamp = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let cell = 0.02;
+    let a_grid: Vec<[f64; 3]> = (0..100).flat_map(|i| (0..50).map(move |j| [(i as f64 + 0.5) * cell, (j as f64 + 0.5) * cell, h])).collect();
+    let kernel = |x: &[f64; 3], y: &[f64; 3]| { let r2 = (x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + h * h; h * h / (std::f64::consts::PI * r2 * r2) * cell * cell };
+    let direct_a: Vec<f64> = a_grid.iter().map(|x| rho_a * emission * lambert_polygon(*x, [0.0, 0.0, -1.0], &lamp)).collect();
+    points.iter().map(|y| rho_b * a_grid.iter().zip(&direct_a).map(|(x, b)| b * kernel(x, y)).sum::<f64>()).collect()
+}

@@ -11,6 +11,7 @@ use crate::{GridKind, Mode, Params};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
+use radiometry::photometry::{DirectLight, Luminaire};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use rayon::prelude::*;
@@ -89,6 +90,11 @@ pub struct FullScene<'a> {
     pub threshold: Option<&'a ContrastImage>,
     /// The camera.
     pub camera: &'a Pinhole,
+    /// The goniometric point lights (luminaires). The solution's element
+    /// radiosity holds the light they reflect; their direct light on the
+    /// receiver is not in the links (a point light is no sender), so each
+    /// camera sample adds it here, with a shadow ray per light.
+    pub lights: &'a [Luminaire],
 }
 
 /// The full (or brute-force) image.
@@ -141,6 +147,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let vertex_contrast = vertex_contrast(params, &grid, &centres, w, h, scene.threshold);
     let gather = FullGather::new(&senders, &grid, &rays, scene.surfaces, params, vertex_contrast, width);
     let spp = params.spp;
+    let luminaires = DirectLight { lights: scene.lights, rays: &rays };
     let rows: Vec<(Vec<([f32; 3], f32, Work, [u32; 3])>, u64)> = (0..height)
         .into_par_iter()
         .map(|y| {
@@ -178,9 +185,11 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                             }
                             _ => gather.irradiance(p, tri.normal, hit.triangle, leaf, &links, k, &mut sample),
                         };
+                        let (direct, cast) = luminaires.at_point(p, tri.normal, hit.triangle);
+                        sample.visibility_rays += cast;
                         work.add(&sample);
                         let s = scene.surfaces[hit.triangle as usize];
-                        (0..3).for_each(|c| sum[c] += (s.emission[c] + s.reflectance[c] * irradiance[c]) / PI);
+                        (0..3).for_each(|c| sum[c] += (s.emission[c] + s.reflectance[c] * (irradiance[c] + direct)) / PI);
                     }
                     let n = f64::from(spp);
                     (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, work, tally.finish())

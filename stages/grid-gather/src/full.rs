@@ -60,7 +60,13 @@
 //! visibility, and `H(p) += B_s sum_i w_i F_i V_i`: where one vertex
 //! resamples a sender and another interpolates it, both are done and
 //! blended (Sec. 4.4.2), so nothing switches at a tetrahedron face. The
-//! radiance is `L = (E + rho H) / pi`.
+//! radiance is `L = (E + rho (H + D)) / pi`, with `D` the direct
+//! irradiance of the goniometric point lights at `p`, `I_e(d) cos / r^2`
+//! with one shadow ray per light per camera sample
+//! (`radiometry::photometry::DirectLight`): a point light is no sender, so
+//! no link carries its direct light, and the solution's element radiosity
+//! (which holds it) is used only for senders, never for the receiver, so
+//! it is not counted twice.
 //!
 //! # Surface-based gather (Sec. 4.5)
 //!

@@ -423,7 +423,12 @@ fn full_gather(
         return Ok((rendered, final_gather::Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
     }
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
-    let full_scene = final_gather::FullScene { triangles, surfaces: &surfaces, ids: &ids, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera };
+    let lights = if scene.manifest.effects.goniometric_lights {
+        radiometry::photometry::Luminaire::all(&scene.manifest.goniometric_lights).map_err(|m| Error::invalid(scene.manifest_path, None, m))?
+    } else {
+        Vec::new()
+    };
+    let full_scene = final_gather::FullScene { triangles, surfaces: &surfaces, ids: &ids, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera, lights: &lights };
     let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
     let mut counters = image.counters;
     counters.insert("triangles".into(), triangles.len() as f64);

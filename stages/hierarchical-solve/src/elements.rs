@@ -48,6 +48,10 @@ pub struct Hierarchy {
     pub emission: Vec<[f64; 3]>,
     /// The clusters above the input triangles, when solving with them.
     pub clusters: Option<ClusterTree>,
+    /// Direct irradiance from the luminaires averaged over each element,
+    /// W/m² (the same in R, G, B; [`crate::luminaires`]); elements past its
+    /// end have not been lit yet.
+    pub direct: Vec<f64>,
 }
 
 impl Hierarchy {
@@ -71,7 +75,7 @@ impl Hierarchy {
         let reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| material(t).diffuse).collect();
         let areas: Vec<f64> = triangles.iter().map(|t| t.area).collect();
         let clusters = clusters.map(|c| ClusterTree::new(c, &areas, &reflectance));
-        Hierarchy { elements, reflectance, emission: mesh.triangles.iter().map(|t| material(t).emission).collect(), triangles, clusters }
+        Hierarchy { elements, reflectance, emission: mesh.triangles.iter().map(|t| material(t).emission).collect(), triangles, clusters, direct: Vec::new() }
     }
 
     /// Unit front normal of element `e` (its triangle's).
@@ -82,6 +86,14 @@ impl Hierarchy {
     /// Diffuse reflectance of element `e`.
     pub fn reflectance_of(&self, e: u32) -> [f64; 3] {
         self.reflectance[self.elements[e as usize].triangle as usize]
+    }
+
+    /// The source term of element `e`, W/m²: its emission plus its
+    /// reflected direct light from the luminaires, `E + rho D`.
+    pub fn source(&self, e: u32) -> [f64; 3] {
+        let t = self.elements[e as usize].triangle as usize;
+        let d = self.direct.get(e as usize).copied().unwrap_or(0.0);
+        [0, 1, 2].map(|c| self.emission[t][c] + self.reflectance[t][c] * d)
     }
 
     /// Creates the four children of `e` if it has none; returns the first.

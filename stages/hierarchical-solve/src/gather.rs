@@ -5,7 +5,7 @@
 //! ```text
 //! G_n      = sum over links l into n of  V_l F_l B_{s(l)}        (irradiance, W/m²)
 //! H_n      = G_n + H_{parent(n)}                                 (push down)
-//! B_leaf   = E_leaf + rho_leaf H_leaf
+//! B_leaf   = S_leaf + rho_leaf H_leaf,  S = E + rho D               (D: luminaires, crate::luminaires)
 //! B_inner  = sum over children c of (A_c / A_n) B_c              (pull up)
 //! ```
 //!
@@ -68,7 +68,8 @@ struct Topology {
     child_start: Vec<usize>,
     children: Vec<usize>,
     area: Vec<f64>,
-    /// Reflectance and emission of leaf elements; `None` for inner nodes.
+    /// Reflectance and source (emission plus reflected luminaire light,
+    /// [`Hierarchy::source`]) of leaf elements; `None` for inner nodes.
     leaf: Vec<Option<([f64; 3], [f64; 3])>>,
 }
 
@@ -83,8 +84,7 @@ impl Topology {
             }
             match this {
                 Node::Element(e) if h.elements[e as usize].is_leaf() => {
-                    let tri = h.elements[e as usize].triangle as usize;
-                    t.leaf[i] = Some((h.reflectance[tri], h.emission[tri]));
+                    t.leaf[i] = Some((h.reflectance_of(e), h.source(e)));
                 }
                 _ => t.children.extend(h.children(this).into_iter().map(|c| h.flat(c))),
             }
@@ -191,7 +191,7 @@ pub const STEADY_RATIO: f64 = 1e-2;
 /// extrapolation with a global ratio):
 ///
 /// ```text
-/// x_leaf <- max(E_leaf, x_leaf + delta_leaf q / (1 - q))
+/// x_leaf <- max(S_leaf, x_leaf + delta_leaf q / (1 - q))
 /// ```
 ///
 /// An error `e` in `q` leaves `e / (1 - q)` of the slowest mode; the faster
@@ -234,8 +234,8 @@ pub fn solve(h: &Hierarchy, links: &[Link], offsets: &[usize], b: &mut [[f64; 3]
         for i in 0..n {
             let above = if topology.parent[i] == usize::MAX { [0.0; 3] } else { h_down[topology.parent[i]] };
             h_down[i] = [0, 1, 2].map(|c| gathered[i][c] + above[c]);
-            if let Some((rho, emitted)) = topology.leaf[i] {
-                let new = [0, 1, 2].map(|c| emitted[c] + rho[c] * h_down[i][c]);
+            if let Some((rho, source)) = topology.leaf[i] {
+                let new = [0, 1, 2].map(|c| source[c] + rho[c] * h_down[i][c]);
                 for c in 0..3 {
                     delta[i][c] = new[c] - b[i][c];
                     change[c] = change[c].max(delta[i][c].abs());
@@ -259,10 +259,10 @@ pub fn solve(h: &Hierarchy, links: &[Link], offsets: &[usize], b: &mut [[f64; 3]
         let steady = rate.steady();
         if steady.iter().any(Option::is_some) && convergence.iterations < max_iterations {
             for i in 0..n {
-                if let Some((_, emitted)) = topology.leaf[i] {
+                if let Some((_, source)) = topology.leaf[i] {
                     for c in 0..3 {
                         if let Some(q) = steady[c] {
-                            b[i][c] = (b[i][c] + delta[i][c] * q / (1.0 - q)).max(emitted[c]);
+                            b[i][c] = (b[i][c] + delta[i][c] * q / (1.0 - q)).max(source[c]);
                         }
                     }
                 }

@@ -7,20 +7,22 @@
 //! receiver ([`radiometry::form_factor`]); visibility is a ray-cast fraction
 //! per link ([`visibility`]); radiosity is gathered with push-pull
 //! ([`gather`]). Refinement needs radiosity and radiosity needs links, so
-//! the two alternate in passes until a pass refines nothing.
+//! the two alternate in passes until a pass refines nothing. Goniometric
+//! point lights shoot first: their direct light, with shadow rays, is a
+//! source term of every element ([`luminaires`]).
 //!
 //! Parameters ([`Params`]):
 //!
 //! | name | meaning | default |
 //! |---|---|---|
 //! | `criterion` | what a link's estimated error is compared with: `relative` (`eps_relative` times the receiver's radiosity) or `absolute` (`eps` times the largest emitted radiosity, HSA's BF criterion) | `relative` |
-//! | `eps` | absolute threshold, as a fraction of the largest emitted radiosity; with `relative`, used by the first pass only | 2e-4 |
+//! | `eps` | absolute threshold, as a fraction of the largest source radiosity (emission, or the reflected direct light of luminaires, [`luminaires`]); with `relative`, used by the first pass only | 2e-4 |
 //! | `eps_relative` | relative threshold: a link's error as a fraction of its receiver's radiosity (brightest channel, current iterate); unset: `eps` x largest emission / (3 x mean reflected radiosity), so that `eps` stays the one accuracy knob ([`RELATIVE_AT`]) | unset (0.9% on the Cornell box) |
 //! | `relative_floor` | least receiver radiosity the relative criterion assumes, as a fraction of the scene's area-mean reflected radiosity (black receivers terminate) | 1e-2 |
 //! | `min_area` | smallest element area, as a fraction of the scene's total area | 1e-4 |
 //! | `visibility_rays` | rays per link between two elements | 16 |
 //! | `cluster_samples` | point pairs (and rays) per link with a cluster end | 16 |
-//! | `quadrature_depth` | deepest split of the adaptive receiver quadrature near touching elements | 3 |
+//! | `quadrature_depth` | deepest split of the adaptive receiver quadrature near touching elements, and of the near-field quadrature of a luminaire's direct light over an element ([`luminaires`]) | 3 |
 //! | `tolerance` | convergence: bound of the remaining error of a leaf's radiosity, relative to the largest radiosity ([`gather::solve`]) | 1e-5 |
 //! | `max_iterations` | Jacobi iterations per solve, at most | 2000 |
 //! | `max_passes` | refine-and-solve passes, at most | 8 |
@@ -49,6 +51,7 @@
 pub mod elements;
 pub mod gather;
 pub mod links;
+pub mod luminaires;
 pub mod nodes;
 pub mod transfer;
 pub mod visibility;
@@ -58,6 +61,7 @@ use links::{children_links, decide, link, self_link, Allowance, Link, Linking, S
 pub use links::Criterion;
 use schemas::cluster::Clusters;
 use schemas::solution::Node;
+use radiometry::photometry::{DirectLight, Luminaire};
 use radiometry::rays::SceneRays;
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
@@ -204,6 +208,10 @@ pub struct Work {
     pub visibility_seconds: f64,
     /// Seconds gathering.
     pub gather_seconds: f64,
+    /// Shadow rays cast to luminaires ([`luminaires`]).
+    pub luminaire_rays: u64,
+    /// Seconds lighting elements from luminaires.
+    pub luminaire_seconds: f64,
 }
 
 /// Progress of a solve, reported as each phase of a pass begins and when
@@ -272,13 +280,24 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
     let mut h = Hierarchy::new(mesh, manifest, clusters);
     let total_area: f64 = (0..n).map(|t| h.elements[t].area).sum();
     let min_area = params.min_area * total_area;
-    let largest_emission = h.emission.iter().flatten().copied().fold(0.0, f64::max);
-    let threshold = params.eps * largest_emission;
     let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed, quadrature_depth: params.quadrature_depth };
     let scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
     let mut work = Work::default();
+    // Luminaires first (crate::luminaires): their direct light on the input
+    // triangles, which joins the emission in the scale of the threshold,
+    // then the elements refined for it.
+    let lights = if manifest.effects.goniometric_lights { Luminaire::all(&manifest.goniometric_lights)? } else { Vec::new() };
+    let direct = DirectLight { lights: &lights, rays: &scene };
+    let started = Instant::now();
+    work.luminaire_rays += luminaires::extend(&mut h, &direct, params.quadrature_depth);
+    let largest_source = (0..n as u32).flat_map(|e| h.source(e)).fold(0.0, f64::max);
+    let threshold = params.eps * largest_source;
+    if !lights.is_empty() {
+        work.luminaire_rays += luminaires::refine(&mut h, &direct, threshold, min_area, params.quadrature_depth);
+    }
+    work.luminaire_seconds += started.elapsed().as_secs_f64();
     let mut b: Vec<[f64; 3]> = vec![[0.0; 3]; h.cluster_count()];
-    b.extend(h.emission.iter().copied());
+    b.extend((0..h.elements.len() as u32).map(|e| h.source(e)));
     gather::pull(&h, &mut b);
 
     let started = Instant::now();
@@ -353,6 +372,10 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         work.refine_seconds += started.elapsed().as_secs_f64();
 
         progress(&Progress { pass, phase: Phase::Visibility, links: all_links.len(), elements: h.elements.len() });
+        let started = Instant::now();
+        work.luminaire_rays += luminaires::extend(&mut h, &direct, params.quadrature_depth);
+        work.luminaire_seconds += started.elapsed().as_secs_f64();
+
         let started = Instant::now();
         let rays: usize = all_links
             .par_iter_mut()
