@@ -133,7 +133,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
     for mesh in &scene.meshes {
         let MeshFile::Obj { file, scale, translate } = mesh;
         let path = base.join(file);
-        if !(scale.is_finite() && *scale > 0.0) || !translate.iter().all(|t| t.is_finite()) {
+        if !(scale.is_finite() && *scale > 0.0 && translate.iter().all(|t| t.is_finite())) {
             return Err(Error::invalid(scene_path, None, format!("mesh '{file}': scale must be positive and translate finite")));
         }
         let obj = read_obj(source, &path)?;
@@ -156,7 +156,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
             object_origins.push(Origin { file: path.clone(), line: object.lines.first().copied() });
             for (t, line) in object.triangles.iter().zip(&object.lines) {
                 let corners = t.map(|i| DVec3::from(obj.positions[i]) * *scale + DVec3::from(*translate));
-                if let Some(c) = corners.iter().find(|c| !(c.abs().max_element() <= MAX_COORDINATE)) {
+                if let Some(c) = corners.iter().find(|c| !c.is_finite() || c.abs().max_element() > MAX_COORDINATE) {
                     let what = format!(
                         "object '{}': a corner lies at {:?} once placed (its mesh entry's scale and translate): not a finite position within {MAX_COORDINATE:e} m",
                         object.name,
