@@ -251,13 +251,14 @@ mod tests {
         (path, back)
     }
 
-    /// The message reading `clusters` gives; it must name the file.
-    fn refusal(name: &str, clusters: &Clusters) -> String {
-        let (path, back) = round_trip(name, clusters);
-        let message = back.unwrap_err().to_string();
-        assert!(message.starts_with(&path.display().to_string()), "{message}");
+    /// Asserts that `clusters` after `edit` is refused with a message
+    /// naming the file and ending in `expected`.
+    fn assert_refused(name: &str, edit: impl FnOnce(&mut Clusters), expected: &str) {
+        let mut edited = clusters();
+        edit(&mut edited);
+        let (path, back) = round_trip(name, &edited);
         std::fs::remove_file(&path).unwrap();
-        message
+        assert_eq!(back.unwrap_err().to_string(), format!("{}: {expected}", path.display()));
     }
 
     #[test]
@@ -269,44 +270,25 @@ mod tests {
 
     #[test]
     fn a_cycle_is_refused_naming_the_cluster_reached_twice() {
-        let mut cyclic = clusters();
-        cyclic.nodes[2] = node(0, (0, 1), (2, 2));
-        let message = refusal("cycle", &cyclic);
-        assert!(message.ends_with("cluster 0: reached twice from the root, through cluster 2 (a cycle or a shared child; field first_child)"), "{message}");
+        let cycle = "cluster 0: reached twice from the root, through cluster 2 (a cycle or a shared child; field first_child)";
+        assert_refused("cycle", |c| c.nodes[2] = node(0, (0, 1), (2, 2)), cycle);
         // A cycle the root does not reach: still refused, never walked forever.
-        let mut detached = clusters();
-        detached.nodes.extend([node(4, (4, 1), (0, 1)), node(3, (3, 1), (0, 1))]);
-        let message = refusal("detached", &detached);
-        assert!(message.ends_with("cluster 3: not reachable from the root (field parent is 4)"), "{message}");
+        let detached = |c: &mut Clusters| c.nodes.extend([node(4, (4, 1), (0, 1)), node(3, (3, 1), (0, 1))]);
+        assert_refused("detached", detached, "cluster 3: not reachable from the root (field parent is 4)");
     }
 
     #[test]
-    fn an_empty_cluster_is_refused() {
-        let mut empty = clusters();
-        empty.nodes[1].triangle_count = 0;
-        let message = refusal("empty", &empty);
-        assert!(message.ends_with("cluster 1: holds no triangle (field triangle_count)"), "{message}");
+    fn an_empty_cluster_and_a_child_range_past_the_end_are_refused() {
+        assert_refused("empty", |c| c.nodes[1].triangle_count = 0, "cluster 1: holds no triangle (field triangle_count)");
+        let past = "cluster 0: children 1..6 run past the end of the table of 3 (field first_child)";
+        assert_refused("past", |c| c.nodes[0].child_count = 5, past);
     }
 
     #[test]
-    fn a_child_range_past_the_end_is_refused() {
-        let mut past = clusters();
-        past.nodes[0].child_count = 5;
-        let message = refusal("past", &past);
-        assert!(message.ends_with("cluster 0: children 1..6 run past the end of the table of 3 (field first_child)"), "{message}");
-    }
-
-    #[test]
-    fn children_that_do_not_split_their_parent_are_refused() {
-        let mut overlapping = clusters();
-        overlapping.nodes[2].first_triangle = 1;
-        let message = refusal("overlap", &overlapping);
-        assert!(message.ends_with("cluster 2: triangles start at 1, but its parent cluster 0 has them start at 2 (field first_triangle)"), "{message}");
-        let mut twice = clusters();
-        twice.order[3] = 3;
-        assert!(refusal("twice", &twice).ends_with("order 3: triangle 3 is listed twice"));
-        let mut nan = clusters();
-        nan.nodes[1].area = f32::NAN;
-        assert!(refusal("nan", &nan).ends_with("cluster 1: field area is NaN"));
+    fn children_that_do_not_split_their_parent_and_bad_orders_and_numbers_are_refused() {
+        let overlap = "cluster 2: triangles start at 1, but its parent cluster 0 has them start at 2 (field first_triangle)";
+        assert_refused("overlap", |c| c.nodes[2].first_triangle = 1, overlap);
+        assert_refused("twice", |c| c.order[3] = 3, "order 3: triangle 3 is listed twice");
+        assert_refused("nan", |c| c.nodes[1].area = f32::NAN, "cluster 1: field area is NaN");
     }
 }

@@ -144,6 +144,24 @@ pub struct Material {
     pub normal_map: Option<String>,
 }
 
+impl Material {
+    /// A diffuse material: reflectance `diffuse`, exitance `emission`,
+    /// nothing specular or transmitted, no maps.
+    pub fn diffuse(name: &str, diffuse: [f64; 3], emission: [f64; 3]) -> Self {
+        Material {
+            name: name.into(),
+            diffuse,
+            emission,
+            specular_reflectance: [0.0; 3],
+            specular_transmittance: [0.0; 3],
+            diffuse_transmittance: [0.0; 3],
+            diffuse_map: None,
+            alpha_map: None,
+            normal_map: None,
+        }
+    }
+}
+
 /// A goniometric point light (luminaire) as data: `mesh-prep` read and
 /// validated its EULUMDAT or IES file, expanded the file's symmetry to a
 /// full sphere of type C angles and converted it to absolute candela; no

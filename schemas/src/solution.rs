@@ -339,35 +339,33 @@ mod tests {
         assert_eq!(round_trip("valid", &solution()).unwrap(), solution());
     }
 
+    /// Asserts that `solution` after `edit` is refused with a message
+    /// naming the file (checked by [`round_trip`]) and ending in `expected`.
+    fn assert_refused(name: &str, edit: impl FnOnce(&mut Solution), expected: &str) {
+        let mut edited = solution();
+        edit(&mut edited);
+        let message = round_trip(name, &edited).unwrap_err();
+        assert!(message.ends_with(&format!(": {expected}")), "{message}");
+    }
+
     #[test]
     fn a_cyclic_element_tree_is_refused() {
-        let mut cyclic = solution();
-        cyclic.elements[3].first_child = 0;
-        let message = round_trip("cycle", &cyclic).unwrap_err();
-        assert!(message.ends_with("element 0: reached twice from the root, through element 3 (a cycle or a shared child; field first_child)"), "{message}");
+        let cycle = "element 0: reached twice from the root, through element 3 (a cycle or a shared child; field first_child)";
+        assert_refused("cycle", |s| s.elements[3].first_child = 0, cycle);
     }
 
     #[test]
     fn children_past_the_end_and_children_on_another_triangle_are_refused() {
-        let mut past = solution();
-        past.elements[1].first_child = 4;
-        let message = round_trip("past", &past).unwrap_err();
-        assert!(message.ends_with("element 1: children 4..8 run past the end of the table of 6 (field first_child)"), "{message}");
-        let mut moved = solution();
-        moved.elements[4].triangle = 0;
-        let message = round_trip("moved", &moved).unwrap_err();
-        assert!(message.ends_with("element 4: on triangle 0 at level 1, but its parent element 1 is on triangle 1 at level 0 (fields triangle, level)"), "{message}");
+        let past = "element 1: children 4..8 run past the end of the table of 6 (field first_child)";
+        assert_refused("past", |s| s.elements[1].first_child = 4, past);
+        let moved = "element 4: on triangle 0 at level 1, but its parent element 1 is on triangle 1 at level 0 (fields triangle, level)";
+        assert_refused("moved", |s| s.elements[4].triangle = 0, moved);
     }
 
     #[test]
     fn a_link_to_a_missing_element_or_cluster_is_refused() {
-        let mut missing = solution();
-        missing.links[0].receiver = Node::Element(6);
-        let message = round_trip("element", &missing).unwrap_err();
-        assert!(message.ends_with("link 0: field receiver names element 6, but the solution has 6"), "{message}");
-        missing.links[0].receiver = Node::Element(5);
-        missing.links[0].sender = Node::Cluster(1);
-        let message = round_trip("cluster", &missing).unwrap_err();
-        assert!(message.ends_with("link 0: field sender names cluster 1, but the solution has 1"), "{message}");
+        let element = "link 0: field receiver names element 6, but the solution has 6";
+        assert_refused("element", |s| s.links[0].receiver = Node::Element(6), element);
+        assert_refused("cluster", |s| s.links[0].sender = Node::Cluster(1), "link 0: field sender names cluster 1, but the solution has 1");
     }
 }

@@ -34,22 +34,11 @@ pub fn closed_box() -> (Mesh, Manifest) {
             triangles.push(Triangle { vertices, material, object: face as u32 / 2, area: length / 2.0, normal: n.map(|x| x / length) });
         }
     }
-    let material = |name: &str, diffuse: f64, emission: f64| Material {
-        name: name.into(),
-        diffuse: [diffuse; 3],
-        emission: [emission; 3],
-        specular_reflectance: [0.0; 3],
-        specular_transmittance: [0.0; 3],
-        diffuse_transmittance: [0.0; 3],
-        diffuse_map: None,
-        alpha_map: None,
-        normal_map: None,
-    };
     let manifest = Manifest {
         header: Manifest::header(provenance()),
         world_from_mesh_translation: [0.0; 3],
         camera: Camera { eye: [0.5, 0.5, 0.05], target: [0.5, 0.5, 1.0], up: [0.0, 1.0, 0.0], vertical_fov_deg: 60.0, width: 8, height: 6 },
-        materials: vec![material("wall", 0.5, 0.0), material("lamp", 0.0, 1.0)],
+        materials: vec![Material::diffuse("wall", [0.5; 3], [0.0; 3]), Material::diffuse("lamp", [0.0; 3], [1.0; 3])],
         objects: vec!["sides".into(), "floor and ceiling".into(), "ends".into()],
         goniometric_lights: vec![],
         effects: Effects { diffuse_interreflection: true, ..Effects::default() },
