@@ -49,7 +49,7 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 /// Master seed when `FUZZ_SEED` is not set.
-pub const DEFAULT_SEED: u64 = 0x5eed_0f_11;
+pub const DEFAULT_SEED: u64 = 0x5eed_0f11;
 
 /// Cases per target when `FUZZ_CASES` is not set: enough to find the
 /// panics issue 11 reports within seconds.
