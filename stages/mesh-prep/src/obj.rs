@@ -35,6 +35,13 @@ pub struct ObjObject {
     pub lines: Vec<usize>,
 }
 
+impl ObjObject {
+    /// An object without faces or material yet.
+    fn named(name: &str) -> Self {
+        ObjObject { name: name.to_string(), material: None, triangles: Vec::new(), lines: Vec::new() }
+    }
+}
+
 /// An OBJ file and the materials of its MTL libraries.
 #[derive(Debug, Clone)]
 pub struct ObjFile {
@@ -61,9 +68,8 @@ pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> 
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut positions = Vec::new();
     let mut materials: Vec<MtlMaterial> = Vec::new();
-    // Objects with the material name they use and the line that names it.
-    let mut objects: Vec<(ObjObject, Option<(String, usize)>)> = Vec::new();
-    let mut current = (ObjObject { name: "unnamed_object".into(), material: None, triangles: Vec::new(), lines: Vec::new() }, None);
+    let mut objects: Vec<Pending> = Vec::new();
+    let mut current: Pending = (ObjObject::named("unnamed_object"), None);
     for statement in statements(&text) {
         let (line, rest) = (statement.line, statement.rest.as_str());
         let error = |message: String| Error::parse(path, Some(line), message);
@@ -81,7 +87,7 @@ pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> 
             }
             "o" | "g" => {
                 let name = if rest.is_empty() { "unnamed_object" } else { rest };
-                let next = (ObjObject { name: name.into(), material: None, triangles: Vec::new(), lines: Vec::new() }, current.1.clone());
+                let next = (ObjObject::named(name), current.1.clone());
                 finish(&mut objects, &mut current, next);
             }
             "usemtl" => {
@@ -89,7 +95,7 @@ pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> 
                     return Err(error("usemtl needs a material name".into()));
                 }
                 if current.1.as_ref().map(|(name, _)| name.as_str()) != Some(rest) {
-                    let next = (ObjObject { name: current.0.name.clone(), material: None, triangles: Vec::new(), lines: Vec::new() }, Some((rest.to_string(), line)));
+                    let next = (ObjObject::named(&current.0.name), Some((rest.to_string(), line)));
                     finish(&mut objects, &mut current, next);
                 }
             }
