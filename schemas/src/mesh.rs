@@ -76,8 +76,9 @@ impl Mesh {
         write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![vertex, triangle] })
     }
 
-    /// Reads and validates `mesh.exr`: positions, areas and normals finite,
-    /// every vertex index in range. The material and object indices are
+    /// Reads and validates `mesh.exr`: at least one triangle (mesh-prep
+    /// refuses an empty scene), positions, areas and normals finite, every
+    /// vertex index in range. The material and object indices are
     /// checked against the manifest by [`Manifest::check_mesh`].
     pub fn read(path: &Path) -> Result<(Mesh, Input)> {
         let (artifact, input) = read_exr::<Mesh>(path)?;
@@ -86,6 +87,9 @@ impl Mesh {
         let (x, y, z) = (vertex.f32s(path, "P.X")?, vertex.f32s(path, "P.Y")?, vertex.f32s(path, "P.Z")?);
         let positions: Vec<[f32; 3]> = (0..vertex.len()).map(|i| [x[i], y[i], z[i]]).collect();
         let tri = artifact.layer(path, "triangle")?;
+        if tri.is_empty() {
+            return Err(Error::invalid(path, None, "layer 'triangle' holds no triangle"));
+        }
         check_finite(path, tri, "triangle", &["area", "N.X", "N.Y", "N.Z"])?;
         let v = [tri.u32s(path, "v0")?, tri.u32s(path, "v1")?, tri.u32s(path, "v2")?];
         let (material, object, area) = (tri.u32s(path, "material")?, tri.u32s(path, "object")?, tri.f32s(path, "area")?);
@@ -304,5 +308,30 @@ impl Manifest {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The message reading one triangle over three vertices gives, after
+    /// `edit`; it names the file.
+    fn refusal(name: &str, edit: impl FnOnce(&mut Mesh)) -> String {
+        let triangle = Triangle { vertices: [0, 1, 2], material: 0, object: 0, area: 0.5, normal: [0.0, 0.0, 1.0] };
+        let mut mesh = Mesh { header: Mesh::header(Provenance::in_memory("test")), positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], triangles: vec![triangle] };
+        edit(&mut mesh);
+        let path = std::env::temp_dir().join(format!("mesh-{name}-{}.exr", std::process::id()));
+        mesh.write(&path).unwrap();
+        let message = Mesh::read(&path).unwrap_err().to_string();
+        std::fs::remove_file(&path).unwrap();
+        message.strip_prefix(&format!("{}: ", path.display())).unwrap_or_else(|| panic!("{message}")).to_string()
+    }
+
+    #[test]
+    fn an_empty_mesh_a_vertex_out_of_range_and_a_nan_are_refused() {
+        assert_eq!(refusal("empty", |m| m.triangles.clear()), "layer 'triangle' holds no triangle");
+        assert_eq!(refusal("vertex", |m| m.triangles[0].vertices[2] = 3), "triangle 0: field v2 names vertex 3, but the mesh has 3");
+        assert_eq!(refusal("nan", |m| m.positions[1][1] = f32::NAN), "vertex 1: field P.Y is NaN");
     }
 }
