@@ -110,6 +110,18 @@ fn artifacts_of_different_runs_are_refused_naming_both_files() {
     let message = refused("hierarchical-solve", &args);
     let prefix = format!("hierarchical-solve: error: {}: does not belong with {} (SHA-256 ", s(&clusters_a), s(&b.join("mesh.exr")));
     assert!(message.starts_with(&prefix) && message.contains(&format!("it was made from {} (SHA-256", s(&mesh_a))), "{message}");
+    // A solution of the first pair, gathered over the second.
+    let coarse = ["--criterion", "absolute", "--eps", "1", "--min-area", "0.1", "--visibility-rays", "1", "--max-passes", "1"];
+    let mut solve = stage_args(&a, "solution.exr");
+    solve.extend(coarse.map(String::from));
+    run_ok("hierarchical-solve", &as_strs(&solve));
+    let mut gather = stage_args(&b, "image.exr");
+    let solution_a = a.join("solution.exr");
+    gather.extend(["--solution".into(), s(&solution_a).into()]);
+    let message = refused("grid-gather", &as_strs(&gather));
+    let prefix = format!("grid-gather: error: {}: does not belong with {} (SHA-256 ", s(&solution_a), s(&b.join("mesh.exr")));
+    assert!(message.starts_with(&prefix), "{message}");
+    assert!(!b.join("image.exr").exists());
 }
 
 /// Which run each of the pair in a killed run's directory comes from.
