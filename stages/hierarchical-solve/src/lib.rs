@@ -293,7 +293,12 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
     let largest_source = (0..n as u32).flat_map(|e| h.source(e)).fold(0.0, f64::max);
     let threshold = params.eps * largest_source;
     if !lights.is_empty() {
-        work.luminaire_rays += luminaires::refine(&mut h, &direct, threshold, min_area, params.quadrature_depth);
+        // The direct light is known before any solve, so the relative
+        // criterion can judge it from the start.
+        let mut sources: Vec<[f64; 3]> = vec![[0.0; 3]; h.cluster_count()];
+        sources.extend((0..n as u32).map(|e| h.source(e)));
+        let allowance = allowance(params, threshold, Some(mean_reflected(&h, &sources)));
+        work.luminaire_rays += luminaires::refine(&mut h, &direct, &allowance, min_area, params.quadrature_depth);
     }
     work.luminaire_seconds += started.elapsed().as_secs_f64();
     let mut b: Vec<[f64; 3]> = vec![[0.0; 3]; h.cluster_count()];
@@ -322,17 +327,8 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         let started = Instant::now();
         let mut refined_any = false;
         progress(&Progress { pass, phase: Phase::Refining, links: all_links.len(), elements: h.elements.len() });
-        let allowance = match params.criterion {
-            // Before the first solve no receiver's radiosity is known.
-            Criterion::Relative if pass > 1 => {
-                let mean = mean_reflected(&h, &b);
-                // Unset: the absolute threshold at a receiver of
-                // RELATIVE_AT times the mean reflected radiosity.
-                let eps = params.eps_relative.unwrap_or(if mean > 0.0 { threshold / (RELATIVE_AT * mean) } else { params.eps });
-                Allowance::Relative { eps, floor: params.relative_floor * mean }
-            }
-            _ => Allowance::Absolute(threshold),
-        };
+        // Before the first solve no receiver's radiosity is known.
+        let allowance = allowance(params, threshold, (pass > 1).then(|| mean_reflected(&h, &b)));
         // The relative criterion sees a sender's variation at every level
         // below it; the absolute one only at its children, as before.
         let deviation = match allowance {
@@ -418,6 +414,22 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         .map(|c| solution::ClusterRadiosity { area: h.area(Node::Cluster(c as u32)) as f32, radiosity: f32x3(b[c]) })
         .collect();
     Ok(Solved { elements: output_elements(&h, &b), clusters: clusters_out, links: output_links(&h, &all_links, &b), work })
+}
+
+/// What a refinement may err by, given the absolute `threshold` and, once
+/// a radiosity is known, the scene's mean reflected radiosity `mean`
+/// ([`mean_reflected`]): the relative criterion's allowance where it is
+/// chosen and `mean` is known, otherwise the absolute one.
+fn allowance(params: &Params, threshold: f64, mean: Option<f64>) -> Allowance {
+    match (params.criterion, mean) {
+        (Criterion::Relative, Some(mean)) => {
+            // Unset: the absolute threshold at a receiver of RELATIVE_AT
+            // times the mean reflected radiosity.
+            let eps = params.eps_relative.unwrap_or(if mean > 0.0 { threshold / (RELATIVE_AT * mean) } else { params.eps });
+            Allowance::Relative { eps, floor: params.relative_floor * mean }
+        }
+        _ => Allowance::Absolute(threshold),
+    }
 }
 
 /// The area-mean over the input triangles of each one's brightest channel

@@ -92,12 +92,14 @@ pub enum Allowance {
 impl Allowance {
     /// The error (W/m², any channel) the link may make on `receiver`.
     pub fn of(&self, receiver: Node, radiosity: &[[f64; 3]], h: &Hierarchy) -> f64 {
+        self.at(radiosity[h.flat(receiver)])
+    }
+
+    /// The error (W/m², any channel) allowed on a receiver of radiosity `b`.
+    pub fn at(&self, b: [f64; 3]) -> f64 {
         match *self {
             Allowance::Absolute(threshold) => threshold,
-            Allowance::Relative { eps, floor } => {
-                let b = radiosity[h.flat(receiver)];
-                eps * b.into_iter().fold(floor, f64::max)
-            }
+            Allowance::Relative { eps, floor } => eps * b.into_iter().fold(floor, f64::max),
         }
     }
 }

@@ -17,13 +17,20 @@
 //!
 //! Elements are refined for the direct light before the links are
 //! ([`refine`]): an element splits while replacing its four children's
-//! `rho D` by its own would err by more than the solver's absolute
-//! threshold (`max_c rho_c max_k |D_k - D_e| > eps B_max`, the BF oracle's
-//! test for a link from the light), down to `min_area`, so the solution
-//! follows the light's pool and its shadows. Elements the links create
-//! later get their `D_e` when they appear ([`extend`]).
+//! `rho D` by its own would err by more than the links may
+//! (`max_c rho_c max_k |D_k - D_e|` against the solver's [`Allowance`]: the
+//! relative criterion's share of the element's own source `E + rho D`,
+//! known here before any solve, or the absolute threshold `eps B_max`),
+//! down to `min_area`, so the solution follows the light's pool and its
+//! shadows. Elements the links create later get their `D_e` when they
+//! appear ([`extend`]). Under a point light `D` falls off as `cos^2 /
+//! r^2` everywhere, so a piecewise-constant element within a 1% share of
+//! its own radiosity is small: on a 2 m room lit by one luminaire at
+//! `make`'s defaults every lit element is refined to `min_area` (3,712
+//! leaves of 28 triangles) by either criterion.
 
 use crate::elements::Hierarchy;
+use crate::links::Allowance;
 use radiometry::photometry::DirectLight;
 use radiometry::subdivision::children;
 use rayon::prelude::*;
@@ -62,7 +69,7 @@ pub fn extend(h: &mut Hierarchy, light: &DirectLight, depth: u32) -> u64 {
 /// splits made in element order, so element indices do not depend on
 /// threads. Every element must have its `D` ([`extend`]) before. Returns
 /// the rays cast.
-pub fn refine(h: &mut Hierarchy, light: &DirectLight, threshold: f64, min_area: f64, depth: u32) -> u64 {
+pub fn refine(h: &mut Hierarchy, light: &DirectLight, allowance: &Allowance, min_area: f64, depth: u32) -> u64 {
     let mut rays = 0;
     let reflects = |h: &Hierarchy, e: u32| h.reflectance_of(e).into_iter().fold(0.0, f64::max);
     let mut frontier: Vec<u32> = (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf()).collect();
@@ -74,7 +81,7 @@ pub fn refine(h: &mut Hierarchy, light: &DirectLight, threshold: f64, min_area: 
             rays += cast;
             let parent = h.direct[e as usize];
             let error = reflects(h, e) * d.iter().map(|x| (x - parent).abs()).fold(0.0, f64::max);
-            if error > threshold {
+            if error > allowance.at(h.source(e)) {
                 let first = h.subdivide(e);
                 h.direct.extend(d);
                 next.extend(first..first + 4);
