@@ -3,6 +3,7 @@
 //! the fixtures of tests that corrupt them.
 
 use schemas::cluster::{ClusterNode, Clusters};
+use schemas::exr_io::{Channel, ExrArtifact, Layer, Samples};
 use schemas::header::{Provenance, Schema};
 use schemas::image::{HdrImage, PixelSurfaces, EMITTER, NO_SURFACE, SINGLE_SURFACE};
 use schemas::lightmap::{Lightmap, Region};
@@ -149,58 +150,48 @@ pub fn image() -> HdrImage {
     }
 }
 
-/// Fields of a cluster node, in the order of [`cluster_words`].
-const CLUSTER_FIELDS: usize = 19;
-
-/// Every field of `clusters`' nodes as a little-endian word (`f32` as its
-/// bits), node after node, indices first (`parent`, `first_child`,
-/// `child_count`, `first_triangle`, `triangle_count`), then bounds, area,
-/// reflectance, cone axis and cosine: what a structural fuzz target
-/// mutates.
-pub fn cluster_words(clusters: &Clusters) -> Vec<u8> {
-    clusters
-        .nodes
-        .iter()
-        .flat_map(|n| {
-            let (b, r, a) = (n.bounds_min, n.reflectance_area, n.normal_axis);
-            let floats = [b[0], b[1], b[2], n.bounds_max[0], n.bounds_max[1], n.bounds_max[2], n.area, r[0], r[1], r[2], a[0], a[1], a[2], n.normal_cos];
-            let words: [u32; CLUSTER_FIELDS] = std::array::from_fn(|k| match k {
-                0 => n.parent,
-                1 => n.first_child,
-                2 => n.child_count,
-                3 => n.first_triangle,
-                4 => n.triangle_count,
-                _ => floats[k - 5].to_bits(),
-            });
-            words
+/// Every sample of the table layer `layer`, record after record, each
+/// channel's as a little-endian word (`f32` as its bits): what a
+/// structural fuzz target mutates.
+pub fn table_words(layer: &Layer) -> Vec<u8> {
+    (0..layer.len())
+        .flat_map(|i| {
+            layer.channels.iter().map(move |c| match &c.samples {
+                Samples::F32(v) => v[i].to_bits(),
+                Samples::U32(v) => v[i],
+            })
         })
         .flat_map(u32::to_le_bytes)
         .collect()
 }
 
-/// `clusters` with its nodes read from `words` (as [`cluster_words`]
-/// writes them): one node per whole record, so mutants may have more or
-/// fewer nodes.
-pub fn with_cluster_words(clusters: &Clusters, words: &[u8]) -> Clusters {
-    let nodes = words
-        .chunks_exact(4 * CLUSTER_FIELDS)
-        .map(|record| {
-            let u = |k: usize| u32::from_le_bytes([record[4 * k], record[4 * k + 1], record[4 * k + 2], record[4 * k + 3]]);
-            let f = |k: usize| f32::from_bits(u(k));
-            ClusterNode {
-                parent: u(0),
-                first_child: u(1),
-                child_count: u(2),
-                first_triangle: u(3),
-                triangle_count: u(4),
-                bounds_min: [f(5), f(6), f(7)],
-                bounds_max: [f(8), f(9), f(10)],
-                area: f(11),
-                reflectance_area: [f(12), f(13), f(14)],
-                normal_axis: [f(15), f(16), f(17)],
-                normal_cos: f(18),
-            }
+/// `layer` with its records read from `words` (as [`table_words`] writes
+/// them): one record per whole group of words, so a mutant may have more
+/// or fewer records than `layer`.
+pub fn with_table_words(layer: &Layer, words: &[u8]) -> Layer {
+    let width = layer.channels.len().max(1);
+    let values: Vec<u32> = words.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
+    let records = values.len() / width;
+    let values = &values;
+    let column = |k: usize| (0..records).map(move |i| values[i * width + k]);
+    let channels = layer
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(k, c)| Channel {
+            samples: match c.samples {
+                Samples::F32(_) => Samples::F32(column(k).map(f32::from_bits).collect()),
+                Samples::U32(_) => Samples::U32(column(k).collect()),
+            },
+            ..c.clone()
         })
         .collect();
-    Clusters { nodes, ..clusters.clone() }
+    Layer::table(&layer.name, records, channels)
+}
+
+/// `artifact` with its table layer `name` replaced by the records of
+/// `words` (see [`with_table_words`]).
+pub fn with_layer_words(artifact: &ExrArtifact, name: &str, words: &[u8]) -> ExrArtifact {
+    let layers = artifact.layers.iter().map(|l| if l.name == name { with_table_words(l, words) } else { l.clone() }).collect();
+    ExrArtifact { layers, ..artifact.clone() }
 }

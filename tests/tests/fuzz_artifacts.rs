@@ -1,14 +1,18 @@
 //! Fuzz targets for the pipeline's own artifacts (issue 11): every EXR
 //! kind (mesh, clusters, solution, lightmap, image) and `manifest.ron`,
 //! each mutated byte by byte from a valid file the `schemas` writers made,
-//! and read back by the reader every stage uses. Any answer is fine; a
-//! panic or a hang fails, naming the case (see `end_to_end::fuzz`). The
-//! hierarchy's own fields are fuzzed, with the solver walking it, in
-//! hierarchical-solve's tests.
+//! and read back by the reader every stage uses; and the records of every
+//! table layer mutated as words (`fuzz_*_tables`), which reach the
+//! structural checks that byte mutations of a compressed file rarely do.
+//! Any answer is fine; a panic or a hang fails, naming the case (see
+//! `end_to_end::fuzz`). The cluster hierarchy is fuzzed with the solver
+//! walking it in hierarchical-solve's tests.
 
-use end_to_end::artifacts::{closed_box, clusters_over, image, lightmap, solution};
+use end_to_end::artifacts::{closed_box, clusters_over, image, lightmap, solution, table_words, with_layer_words};
 use end_to_end::fuzz::{fuzz, Kind};
 use schemas::cluster::Clusters;
+use schemas::exr_io::{read_exr, write_exr};
+use schemas::header::Schema;
 use schemas::image::HdrImage;
 use schemas::lightmap::Lightmap;
 use schemas::mesh::{Manifest, Mesh};
@@ -91,5 +95,59 @@ fn fuzz_image_exr() {
     let image = image();
     fuzz_file("image.exr", &written("exr", |p| image.write(p)), Kind::Binary, "exr", |path| {
         let _ = HdrImage::read_any(path);
+    });
+}
+
+/// Fuzzes `read` on artifacts of schema `S` whose table layers `layers`
+/// are, one at a time, replaced by mutants of their records; `write`
+/// writes the valid artifact the mutants start from.
+fn fuzz_tables<S: Schema>(target: &str, layers: &[&'static str], write: impl FnOnce(&Path) -> schemas::Result<()>, read: fn(&Path)) {
+    let seed = case_path("exr");
+    write(&seed).unwrap();
+    let (artifact, _) = read_exr::<S>(&seed).unwrap();
+    std::fs::remove_file(&seed).unwrap();
+    for &layer in layers {
+        let words = table_words(artifact.layer(&seed, layer).unwrap());
+        let artifact = artifact.clone();
+        fuzz(&format!("{target} layer {layer}"), &[&words], Kind::Binary, move |bytes| {
+            let path = case_path("exr");
+            write_exr(&path, &with_layer_words(&artifact, layer, bytes)).unwrap();
+            read(&path);
+            let _ = std::fs::remove_file(&path);
+        });
+    }
+}
+
+#[test]
+fn fuzz_mesh_tables() {
+    let (mesh, _) = closed_box();
+    fuzz_tables::<Mesh>("mesh.exr", &["vertex", "triangle"], |p| mesh.write(p), |path| {
+        if let Ok((mesh, _)) = Mesh::read(path) {
+            let _ = closed_box().1.check_mesh(path, &mesh);
+        }
+    });
+}
+
+#[test]
+fn fuzz_clusters_tables() {
+    let clusters = clusters_over(&closed_box().0);
+    fuzz_tables::<Clusters>("clusters.exr", &["cluster", "order"], |p| clusters.write(p), |path| {
+        let _ = Clusters::read(path, 12);
+    });
+}
+
+#[test]
+fn fuzz_solution_tables() {
+    let solution = solution(&closed_box().0);
+    fuzz_tables::<Solution>("solution.exr", &["element", "cluster", "link"], |p| solution.write(p), |path| {
+        let _ = Solution::read(path);
+    });
+}
+
+#[test]
+fn fuzz_lightmap_tables() {
+    let lightmap = lightmap(&closed_box().0);
+    fuzz_tables::<Lightmap>("lightmap.exr", &["region"], |p| lightmap.write(p), |path| {
+        let _ = Lightmap::read(path);
     });
 }
