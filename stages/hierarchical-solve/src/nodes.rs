@@ -29,6 +29,11 @@ pub struct ClusterTree {
 
 impl ClusterTree {
     /// Prepares `clusters` over triangles with these areas and reflectances.
+    /// `clusters` must hold the invariants [`Clusters::read`] checks (a
+    /// tree below the root, every cluster non-empty with its range inside
+    /// `order`, `order` each triangle once): this indexes without checks
+    /// of its own, and the link refinement descends the tree trusting that
+    /// it ends.
     pub fn new(clusters: Clusters, triangle_area: &[f64], triangle_reflectance: &[[f64; 3]]) -> Self {
         let mut cumulative = Vec::with_capacity(clusters.order.len() + 1);
         cumulative.push(0.0);
