@@ -7,17 +7,7 @@ use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, T
 
 /// A material with reflectance `rho` and emitted exitance `emission` W/m².
 pub fn material(rho: [f64; 3], emission: [f64; 3]) -> Material {
-    Material {
-        name: "m".into(),
-        diffuse: rho,
-        emission,
-        specular_reflectance: [0.0; 3],
-        specular_transmittance: [0.0; 3],
-        diffuse_transmittance: [0.0; 3],
-        diffuse_map: None,
-        alpha_map: None,
-        normal_map: None,
-    }
+    Material::diffuse("m", rho, emission)
 }
 
 /// A manifest with `objects` objects and these materials.

@@ -8,17 +8,7 @@ use std::f64::consts::PI;
 
 /// The material of an OBJ object without `usemtl`: grey, diffuse.
 pub fn default_material() -> Material {
-    Material {
-        name: "default".into(),
-        diffuse: [0.5; 3],
-        emission: [0.0; 3],
-        specular_reflectance: [0.0; 3],
-        specular_transmittance: [0.0; 3],
-        diffuse_transmittance: [0.0; 3],
-        diffuse_map: None,
-        alpha_map: None,
-        normal_map: None,
-    }
+    Material::diffuse("default", [0.5; 3], [0.0; 3])
 }
 
 /// The pipeline's material for an MTL entry.
