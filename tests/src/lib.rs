@@ -53,6 +53,20 @@ pub fn refused(name: &str, args: &[&str]) -> String {
     stderr
 }
 
+/// Whether a gpu-shoot run failed for want of a Vulkan adapter: then the
+/// test `test` is skipped, loudly, except under CI (the environment
+/// variable `CI` set), where it fails. Any other failure fails the test.
+pub fn skipped_without_gpu(out: &Output, test: &str) -> bool {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() && stderr.contains("no GPU adapter") {
+        assert!(std::env::var_os("CI").is_none(), "CI has no Vulkan adapter for gpu-shoot: {stderr}");
+        eprintln!("\n*** SKIPPED {test}: {stderr} ***\n");
+        return true;
+    }
+    assert!(out.status.success(), "gpu-shoot failed:\n{stderr}");
+    false
+}
+
 /// Path as `&str` (test paths are UTF-8).
 pub fn s(path: &Path) -> &str {
     path.to_str().expect("UTF-8 path")

@@ -196,21 +196,40 @@ fn straddling_sender(clustered: bool) {
     let lamp = [[-0.7, -0.5, 1.5], [1.3, -0.5, 1.5], [1.3, 1.5, 1.5], [-0.7, 1.5, 1.5]];
     let (r_origin, r_normal) = ([0.0; 3], [1.0, 0.0, 0.0]);
     let front = clip_to_front(&lamp, r_origin, r_normal);
-    let (mut checked, mut worst, mut sum_sq) = (0, 0.0f64, 0.0);
+    let mut errors = LeafErrors::default();
     for (object, _, b, i) in solved.leaves() {
         if object != "R" {
             continue;
         }
         let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
         let exact = mean_over_triangle(&corners, 2, &|x| lambert_polygon(x, r_normal, &front));
-        let error = (b / (rho * emission) - exact) / exact;
-        worst = worst.max(error.abs());
-        sum_sq += error * error;
-        checked += 1;
+        errors.add((b / (rho * emission) - exact) / exact);
     }
-    eprintln!("straddling, clustered {clustered}: {checked} leaves of R, largest relative error {worst:.2e}, rms {:.2e}", (sum_sq / f64::from(checked)).sqrt());
+    let (checked, worst) = (errors.checked, errors.worst);
+    eprintln!("straddling, clustered {clustered}: {checked} leaves of R, largest relative error {worst:.2e}, rms {:.2e}", errors.rms());
     assert!(checked >= 8, "only {checked} leaves on R");
     assert!(worst <= 0.005, "clustered {clustered}: a leaf of R is {worst:.2e} off Lambert's formula for the emitter's part in front");
+}
+
+/// Relative errors of leaves against a closed form: how many, the
+/// largest in magnitude, and their root mean square.
+#[derive(Default)]
+struct LeafErrors {
+    checked: u32,
+    worst: f64,
+    sum_sq: f64,
+}
+
+impl LeafErrors {
+    fn add(&mut self, error: f64) {
+        self.worst = self.worst.max(error.abs());
+        self.sum_sq += error * error;
+        self.checked += 1;
+    }
+
+    fn rms(&self) -> f64 {
+        (self.sum_sq / f64::from(self.checked.max(1))).sqrt()
+    }
 }
 
 /// The mean of `f` over a triangle: its centroids after `levels` midpoint
@@ -556,16 +575,14 @@ fn luminaire_gives_every_floor_leaf_i_cos_over_d_squared() {
         let cos = -d[2] / r; // both the receiver's cosine and cos(gamma)
         intensity(cos.acos().to_degrees()) / 683.0 * cos / (r * r)
     };
-    let (mut checked, mut worst, mut sum_sq) = (0, 0.0f64, 0.0);
+    let mut errors = LeafErrors::default();
     for (_, _, b, i) in solved.leaves() {
         let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
         let exact = rho * mean_over_triangle(&corners, 4, &irradiance);
-        let error = (b - exact) / exact;
-        worst = worst.max(error.abs());
-        sum_sq += error * error;
-        checked += 1;
+        errors.add((b - exact) / exact);
     }
-    eprintln!("luminaire over a floor: {checked} leaves, largest relative error {worst:.2e}, rms {:.2e}", (sum_sq / f64::from(checked)).sqrt());
+    let (checked, worst) = (errors.checked, errors.worst);
+    eprintln!("luminaire over a floor: {checked} leaves, largest relative error {worst:.2e}, rms {:.2e}", errors.rms());
     assert!(checked >= 16, "only {checked} floor leaves: the direct light was not refined");
     assert!(worst <= 0.01, "a floor leaf is {worst:.2e} off I cos(theta) / d^2");
 }
