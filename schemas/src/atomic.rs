@@ -4,11 +4,46 @@
 //! [`Staged`] is the first half alone: a complete file beside its target,
 //! put in place by [`Staged::commit`]. A stage with several outputs stages
 //! them all and commits them together (see [`crate::stage::Outputs`]).
+//!
+//! Every temporary file is removed on every path that can be caught: an
+//! error or a panic (by [`Staged`]'s `Drop`), and an interrupt (SIGINT,
+//! SIGTERM, SIGHUP: by [`remove_temporaries_on_interrupt`]'s handler).
+//! Only SIGKILL, or a machine's crash, can leave one, hidden
+//! (`.NAME.PID.tmp`) beside its target.
 
 use crate::error::{Error, Result};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
+
+/// The temporary files of this process not yet committed or removed: what
+/// the interrupt handler removes.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// [`PENDING`], usable even after a panic while it was held (a list of
+/// paths cannot be left inconsistent).
+fn pending() -> MutexGuard<'static, Vec<PathBuf>> {
+    PENDING.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// From now on, SIGINT, SIGTERM and SIGHUP remove this process's
+/// temporary files, then end it with exit code 128 + the signal's number,
+/// as the default action would have (the shell's convention), so that an
+/// interrupted `make` leaves nothing hidden behind. Should the handler not
+/// install, the default actions stay.
+pub fn remove_temporaries_on_interrupt() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else { return };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            for path in pending().drain(..) {
+                let _ = std::fs::remove_file(path);
+            }
+            std::process::exit(128 + signal);
+        }
+    });
+}
 
 /// The temporary path beside `target`: same directory (so the rename stays on
 /// one file system), hidden, and tagged with the process id so two runs never
@@ -37,7 +72,7 @@ impl Staged {
     where
         F: FnOnce(&mut BufWriter<File>) -> Result<()>,
     {
-        let staged = Staged { temporary: temporary_beside(target), target: target.to_path_buf(), committed: false };
+        let staged = Staged::beside(target);
         let file = File::create(&staged.temporary).map_err(|e| Error::io(target, e))?;
         let mut writer = BufWriter::new(file);
         fill(&mut writer)?;
@@ -52,9 +87,17 @@ impl Staged {
     /// error names `target`, not the temporary file, and removes the
     /// temporary file.
     pub fn written_by(target: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<Staged> {
-        let staged = Staged { temporary: temporary_beside(target), target: target.to_path_buf(), committed: false };
+        let staged = Staged::beside(target);
         write(&staged.temporary).map_err(|e| renamed(e, &staged.temporary, target))?;
         Ok(staged)
+    }
+
+    /// A temporary file for `target`, not yet created, registered for
+    /// removal on interrupt.
+    fn beside(target: &Path) -> Staged {
+        let temporary = temporary_beside(target);
+        pending().push(temporary.clone());
+        Staged { temporary, target: target.to_path_buf(), committed: false }
     }
 
     /// The file's final path.
@@ -65,7 +108,18 @@ impl Staged {
     /// Puts the file in place: renames it over its target (atomic on one
     /// file system). On failure the temporary file is removed.
     pub fn commit(mut self) -> Result<()> {
-        std::fs::rename(&self.temporary, &self.target).map_err(|e| Error::io(&self.target, e))?;
+        // The list is held across the rename, so that an interrupt removes
+        // the temporary file before it or nothing after it, never a file
+        // just renamed.
+        let renamed = {
+            let mut pending = pending();
+            let renamed = std::fs::rename(&self.temporary, &self.target);
+            if renamed.is_ok() {
+                pending.retain(|p| *p != self.temporary);
+            }
+            renamed
+        };
+        renamed.map_err(|e| Error::io(&self.target, e))?;
         self.committed = true;
         Ok(())
     }
@@ -75,6 +129,7 @@ impl Drop for Staged {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_file(&self.temporary);
+            pending().retain(|p| *p != self.temporary);
         }
     }
 }

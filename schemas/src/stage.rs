@@ -41,14 +41,20 @@ pub struct Run {
 }
 
 impl Run {
-    /// Starts the clock for `stage` at crate `version`, and makes a write
-    /// over a file-size limit (`ulimit -f`) an error instead of a kill:
-    /// SIGXFSZ, whose default action ends the process before any cleanup,
-    /// gets a handler that does nothing, so the write returns EFBIG and the
-    /// run ends in its normal error path, which removes its temporary files.
+    /// Starts the clock for `stage` at crate `version`, and makes sure no
+    /// temporary file outlives the run where that can be helped: a write
+    /// over a file-size limit (`ulimit -f`) becomes an error instead of a
+    /// kill (SIGXFSZ, whose default action ends the process before any
+    /// cleanup, gets a handler that does nothing, so the write returns
+    /// EFBIG and the run ends in its normal error path), and an interrupt
+    /// removes them (see [`crate::atomic::remove_temporaries_on_interrupt`]).
     pub fn start(stage: &'static str, version: &'static str) -> Self {
-        // Failing to install the handler only keeps the default action.
-        let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, std::sync::Arc::default());
+        static HANDLERS: std::sync::Once = std::sync::Once::new();
+        HANDLERS.call_once(|| {
+            // Failing to install the handler only keeps the default action.
+            let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, std::sync::Arc::default());
+            crate::atomic::remove_temporaries_on_interrupt();
+        });
         Run { stage, version, started: Instant::now(), inputs: Vec::new() }
     }
 
@@ -212,18 +218,20 @@ pub fn check_writable(path: &Path) -> Result<()> {
     std::fs::remove_file(&probe).map_err(|e| Error::io(path, e))
 }
 
-/// The environment variable that makes [`Outputs::keep`] abort the process
-/// (no cleanup, as a kill) after putting this many outputs in place: a
-/// test-only hook for the kill tests, which stop a stage between two of
-/// its renames. Unset in normal runs.
-pub const ABORT_AFTER_COMMITS: &str = "PIPELINE_TEST_ABORT_AFTER_COMMITS";
+/// The environment variable that makes [`Outputs::keep`] pause for a
+/// minute after putting this many outputs in place, saying so on stderr
+/// (`paused after N renames`): a test-only hook for the kill and interrupt
+/// tests, which signal a stage between two of its renames. Unset in
+/// normal runs.
+pub const PAUSE_AFTER_COMMITS: &str = "PIPELINE_TEST_PAUSE_AFTER_COMMITS";
 
 /// The outputs of one run, one unit: each is written completely beside its
 /// target first ([`Outputs::write`]), and only when all are written does
 /// [`Outputs::keep`] rename them into place, in the order written. A run
 /// that fails, or panics, before that leaves every old output as it was
-/// and no temporary file; a kill while writing leaves the old outputs (and
-/// at worst a hidden `.NAME.PID.tmp` file); a kill between two renames
+/// and no temporary file; an interrupt (SIGINT, SIGTERM) the same; a
+/// SIGKILL while writing leaves the old outputs (and at worst a hidden
+/// `.NAME.PID.tmp` file); a kill between two renames
 /// leaves a mixed set, which the next stage refuses because the outputs'
 /// provenance differs (see [`read_prepared`]).
 #[derive(Default)]
@@ -249,11 +257,12 @@ impl Outputs {
     /// the outputs already renamed are removed again, so that `make` sees
     /// none of this run's outputs, and the error names the file.
     pub fn keep(self) -> Result<()> {
-        let abort_after = std::env::var(ABORT_AFTER_COMMITS).ok().and_then(|n| n.parse::<usize>().ok());
+        let pause_after = std::env::var(PAUSE_AFTER_COMMITS).ok().and_then(|n| n.parse::<usize>().ok());
         let mut placed: Vec<std::path::PathBuf> = Vec::new();
         for staged in self.staged {
-            if abort_after == Some(placed.len()) {
-                std::process::abort();
+            if pause_after == Some(placed.len()) {
+                eprintln!("paused after {} renames ({PAUSE_AFTER_COMMITS})", placed.len());
+                std::thread::sleep(std::time::Duration::from_secs(60));
             }
             let target = staged.target().to_path_buf();
             if let Err(e) = staged.commit() {

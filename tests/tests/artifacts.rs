@@ -6,7 +6,8 @@
 
 use end_to_end::{bin, refused, run_ok, s, scratch};
 use schemas::cluster::Clusters;
-use schemas::stage::ABORT_AFTER_COMMITS;
+use schemas::stage::PAUSE_AFTER_COMMITS;
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -186,17 +187,50 @@ impl KillTest {
     }
 }
 
+impl KillTest {
+    /// Runs the new mesh-prep over the old pair, waits until the test hook
+    /// has it pause after `renames` renames, sends it `signal` (`KILL`,
+    /// `INT`, `TERM`) and returns its exit code (`None` when killed).
+    fn stop_after(&self, scene: &str, renames: usize, signal: &str) -> Option<i32> {
+        self.restore();
+        let mut child = mesh_prep(&self.dir, scene, &[])
+            .env(PAUSE_AFTER_COMMITS, renames.to_string())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+        let mut line = String::new();
+        while !line.contains("paused after") {
+            line.clear();
+            assert!(stderr.read_line(&mut line).unwrap() > 0, "mesh-prep ended without pausing after {renames} renames");
+        }
+        let sent = Command::new("kill").args([format!("-{signal}"), child.id().to_string()]).status().unwrap();
+        assert!(sent.success());
+        child.wait().unwrap().code()
+    }
+}
+
 #[test]
 fn a_kill_between_the_renames_leaves_a_pair_the_next_stage_can_trust() {
     let test = KillTest::new("artifacts_kill_hook", "cornell-box", "cornell-box-2k");
     // The outputs are renamed in the order written: mesh, manifest, report.
     for (renames, expected) in [(0, Pair::Old), (1, Pair::Mixed), (2, Pair::New)] {
-        test.restore();
-        let out = mesh_prep(&test.dir, "cornell-box-2k", &[]).env(ABORT_AFTER_COMMITS, renames.to_string()).output().unwrap();
-        assert!(!out.status.success(), "the hook aborts after {renames} renames");
+        assert_eq!(test.stop_after("cornell-box-2k", renames, "KILL"), None);
         assert_eq!(test.pair(), expected, "after {renames} renames");
         let clustered = Command::new(bin("cluster")).args(cluster_args(&test.dir)).output().unwrap();
         assert_eq!(clustered.status.success(), expected != Pair::Mixed, "cluster on the pair left after {renames} renames");
+    }
+}
+
+#[test]
+fn an_interrupt_between_the_renames_removes_every_temporary_file() {
+    let test = KillTest::new("artifacts_interrupt", "cornell-box", "cornell-box-2k");
+    // Before the first rename all three outputs are staged; after the first,
+    // two. Exit code 128 + the signal, as the shell reports one.
+    for (renames, signal, code, expected) in [(0, "INT", 130, Pair::Old), (1, "TERM", 143, Pair::Mixed)] {
+        assert_eq!(test.stop_after("cornell-box-2k", renames, signal), Some(code), "SIG{signal} after {renames} renames");
+        assert_eq!(everything(&test.dir), ["manifest.ron", "mesh.exr"], "no temporary file left");
+        assert_eq!(test.pair(), expected);
     }
 }
 
