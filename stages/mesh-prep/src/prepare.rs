@@ -192,7 +192,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
                 raw.push(RawTriangle { corners: [c, c + u + v, c + v], material, object });
             }
             Light::Goniometric { file, position, nadir, scale } => {
-                goniometric_lights.push(crate::photometry::read_light(source, scene_path, base, k, file, *position, *nadir, *scale)?);
+                goniometric_lights.push(crate::photometry::read_light(source, scene_path, k, file, *position, *nadir, *scale)?);
             }
         }
     }

@@ -140,13 +140,14 @@ pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
 }
 
 /// A scene's `Goniometric` light `k` as manifest data, position still in
-/// the world frame: reads `base/file` through `source` (which records it
+/// the world frame: reads `file` (relative to the scene file's folder)
+/// through `source` (which records it
 /// as an input), validates the placement (`scale` finite and > 0,
 /// `position` finite, `nadir` finite and non-zero: errors name the scene
 /// file and the field) and the file (errors name it and its line), and
 /// records the C0 direction the solvers use: the mesh-frame x axis made
 /// perpendicular to the nadir ([`frame_with_normal`]; the scene gives none).
-pub fn read_light(source: &dyn TextSource, scene_path: &Path, base: &Path, k: usize, file: &str, position: [f64; 3], nadir: [f64; 3], scale: f64) -> Result<GoniometricLight, Error> {
+pub fn read_light(source: &dyn TextSource, scene_path: &Path, k: usize, file: &str, position: [f64; 3], nadir: [f64; 3], scale: f64) -> Result<GoniometricLight, Error> {
     let field = |name: &str, message: String| Error::invalid(scene_path, None, format!("lights[{k}] (Goniometric '{file}'): {name}: {message}"));
     if !(scale.is_finite() && scale > 0.0) {
         return Err(field("scale", format!("{scale} must be finite and > 0")));
@@ -156,7 +157,7 @@ pub fn read_light(source: &dyn TextSource, scene_path: &Path, base: &Path, k: us
     }
     let n0 = DVec3::from(nadir);
     let n0 = n0.is_finite().then(|| n0.try_normalize()).flatten().ok_or_else(|| field("nadir", format!("{nadir:?} must be finite and non-zero")))?;
-    let path = base.join(file);
+    let path = scene_path.parent().unwrap_or(Path::new("")).join(file);
     if !source.exists(&path) {
         return Err(field("file", format!("photometric file '{}' does not exist", path.display())));
     }
