@@ -200,3 +200,20 @@ fn fuzz_ldt() {
 fn fuzz_ies() {
     fuzz_photometry("ies", "ies");
 }
+
+/// A manifest whose luminaire table was edited by hand (a negative
+/// intensity) is refused by every stage that lights the scene, with one
+/// line naming the manifest and the light: no stage trusts the table
+/// unchecked, although only mesh-prep reads photometric files.
+#[test]
+fn an_edited_luminaire_table_is_refused_by_every_solver() {
+    let (dir, mesh, manifest) = prepared_room("luminaire_edited_table");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, text.replacen("intensity_cd: [\n        1000.0,", "intensity_cd: [\n        -1000.0,", 1)).unwrap();
+    let solution = dir.join("solution.exr");
+    let line = refused("hierarchical-solve", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution)]);
+    assert!(line.contains("manifest.ron") && line.contains("goniometric light 0") && line.contains("intensity"), "{line}");
+    assert!(!solution.exists());
+    let line = refused("gpu-shoot", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution)]);
+    assert!(line.contains("manifest.ron") && line.contains("goniometric light 0"), "{line}");
+}
