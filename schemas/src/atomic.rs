@@ -37,7 +37,10 @@ pub fn remove_temporaries_on_interrupt() {
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else { return };
     std::thread::spawn(move || {
         if let Some(signal) = signals.forever().next() {
-            for path in pending().drain(..) {
+            // Held until the exit: no temporary file is created or renamed
+            // after these are removed (creations and renames take the list).
+            let mut listed = pending();
+            for path in listed.drain(..) {
                 let _ = std::fs::remove_file(path);
             }
             std::process::exit(128 + signal);
@@ -73,7 +76,11 @@ impl Staged {
         F: FnOnce(&mut BufWriter<File>) -> Result<()>,
     {
         let staged = Staged::beside(target);
-        let file = File::create(&staged.temporary).map_err(|e| Error::io(target, e))?;
+        let file = {
+            let _listed = pending();
+            File::create(&staged.temporary)
+        };
+        let file = file.map_err(|e| Error::io(target, e))?;
         let mut writer = BufWriter::new(file);
         fill(&mut writer)?;
         let file = writer.into_inner().map_err(|e| Error::io(target, e.into_error()))?;
