@@ -204,7 +204,8 @@ impl KillTest {
             line.clear();
             assert!(stderr.read_line(&mut line).unwrap() > 0, "mesh-prep ended without pausing after {renames} renames");
         }
-        let sent = Command::new("kill").args([format!("-{signal}"), child.id().to_string()]).status().unwrap();
+        // bash's own kill: a minimal machine may have no kill binary.
+        let sent = Command::new("bash").arg("-c").arg(format!("kill -{signal} {}", child.id())).status().unwrap();
         assert!(sent.success());
         child.wait().unwrap().code()
     }
