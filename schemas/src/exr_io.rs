@@ -229,8 +229,8 @@ pub(crate) fn check_forest(
         if number > 0 && end > count as u64 {
             return invalid(format!("{record} {i}: children {first}..{end} run past the end of the table of {count} (field first_child)"));
         }
-        for child in first as usize..end as usize {
-            if reached[child] {
+        for (child, seen) in reached.iter_mut().enumerate().skip(first as usize).take(number as usize) {
+            if *seen {
                 return invalid(format!(
                     "{record} {child}: reached twice from the root, through {record} {i} (a cycle or a shared child; field first_child)"
                 ));
@@ -239,7 +239,7 @@ pub(crate) fn check_forest(
             if named as usize != i {
                 return invalid(format!("{record} {child}: field parent is {named}, but {record} {i} lists it as a child"));
             }
-            reached[child] = true;
+            *seen = true;
             stack.push(child);
         }
     }
