@@ -26,7 +26,7 @@ $(GPU_OUT)/params/gpu-shoot.ron: $(BIN)/gpu-shoot FORCE | $(GPU_OUT)/params
 
 $(GPU_OUT)/solution.exr $(GPU_OUT)/lightmap.exr &: $(BIN)/gpu-shoot $(GPU_OUT)/params/gpu-shoot.ron $(OUT)/mesh.exr $(OUT)/manifest.ron | $(GPU_OUT)
 	$(BIN)/gpu-shoot --params $(GPU_OUT)/params/gpu-shoot.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron \
-	  -o $(GPU_OUT)/solution.exr --lightmap $(GPU_OUT)/lightmap.exr --convergence $(GPU_OUT)/convergence.ron \
+	  -o $(GPU_OUT)/solution.exr --lightmap $(GPU_OUT)/lightmap.exr --convergence-log $(GPU_OUT)/convergence.ron \
 	  --plot $(GPU_OUT)/convergence.svg --report $(GPU_OUT)/gpu-shoot.report.ron
 
 $(GPU_OUT)/preview.exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(GPU_OUT)/solution.exr

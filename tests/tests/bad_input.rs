@@ -93,13 +93,15 @@ fn prepared(dir: &Path, scene: &Path) -> (PathBuf, PathBuf) {
 fn unknown_schema_version_of_a_ron_artifact() {
     let (dir, scene) = scene("ron_version");
     let (mesh, manifest) = prepared(&dir, &scene);
-    let text = std::fs::read_to_string(&manifest).unwrap().replacen("version: 1,", "version: 99,", 1);
-    std::fs::write(&manifest, text).unwrap();
+    let current = format!("version: {},", <schemas::mesh::Manifest as schemas::header::Schema>::VERSION);
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    assert!(text.contains(&current), "the manifest names its version as {current}");
+    std::fs::write(&manifest, text.replacen(&current, "version: 99,", 1)).unwrap();
     let solution = dir.join("solution.exr");
     assert_refused(
         "hierarchical-solve",
         &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution)],
-        &["manifest.ron", "version 99", "version 1"],
+        &["manifest.ron", "version 99", &format!("version {}", <schemas::mesh::Manifest as schemas::header::Schema>::VERSION)],
         &[&solution],
     );
 }

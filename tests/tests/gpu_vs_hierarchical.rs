@@ -16,7 +16,7 @@ fn gpu_shoot_and_hierarchical_solve_previews_agree_on_the_cornell_box() {
     let convergence = dir.join("convergence.ron");
     let gpu = run(
         "gpu-shoot",
-        &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&gpu_solution), "--convergence", s(&convergence), "--texels", "8000", "--convergence-target", "0.99"],
+        &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&gpu_solution), "--convergence-log", s(&convergence), "--texels", "8000", "--convergence-target", "0.99"],
     );
     if skipped_without_gpu(&gpu, "gpu_vs_hierarchical") {
         return;

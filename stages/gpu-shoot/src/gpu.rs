@@ -17,6 +17,20 @@ use wgpu::util::DeviceExt;
 pub const NO_ADAPTER: &str =
     "no GPU adapter found (Vulkan): install Mesa's software Vulkan driver lavapipe (Debian/Ubuntu: apt-get install mesa-vulkan-drivers) or a GPU driver";
 
+/// Keeps Mesa's device-selection Vulkan layer quiet where there is no
+/// desktop session: without a valid `XDG_RUNTIME_DIR` the layer's probe for
+/// a Wayland display prints "error: XDG_RUNTIME_DIR is invalid" twice on
+/// every successful run. The layer only reorders adapters, and
+/// [`acquire`] chooses its adapter itself, so it is switched off
+/// (`NODEVICE_SELECT=1`) in that case. Call it first thing in `main`,
+/// before any thread exists (it sets an environment variable).
+pub fn quiet_device_select_layer() {
+    let session = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if !session && std::env::var_os("NODEVICE_SELECT").is_none() {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
+}
+
 /// Acquires a device and queue on the best Vulkan adapter (a hardware GPU
 /// before lavapipe), with the adapter's own limits (the solver binds nine
 /// storage buffers to one stage; WebGPU's default allows eight).

@@ -28,7 +28,7 @@
 //! | `resolution` | side of a hemicube face / the stereographic map, pixels | 128 |
 //! | `tolerance` | relative depth tolerance of the visibility test | 0.02 |
 //! | `overshoot` | ambient overshooting (004 Eq. 4.9) | true |
-//! | `convergence` | stop when this fraction of the emitted power is shot | 0.99 |
+//! | `convergence_target` | stop when this fraction of the emitted power is shot | 0.99 |
 //! | `max_shots` | stop after this many shots | 100000 |
 //! | `ambient` | add `rho x ambient` (Eq. 2.4) to the solution's radiosity | true |
 //! | `texels_per_leaf` | solution leaves: about this many texels each | 4 |
@@ -84,7 +84,7 @@ pub struct Params {
     /// Ambient overshooting.
     pub overshoot: bool,
     /// Stop when this fraction of the emitted power has been shot.
-    pub convergence: f64,
+    pub convergence_target: f64,
     /// Stop after this many shots.
     pub max_shots: usize,
     /// Add rho x ambient to the solution's radiosity.
@@ -104,7 +104,7 @@ impl Default for Params {
             resolution: 128,
             tolerance: 0.02,
             overshoot: true,
-            convergence: 0.99,
+            convergence_target: 0.99,
             max_shots: 100_000,
             ambient: true,
             texels_per_leaf: 4.0,
@@ -130,8 +130,8 @@ impl Params {
         if !(self.tolerance.is_finite() && (0.0..0.5).contains(&self.tolerance)) {
             return Some(format!("tolerance must be in [0, 0.5), got {}", self.tolerance));
         }
-        if !(self.convergence.is_finite() && (0.0..=1.0).contains(&self.convergence)) {
-            return Some(format!("convergence must be in [0, 1], got {}", self.convergence));
+        if !(self.convergence_target.is_finite() && (0.0..=1.0).contains(&self.convergence_target)) {
+            return Some(format!("convergence_target must be in [0, 1], got {}", self.convergence_target));
         }
         if !(self.texels_per_leaf.is_finite() && self.texels_per_leaf >= 1.0) {
             return Some(format!("texels_per_leaf must be at least 1, got {}", self.texels_per_leaf));
@@ -379,7 +379,7 @@ pub fn solve(
         on_shot(&shot);
         shots.push(shot);
     }
-    while shots.len() < params.max_shots && unshot_of(&selection, unshot_lights) > 1.0 - params.convergence {
+    while shots.len() < params.max_shots && unshot_of(&selection, unshot_lights) > 1.0 - params.convergence_target {
         let shooter = selection.shooter[0];
         if shooter as usize >= tris.len() || selection.score[0] <= 0.0 {
             break;

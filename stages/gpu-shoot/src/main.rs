@@ -1,13 +1,14 @@
 //! `gpu-shoot`: see the library's documentation and `--help`.
 
 use clap::Parser;
+use schemas::cli::{check_outputs, main_of};
 use gpu_shoot::{gpu, output, solve, Luminaire, Params, Visibility};
 use schemas::header::Schema;
 use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
 use schemas::ron_io::write_ron;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, check_writable, exit_code, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -33,9 +34,9 @@ struct Args {
     /// Output: the lightmap atlas and its region table (EXR).
     #[arg(long)]
     lightmap: Option<PathBuf>,
-    /// Output: shots, unshot fraction and time per shot (RON; timings are volatile).
+    /// Output: the convergence log, shot by shot: unshot fraction and time (RON; timings are volatile).
     #[arg(long)]
-    convergence: Option<PathBuf>,
+    convergence_log: Option<PathBuf>,
     /// Output: a plot of the unshot fraction against time (SVG).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -44,6 +45,12 @@ struct Args {
     /// Covered texels to aim for over the scene.
     #[arg(long)]
     texels: Option<f64>,
+    /// Smallest side of a triangle's lightmap region, texels.
+    #[arg(long)]
+    min_size: Option<u32>,
+    /// Largest side of a triangle's lightmap region, texels.
+    #[arg(long)]
+    max_size: Option<u32>,
     /// Substructuring: shoot from groups of 2^level x 2^level texels.
     #[arg(long)]
     shoot_level: Option<u32>,
@@ -92,8 +99,10 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     if args.no_overshoot {
         p.overshoot = false;
     }
-    p.convergence = args.convergence_target.unwrap_or(p.convergence);
+    p.convergence_target = args.convergence_target.unwrap_or(p.convergence_target);
     p.max_shots = args.max_shots.unwrap_or(p.max_shots);
+    p.min_size = args.min_size.unwrap_or(p.min_size);
+    p.max_size = args.max_size.unwrap_or(p.max_size);
     if args.ambient {
         p.ambient = true;
     }
@@ -153,9 +162,10 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
         unreachable!("clap requires the inputs and output without --print-params")
     };
-    for path in [Some(output), args.lightmap.as_ref(), args.convergence.as_ref(), args.plot.as_ref(), args.stage.report.as_ref()].into_iter().flatten() {
-        check_writable(path)?;
-    }
+    check_outputs(
+        &[args.mesh.as_deref(), args.manifest.as_deref()],
+        &[Some(output), args.lightmap.as_deref(), args.convergence_log.as_deref(), args.plot.as_deref(), args.stage.report.as_deref()],
+    )?;
     let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let lights = Luminaire::all(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
@@ -194,7 +204,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     if let Some(path) = &args.lightmap {
         outputs.write(path, |p| lightmap.write(p))?;
     }
-    if let Some(path) = &args.convergence {
+    if let Some(path) = &args.convergence_log {
         outputs.write(path, |p| write_ron(p, &convergence))?;
     }
     if let Some(path) = &args.plot {
@@ -222,5 +232,6 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("gpu-shoot", run(Args::parse()))
+    gpu::quiet_device_select_layer();
+    main_of("gpu-shoot", run)
 }

@@ -54,7 +54,7 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert_and_the_cpu_kernel() 
     ]);
     let m = manifest(2, vec![material([rho; 3], [0.0; 3]), material([0.0; 3], [e; 3])]);
     for visibility in [Visibility::Hemicube, Visibility::Stereographic] {
-    let params = Params { texels: 6000.0, shoot_level: 0, max_shots: 2, convergence: 1.0, resolution: 256, visibility, ..Params::default() };
+    let params = Params { texels: 6000.0, shoot_level: 0, max_shots: 2, convergence_target: 1.0, resolution: 256, visibility, ..Params::default() };
     let Some(solved) = run(&mesh, &m, &[], &params) else { return };
     assert_eq!(solved.shots.len(), 2);
     let (mut worst, mut worst_cpu, mut count) = (0.0f64, 0.0f64, 0);
@@ -98,7 +98,7 @@ fn closed_box_balances_energy_with_and_without_overshooting() {
     for (rho, overshoot, visibility) in cases {
         {
             let m = manifest(2, vec![material([rho; 3], [0.0; 3]), material([rho; 3], [10.0; 3])]);
-            let params = Params { texels: 2000.0, shoot_level: 1, convergence: 0.999, overshoot, visibility, ..Params::default() };
+            let params = Params { texels: 2000.0, shoot_level: 1, convergence_target: 0.999, overshoot, visibility, ..Params::default() };
             let Some(solved) = run(&mesh, &m, &[], &params) else { return };
             let power = solved.emitted_power[0];
             let expected = power / ((1.0 - rho) * area);
@@ -127,7 +127,7 @@ fn closed_box_balances_energy_with_and_without_overshooting() {
 fn overshooting_reaches_90_percent_in_fewer_shots_on_the_cornell_box() {
     let (mesh, m) = mesh_prep::prepare_builtin("cornell-box", "test").unwrap();
     let shots = |overshoot: bool| {
-        let params = Params { texels: 4000.0, convergence: 0.9, overshoot, ..Params::default() };
+        let params = Params { texels: 4000.0, convergence_target: 0.9, overshoot, ..Params::default() };
         run(&mesh, &m, &[], &params).map(|s| s.shots.len())
     };
     let (Some(plain), Some(over)) = (shots(false), shots(true)) else { return };
@@ -142,7 +142,7 @@ fn constant_intensity_light_gives_i_cos_over_d_squared() {
     let m = manifest(1, vec![material([rho; 3], [0.0; 3])]);
     let d = Distribution { c_angles: vec![0.0], gamma_angles: vec![0.0, 90.0, 180.0], intensity: vec![K_M; 3] };
     let light = point_light(d, [0.2, 0.7, -0.1]);
-    let params = Params { texels: 4000.0, max_shots: 1, convergence: 1.0, resolution: 256, ..Params::default() };
+    let params = Params { texels: 4000.0, max_shots: 1, convergence_target: 1.0, resolution: 256, ..Params::default() };
     let Some(solved) = run(&mesh, &m, std::slice::from_ref(&light), &params) else { return };
     let mut worst = 0.0f64;
     for (k, t) in solved.atlas.texels.iter().enumerate() {
@@ -165,7 +165,7 @@ fn asymmetric_ldt_and_ies_lights_match_the_cpu_lookup_on_the_gpu() {
     let mesh = quads(&[(DVec3::new(-1.0, 0.0, -1.0), DVec3::Z * 2.0, DVec3::X * 2.0, 0, 0)]);
     let m = manifest(1, vec![material([rho; 3], [0.0; 3])]);
     let light = point_light(d, [0.1, 0.6, 0.05]);
-    let params = Params { texels: 3000.0, max_shots: 1, convergence: 1.0, resolution: 256, ..Params::default() };
+    let params = Params { texels: 3000.0, max_shots: 1, convergence_target: 1.0, resolution: 256, ..Params::default() };
     let Some(solved) = run(&mesh, &m, std::slice::from_ref(&light), &params) else { return };
     let i_max = light.i_max();
     let mut worst = 0.0f64;
@@ -200,7 +200,7 @@ fn every_shot_in_a_closed_box_delivers_its_power() {
         }
         // Receivers reflect everything (rho 1), so radiosity x area is received power.
         let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
-        let params = Params { texels: 1500.0, shoot_level: 0, max_shots: 1, convergence: 1.0, overshoot: false, visibility, ..Params::default() };
+        let params = Params { texels: 1500.0, shoot_level: 0, max_shots: 1, convergence_target: 1.0, overshoot: false, visibility, ..Params::default() };
         let solved = solve(&device, &queue, &mesh, &m, &[], &params, &mut |_| {}).unwrap();
         assert_eq!(solved.shots[0].shooter, format!("triangle {shooter}"));
         let received: f64 = solved

@@ -4,9 +4,10 @@ use clap::Parser;
 use mesh_prep::builtin::Builtin;
 use mesh_prep::obj::Files;
 use mesh_prep::{prepare, read_scene, Params, Recording};
-use schemas::stage::{check_writable, exit_code, load_params, print_params, Outputs, Run, StageArgs};
+use schemas::cli::{check_outputs, main_of};
+use schemas::stage::{load_params, print_params, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Prepare a scene for the radiosity pipeline: read scene.ron (OBJ/MTL
@@ -60,9 +61,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(mesh_path), Some(manifest_path)) = (args.mesh, args.manifest) else {
         unreachable!("clap requires --mesh and --manifest without --print-params")
     };
-    for path in [Some(&mesh_path), Some(&manifest_path), args.stage.report.as_ref(), args.depfile.as_ref()].into_iter().flatten() {
-        check_writable(path)?;
-    }
+    let outputs = [Some(mesh_path.as_path()), Some(manifest_path.as_path()), args.stage.report.as_deref(), args.depfile.as_deref()];
+    check_outputs(&[args.scene.as_deref()], &outputs)?;
     let mut run = Run::start("mesh-prep", env!("CARGO_PKG_VERSION"));
     let (source, scene_path): (&dyn mesh_prep::obj::TextSource, PathBuf) = match (&args.builtin, &args.scene) {
         (Some(b), _) => (b, b.scene_path()),
@@ -81,6 +81,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     // A built-in scene's files are inside the binary, which the Makefile
     // already lists.
     let read: Vec<&str> = if args.builtin.is_some() { Vec::new() } else { provenance.inputs.iter().map(|i| i.path.as_str()).collect() };
+    // Every file the scene named (OBJ, MTL, textures, photometry) is an
+    // input too: none may be overwritten.
+    check_outputs(&read.iter().map(|p| Some(Path::new(*p))).collect::<Vec<_>>(), &outputs)?;
     let depfile_text = mesh_prep::depfile::rule(&[&mesh_path.display().to_string(), &manifest_path.display().to_string()], &read);
     let (mesh, manifest) = prepared.into_artifacts(provenance);
     for warning in &warnings {
@@ -112,5 +115,5 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("mesh-prep", run(Args::parse()))
+    main_of("mesh-prep", run)
 }

@@ -52,7 +52,7 @@ fn run(args: Args) -> Result<ExitCode, String> {
     eprintln!("{:>14} {:>9} {:>8} {:>6} {:>9} {:>9}", "visibility", "overshoot", "texels", "shots", "setup s", "shoot s");
     for visibility in [Visibility::Hemicube, Visibility::Stereographic] {
         for overshoot in [false, true] {
-            let params = Params { texels: args.texels, visibility, overshoot, convergence: args.convergence, ..Params::default() };
+            let params = Params { texels: args.texels, visibility, overshoot, convergence_target: args.convergence, ..Params::default() };
             let solved = solve(&device, &queue, &mesh, &manifest, &[], &params, &mut |_| {})?;
             let row = Row {
                 visibility: format!("{visibility:?}").to_lowercase(),
