@@ -67,6 +67,21 @@ pub fn skipped_without_gpu(out: &Output, test: &str) -> bool {
     false
 }
 
+/// Runs `stage`, expects failure with exit 2, one stderr line containing
+/// every `needle`, and none of `outputs` on disk.
+pub fn assert_refused(stage: &str, args: &[&str], needles: &[&str], outputs: &[&Path]) {
+    let out = run(stage, args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stage} should exit 2; stderr: {stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "one line expected, got:\n{stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "error should mention {needle:?}: {stderr}");
+    }
+    for output in outputs {
+        assert!(!output.exists(), "{} was written despite the error", output.display());
+    }
+}
+
 /// Path as `&str` (test paths are UTF-8).
 pub fn s(path: &Path) -> &str {
     path.to_str().expect("UTF-8 path")

@@ -2,23 +2,8 @@
 //! known), exit code 2, and no output file.
 
 use end_to_end::scenes::{closed_box, QuadScene};
-use end_to_end::{run, run_ok, s, scratch};
+use end_to_end::{assert_refused, run_ok, s, scratch};
 use std::path::{Path, PathBuf};
-
-/// Runs `stage`, expects failure with exit 2, one stderr line containing
-/// every `needle`, and none of `outputs` on disk.
-fn assert_refused(stage: &str, args: &[&str], needles: &[&str], outputs: &[&Path]) {
-    let out = run(stage, args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{stage} should exit 2; stderr: {stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "one line expected, got:\n{stderr}");
-    for needle in needles {
-        assert!(stderr.contains(needle), "error should mention {needle:?}: {stderr}");
-    }
-    for output in outputs {
-        assert!(!output.exists(), "{} was written despite the error", output.display());
-    }
-}
 
 /// A valid little scene in a fresh directory; returns (dir, scene path).
 fn scene(test: &str) -> (PathBuf, PathBuf) {

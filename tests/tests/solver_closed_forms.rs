@@ -335,12 +335,12 @@ fn closed_box_conserves_energy_rho_0_9() {
 
 /// The one-bounce configuration ([`one_bounce`]), by quadrature written
 /// here apart from the solver: A's radiosity is `rho_A E F_{x->L}` (Lambert's
-/// formula, exact) plus what it reflects of B's first-bounce radiosity; B's
-/// is `rho_B / pi` times the integral over A of `B_A(x) cos cos / r^2`
-/// (parallel planes 0.5 m apart: `h^2 / (pi r^4)`), midpoint rule on a 2 cm
-/// grid of A (and of B for the second bounce). Bounces past the second
-/// change B by less than `rho_A rho_B F_AB F_BA` ~ 1e-3 relative at
-/// rho_B = 0.05 and are left out. Returns `B(y)` per point `y` of B.
+/// formula, exact) plus what it reflects of B's; B's is `rho_B / pi` times
+/// the integral over A of `B_A(x) cos cos / r^2` (parallel planes 0.5 m
+/// apart: `h^2 / (pi r^4)`), midpoint rule on a 2 cm grid of A and of B.
+/// The exchange between A and B is iterated until B changes by less than
+/// 1e-9 of itself: every bounce (at rho_B 0.5 the bounces past the second
+/// add 0.5% to B). Returns `B(y)` per point `y` of B.
 fn one_bounce_reference(rho_a: f64, rho_b: f64, emission: f64, points: &[[f64; 3]]) -> Vec<f64> {
     let h = 0.5;
     let lamp = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
@@ -355,14 +355,18 @@ fn one_bounce_reference(rho_a: f64, rho_b: f64, emission: f64, points: &[[f64; 3
         h * h / (std::f64::consts::PI * r2 * r2) * cell * cell
     };
     let direct_a: Vec<f64> = a_grid.iter().map(|x| rho_a * emission * lambert_polygon(*x, [0.0, 0.0, -1.0], &lamp)).collect();
-    let gather_b = |b_a: &[f64], y: &[f64; 3]| rho_b * a_grid.iter().zip(b_a).map(|(x, b)| b * kernel(x, y)).sum::<f64>();
-    let first_b: Vec<f64> = b_grid.iter().map(|y| gather_b(&direct_a, y)).collect();
-    let b_a: Vec<f64> = a_grid
-        .iter()
-        .zip(&direct_a)
-        .map(|(x, d)| d + rho_a * b_grid.iter().zip(&first_b).map(|(y, b)| b * kernel(x, y)).sum::<f64>())
-        .collect();
-    points.iter().map(|y| gather_b(&b_a, y)).collect()
+    let gather = |from: &[[f64; 3]], values: &[f64], to: &[f64; 3]| from.iter().zip(values).map(|(x, b)| b * kernel(x, to)).sum::<f64>();
+    let mut b_b = vec![0.0; b_grid.len()];
+    let b_a = loop {
+        let b_a: Vec<f64> = a_grid.iter().zip(&direct_a).map(|(x, d)| d + rho_a * gather(&b_grid, &b_b, x)).collect();
+        let next: Vec<f64> = b_grid.iter().map(|y| rho_b * gather(&a_grid, &b_a, y)).collect();
+        let change = next.iter().zip(&b_b).map(|(n, o)| (n - o).abs() / n.abs().max(1e-300)).fold(0.0, f64::max);
+        b_b = next;
+        if change < 1e-9 {
+            break b_a;
+        }
+    };
+    points.iter().map(|y| rho_b * gather(&a_grid, &b_a, y)).collect()
 }
 
 /// Per leaf of B: the relative error against [`one_bounce_reference`]
@@ -394,33 +398,29 @@ fn one_bounce_errors(test: &str, rho_b: f64, args: &[&str]) -> Vec<f64> {
     }).collect()
 }
 
-/// Issue 10, item 2: B (rho_B 0.05, so the second bounce, which the
-/// reference includes, is already about 1% and later ones ~1e-3) is lit
-/// only by what A reflects, its radiosity ~2e-3 of the lamp's. The absolute
-/// criterion (error in units of the lamp's exitance) leaves links onto B
-/// carrying the mean radiosity of large parts of A, whose radiosity falls
-/// off from above the lamp to above B's far edge: measured, B's worst leaf
-/// 71% off, rms 11%. The relative criterion (error against B's own
-/// radiosity, sender variation at every level below the sender) splits A
-/// where it matters: worst 8.9%, rms 2.2%, at default settings (404 -> 1820
-/// leaves on B). Bound: worst leaf within 12% and rms within 3%, which the
-/// relative criterion meets and the absolute one fails. Not the issue's 2%: even at `--criterion absolute
-/// --eps 1e-6 --min-area 1e-5` B's leaves stay up to 6.7% off (rms 1.4%)
-/// while A's leaves match Lambert within 2.6% and B under a uniformly
-/// emitting A matches Lambert to 4e-6; that residual is left to find.
+/// Issue 10, item 2: B is lit only by what A reflects, its radiosity
+/// ~2e-3 (rho_B 0.05) to 2e-2 (0.5) of the lamp's. Every leaf of B must be
+/// within 2% of the quadrature reference at default settings, for rho_B 0.5
+/// and 0.05. The absolute criterion (error in units of the lamp's
+/// exitance) leaves links onto B carrying the mean radiosity of large parts
+/// of A, whose radiosity falls off from above the lamp to above B's far
+/// edge: measured, B's worst leaf 71% off. A per-link allowance of
+/// `eps_relative` of the receiver's radiosity let the links' same-signed
+/// errors add up: worst leaf 8.9%, rms 2.1%. Shared among the links
+/// (hierarchical-solve's `Allowance::for_link`): worst 1.1%.
 #[test]
-fn one_bounce_receiver_leaves_closer_to_quadrature_with_the_relative_criterion() {
-    let rho_b = 0.05;
-    let mut worst = [0.0f64; 2];
-    let mut rms = [0.0f64; 2];
-    for (k, criterion) in ["absolute", "relative"].into_iter().enumerate() {
-        let errors = one_bounce_errors(&format!("one_bounce_{criterion}"), rho_b, &["--criterion", criterion]);
-        rms[k] = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
-        worst[k] = errors.iter().fold(0.0f64, |w, e| w.max(e.abs()));
-        eprintln!("one bounce, rho_B {rho_b}, {criterion}: {} leaves of B, largest relative error {:.2e}, rms {:.2e}", errors.len(), worst[k], rms[k]);
+fn one_bounce_receiver_leaves_within_two_percent_of_quadrature() {
+    for rho_b in [0.05, 0.5] {
+        let mut worst = [0.0f64; 2];
+        for (k, criterion) in ["absolute", "relative"].into_iter().enumerate() {
+            let errors = one_bounce_errors(&format!("one_bounce_{criterion}_{rho_b}"), rho_b, &["--criterion", criterion]);
+            let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+            worst[k] = errors.iter().fold(0.0f64, |w, e| w.max(e.abs()));
+            eprintln!("one bounce, rho_B {rho_b}, {criterion}: {} leaves of B, largest relative error {:.2e}, rms {rms:.2e}", errors.len(), worst[k]);
+        }
+        assert!(worst[1] <= 0.02, "rho_B {rho_b}: a leaf of B is {:.2e} off the quadrature reference", worst[1]);
+        assert!(worst[0] > 0.02, "rho_B {rho_b}: the absolute criterion also meets 2% ({:.2e}); the test no longer tells them apart", worst[0]);
     }
-    assert!(worst[1] <= 0.12 && rms[1] <= 0.03, "relative criterion: a leaf of B is {:.2e} off the quadrature reference (rms {:.2e})", worst[1], rms[1]);
-    assert!(worst[0] > 0.12, "the absolute criterion also meets 12% ({:.2e}); the test no longer tells them apart", worst[0]);
 }
 
 /// World corners of solution element `e`: its barycentric corners mapped
@@ -496,128 +496,3 @@ fn a_tilted_one_sided_lamp_lights_nothing_behind_its_plane_with_clusters() {
     tilted_lamp(true);
 }
 
-#[test]
-#[ignore]
-fn debug_one_bounce() {
-    let (rho_a, emission) = (0.5, 1.0);
-    let extra: Vec<String> = std::env::var("DEBUG_ARGS").unwrap_or_default().split_whitespace().map(String::from).collect();
-    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
-    for (rho_b, args) in [(0.05, extra.clone()), (0.5, extra.clone())] {
-        let (solved, dir) = solve("debug_one_bounce", &one_bounce(rho_a, rho_b, emission), &args, false);
-        let (mesh, _) = Mesh::read(&dir.join("mesh.exr")).unwrap();
-        let origin = read_ron::<Manifest>(&dir.join("manifest.ron")).unwrap().value.world_from_mesh_translation;
-        let lamp = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
-        let b_grid: Vec<[f64; 3]> = (0..50).flat_map(|i| (0..50).map(move |j| [1.0 + (i as f64 + 0.5) * 0.02, (j as f64 + 0.5) * 0.02, 0.0])).collect();
-        let first_b = one_bounce_reference_first(rho_a, rho_b, emission, &b_grid);
-        let mut b_leaves = Vec::new();
-        let (mut worst_a, mut n_a) = (0.0f64, 0);
-        for (object, _, b, i) in solved.leaves() {
-            let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
-            let c: [f64; 3] = std::array::from_fn(|a| (corners[0][a] + corners[1][a] + corners[2][a]) / 3.0);
-            if object == "A" {
-                let direct = {
-                    let h = 0.5; let cell = 0.02;
-                    let k = |x: &[f64; 3], y: &[f64; 3]| { let r2 = (x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + h * h; h * h / (std::f64::consts::PI * r2 * r2) * cell * cell };
-                    rho_a * emission * mean_over_triangle(&corners, 2, &|x| lambert_polygon(x, [0.0, 0.0, -1.0], &lamp)) + rho_a * b_grid.iter().zip(&first_b).map(|(y, b)| b * k(&c, y)).sum::<f64>()
-                };
-                let e = (b - direct) / direct;
-                if e.abs() > worst_a.abs() { worst_a = e; }
-                n_a += 1;
-            }
-            if object == "B" { b_leaves.push((b, corners, c)); }
-        }
-        let all: Vec<[f64; 3]> = b_leaves.iter().map(|l| l.2).collect();
-        let reference = one_bounce_reference(rho_a, rho_b, emission, &all);
-        let mut errs: Vec<(f64, [f64; 3])> = b_leaves.iter().zip(&reference).map(|((b, _, c), r)| ((b - r) / r, *c)).collect();
-        errs.sort_by(|a, b| b.0.abs().partial_cmp(&a.0.abs()).unwrap());
-        let mean: f64 = errs.iter().map(|e| e.0).sum::<f64>() / errs.len() as f64;
-        let rms = (errs.iter().map(|e| e.0 * e.0).sum::<f64>() / errs.len() as f64).sqrt();
-        let report = std::fs::read_to_string(dir.join("solve.report.ron")).unwrap_or_default();
-        let links = report.lines().find(|l| l.contains("\"links\"")).unwrap_or("").trim().to_string();
-        eprintln!("rho_b {rho_b} {args:?}: A leaves {n_a} worst {worst_a:.3e}; B leaves {} mean signed {mean:.3e} rms {rms:.3e} worst {:.3e} at {:?}; {links}", errs.len(), errs[0].0, errs[0].1);
-    }
-}
-
-/// A luminaire over a 2 x 2 m floor (reflectance 1/2, nothing else in the
-/// scene, so nothing interreflects): every floor leaf's radiosity must be
-/// `rho` times the luminaire's irradiance `I_e(gamma) cos(theta) / d^2`
-/// averaged over the leaf by an independent quadrature (256 sub-triangle
-/// centroids), within 1%. The luminaire is an EULUMDAT file of the smooth
-/// distribution `I_v = 500 (1 + cos gamma)` cd, placed 0.8 m up, off the
-/// floor's centre, nadir down; `I_e = I_v / 683` W/sr (004 Eq. 2.12).
-/// Returns the scene directory.
-fn luminaire_over_floor(test: &str, height: f64, intensity: &dyn Fn(f64) -> f64) -> (Solved, std::path::PathBuf, [f64; 3]) {
-    let mut scene = QuadScene { camera: ([0.0, -3.0, 2.0], [0.0, 0.0, 0.0]), ..Default::default() };
-    scene.material("floor", 0.5, 0.0);
-    scene.quad("floor", "floor", rectangle(2, 0.0, [-1.0, -1.0], [1.0, 1.0]), [0.0, 0.0, 1.0]);
-    let light = [0.13, -0.21, height];
-    scene.lights.push(format!("Goniometric(file: \"lamp.ldt\", position: ({:?}, {:?}, {:?}), nadir: (0.0, 0.0, -1.0))", light[0], light[1], light[2]));
-    let dir = scratch(test);
-    std::fs::write(dir.join("lamp.ldt"), end_to_end::scenes::rotational_ldt(intensity)).unwrap();
-    let scene_path = scene.write(&dir);
-    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
-    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
-    let solution = solve_prepared(&dir, &[], None);
-    (load(&mesh, &manifest, &solution), dir, light)
-}
-
-#[test]
-fn luminaire_gives_every_floor_leaf_i_cos_over_d_squared() {
-    let rho = 0.5;
-    let intensity = |gamma: f64| 500.0 * (1.0 + gamma.to_radians().cos());
-    let (solved, dir, light) = luminaire_over_floor("luminaire_floor", 0.8, &intensity);
-    let (mesh, _) = Mesh::read(&dir.join("mesh.exr")).unwrap();
-    let manifest = read_ron::<Manifest>(&dir.join("manifest.ron")).unwrap().value;
-    let origin = manifest.world_from_mesh_translation;
-    let irradiance = |x: [f64; 3]| {
-        let d: [f64; 3] = std::array::from_fn(|a| x[a] - light[a]);
-        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        let cos = -d[2] / r; // both the receiver's cosine and cos(gamma)
-        intensity(cos.acos().to_degrees()) / 683.0 * cos / (r * r)
-    };
-    let mut errors = LeafErrors::default();
-    for (_, _, b, i) in solved.leaves() {
-        let corners = leaf_world_corners(&mesh, origin, &solved.solution.elements[i]);
-        let exact = rho * mean_over_triangle(&corners, 4, &irradiance);
-        errors.add((b - exact) / exact);
-    }
-    let (checked, worst) = (errors.checked, errors.worst);
-    eprintln!("luminaire over a floor: {checked} leaves, largest relative error {worst:.2e}, rms {:.2e}", errors.rms());
-    assert!(checked >= 16, "only {checked} floor leaves: the direct light was not refined");
-    assert!(worst <= 0.01, "a floor leaf is {worst:.2e} off I cos(theta) / d^2");
-}
-
-/// A luminaire 2 cm above the floor (isotropic, 683 cd = 1 W/sr): the
-/// irradiance is singular at its foot, but its integral is the light's
-/// intensity times the solid angle the floor subtends, `Omega = 4 asin(a^2
-/// / (a^2 + h^2))` for a square of half-side `a` under its centre (here
-/// off-centre: the sum of four rectangles with a corner under the light).
-/// The floor's reflected power, `sum B A / rho`, must match within 1%, and
-/// no leaf may be non-finite or brighter than the bound `rho I / h^2`.
-#[test]
-fn luminaire_next_to_the_floor_delivers_its_solid_angle() {
-    let (rho, h) = (0.5, 0.02);
-    let (solved, _, light) = luminaire_over_floor("luminaire_near_floor", h, &|_| 683.0);
-    let (mut power, mut brightest) = (0.0, 0.0f64);
-    for (_, a, b, _) in solved.leaves() {
-        assert!(b.is_finite(), "a floor leaf is not finite");
-        brightest = brightest.max(b);
-        power += a * b / rho;
-    }
-    // Solid angle of the rectangle [0, x] x [0, y] at height h over its corner.
-    let corner = |x: f64, y: f64| (x * y / ((x * x + h * h) * (y * y + h * h)).sqrt()).asin();
-    let omega: f64 = [(1.0 - light[0], 1.0 - light[1]), (1.0 + light[0], 1.0 - light[1]), (1.0 - light[0], 1.0 + light[1]), (1.0 + light[0], 1.0 + light[1])].iter().map(|&(x, y)| corner(x, y)).sum();
-    eprintln!("luminaire 2 cm above the floor: floor power {power:.5} W vs I Omega = {omega:.5} W; brightest leaf {brightest:.3e} W/m2");
-    assert_close("power on the floor", power, omega, 0.01);
-    assert!(brightest <= rho / (h * h), "a leaf is brighter than the point bound: {brightest}");
-}
-
-fn one_bounce_reference_first(rho_a: f64, rho_b: f64, emission: f64, points: &[[f64; 3]]) -> Vec<f64> {
-    let h = 0.5;
-    let lamp = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
-    let cell = 0.02;
-    let a_grid: Vec<[f64; 3]> = (0..100).flat_map(|i| (0..50).map(move |j| [(i as f64 + 0.5) * cell, (j as f64 + 0.5) * cell, h])).collect();
-    let kernel = |x: &[f64; 3], y: &[f64; 3]| { let r2 = (x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + h * h; h * h / (std::f64::consts::PI * r2 * r2) * cell * cell };
-    let direct_a: Vec<f64> = a_grid.iter().map(|x| rho_a * emission * lambert_polygon(*x, [0.0, 0.0, -1.0], &lamp)).collect();
-    points.iter().map(|y| rho_b * a_grid.iter().zip(&direct_a).map(|(x, b)| b * kernel(x, y)).sum::<f64>()).collect()
-}

@@ -53,6 +53,9 @@ struct Args {
     /// Relative criterion: least receiver radiosity, as a fraction of the scene's area-mean reflected radiosity.
     #[arg(long)]
     relative_floor: Option<f64>,
+    /// Relative criterion: least share of its receiver's radiosity a link's allowed error is computed from [default: 1/16].
+    #[arg(long)]
+    share_floor: Option<f64>,
     /// Smallest element area, as a fraction of the scene's total area.
     #[arg(long)]
     min_area: Option<f64>,
@@ -85,6 +88,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.eps = args.eps.unwrap_or(p.eps);
     p.eps_relative = args.eps_relative.or(p.eps_relative);
     p.relative_floor = args.relative_floor.unwrap_or(p.relative_floor);
+    p.share_floor = args.share_floor.unwrap_or(p.share_floor);
     p.min_area = args.min_area.unwrap_or(p.min_area);
     p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
     p.cluster_samples = args.cluster_samples.unwrap_or(p.cluster_samples);

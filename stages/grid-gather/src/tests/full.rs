@@ -244,14 +244,17 @@ fn full_gather_images_are_bit_identical_on_one_thread_and_many() {
 /// The closed box built into mesh-prep (`box-<n>`: a convex room, so no
 /// surface hides another) solved with clusters: links with cluster ends,
 /// among them the root's self-link refined, so some senders are clusters
-/// holding the grid vertices.
+/// holding the grid vertices. The links' whole allowance (`share_floor`
+/// 1) keeps the coarse links these tests are about: with the default
+/// share, this 300-triangle box's solve left the full gather no grid
+/// vertex.
 pub(crate) fn clustered_box(triangles: usize, eps: f64) -> (Mesh, Manifest, Solution, schemas::cluster::Clusters) {
     let (mesh, manifest) = mesh_prep::prepare_builtin(&format!("box-{triangles}"), "test").expect("built-in box");
     let geometry = radiometry::geometry::mesh_triangles(&mesh);
     let reflectances: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.materials[t.material as usize].diffuse).collect();
     let h = cluster::build(&geometry, &reflectances, &cluster::Params::default());
     let clusters = schemas::cluster::Clusters { header: schemas::cluster::Clusters::header(Provenance::in_memory("test")), nodes: h.nodes, order: h.order };
-    let params = hierarchical_solve::Params { eps, ..hierarchical_solve::Params::default() };
+    let params = hierarchical_solve::Params { eps, share_floor: 1.0, ..hierarchical_solve::Params::default() };
     let solved = hierarchical_solve::solve(&mesh, &manifest, Some(clusters.clone()), &params, &|_| {}).expect("solve");
     let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links };
     (mesh, manifest, solution, clusters)
