@@ -43,3 +43,50 @@ fn gpu_shoot_and_hierarchical_solve_previews_agree_on_the_cornell_box() {
     eprintln!("gpu-shoot vs hierarchical-solve at unshot {unshot:.4}:\n{text}");
     assert_eq!(out.status.code(), Some(0), "relative RMSE of the previews over 3%: {text}");
 }
+
+/// Power (W, channel 0) leaving `object`: its leaves' area times radiosity.
+fn flux(mesh: &std::path::Path, manifest: &std::path::Path, solution: &std::path::Path, object: &str) -> f64 {
+    let (mesh, _) = schemas::mesh::Mesh::read(mesh).unwrap();
+    let manifest = schemas::ron_io::read_ron::<schemas::mesh::Manifest>(manifest).unwrap().value;
+    let (solution, _) = schemas::solution::Solution::read(solution).unwrap();
+    solution
+        .elements
+        .iter()
+        .filter(|e| e.is_leaf() && manifest.objects[mesh.triangles[e.triangle as usize].object as usize] == object)
+        .map(|e| f64::from(e.area) * f64::from(e.radiosity[0]))
+        .sum()
+}
+
+/// Issue 10, item 7: gpu-shoot's ambient term (004 Eq. 2.4) spreads the
+/// unshot power over the scene as if it were closed; in an open scene it
+/// adds light that is not there. On paper 002's one-bounce configuration
+/// (open: everything leaves past the edges of A), receiver B's power from
+/// gpu-shoot at 99% shot (default atlas) must match hierarchical-solve's
+/// (which its own test holds within 1.1% per leaf of a quadrature
+/// reference) within 2% by default, and the ambient term, asked for, must
+/// add over 1% to it, or this test no longer tells the two apart. Measured:
+/// +1.3% by default, +3.0% with `--ambient` (with a 131k-texel atlas 0.0%
+/// and +1.7%; the issue measured +6.3% at its settings).
+#[test]
+fn gpu_shoot_adds_no_ambient_light_to_an_open_scene_by_default() {
+    let dir = scratch("gpu_open_scene");
+    let scene = end_to_end::scenes::one_bounce(0.5, 0.05, 1.0).write(&dir);
+    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
+    run_ok("mesh-prep", &[s(&scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let hierarchical = dir.join("hierarchical.exr");
+    run_ok("hierarchical-solve", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&hierarchical)]);
+    let reference = flux(&mesh, &manifest, &hierarchical, "B");
+    let mut relative = Vec::new();
+    for extra in [None, Some("--ambient")] {
+        let solution = dir.join(format!("gpu{}.exr", extra.unwrap_or("")));
+        let mut args = vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--convergence-target", "0.99"];
+        args.extend(extra);
+        if skipped_without_gpu(&run("gpu-shoot", &args), "gpu_open_scene") {
+            return;
+        }
+        relative.push(flux(&mesh, &manifest, &solution, "B") / reference - 1.0);
+    }
+    eprintln!("B's power, gpu-shoot vs hierarchical-solve: default {:+.2}%, --ambient {:+.2}%", 100.0 * relative[0], 100.0 * relative[1]);
+    assert!(relative[0].abs() <= 0.02, "gpu-shoot's B is {:+.2}% off hierarchical-solve's", 100.0 * relative[0]);
+    assert!(relative[1] - relative[0] > 0.01, "the ambient term no longer shows its bias ({:+.2}% against {:+.2}%)", 100.0 * relative[1], 100.0 * relative[0]);
+}

@@ -75,7 +75,7 @@ struct Args {
     /// Stop after this many shots.
     #[arg(long)]
     max_shots: Option<usize>,
-    /// Add rho x ambient to the solution (display).
+    /// Add rho x ambient to the solution: a display aid for an unconverged solution [default: off].
     #[arg(long, overrides_with = "no_ambient")]
     ambient: bool,
     /// Leave the ambient term out of the solution.
