@@ -230,8 +230,8 @@ impl Params {
         // The whole size (with the camera's for a side not given) is
         // checked by `gather_with`.
         for (name, side) in [("width", self.width), ("height", self.height)] {
-            if let Some(side) = side.filter(|s| !(1..=MAX_SIDE).contains(s)) {
-                return Err(bad_parameter(format!("{name} must be 1 to {MAX_SIDE} pixels, got {side}")));
+            if let Some(side) = side {
+                check_side(name, side).map_err(bad_parameter)?;
             }
         }
         if !(0.0..=180.0).contains(&self.crease_angle_deg) {
@@ -310,13 +310,21 @@ pub const MAX_PIXELS: u64 = 1 << 26;
 /// `1..=MAX_SIDE`, at most [`MAX_PIXELS`] in all, so a mistyped size is an
 /// error at once rather than an hour of work or an allocation failure.
 pub fn check_image_size(width: u32, height: u32) -> std::result::Result<(), String> {
-    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-        return Err(format!("image size {width}x{height}: each side must be 1 to {MAX_SIDE} pixels"));
-    }
+    check_side("width", width)?;
+    check_side("height", height)?;
     if u64::from(width) * u64::from(height) > MAX_PIXELS {
         return Err(format!("image size {width}x{height}: more than {MAX_PIXELS} pixels"));
     }
     Ok(())
+}
+
+/// One side of an image, named `name`, in `1..=MAX_SIDE`.
+fn check_side(name: &str, side: u32) -> std::result::Result<(), String> {
+    if (1..=MAX_SIDE).contains(&side) {
+        Ok(())
+    } else {
+        Err(format!("{name} must be 1 to {MAX_SIDE} pixels, got {side}"))
+    }
 }
 
 /// The image size: `params`' where given, else the camera's.

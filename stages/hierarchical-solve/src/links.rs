@@ -251,10 +251,10 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[
     if r == s {
         return Split::Both;
     }
-    let threshold = allowance.at(radiosity[h.flat(r)]);
     let wanted = match (r, s) {
         (Node::Element(_), Node::Element(_)) => decide_elements(h, link, radiosity, deviation, allowance),
         _ => {
+            let threshold = allowance.at(radiosity[h.flat(r)]);
             let rho = h.node_reflectance(r);
             let b = radiosity[h.flat(s)];
             let reflected = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);

@@ -253,16 +253,17 @@ pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender
     let count = clip_to_upper_hemisphere(origin, sender_normal, receiver, &mut front);
     let area = |t: &[DVec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).length();
     let whole = area(receiver);
-    let mut result = AreaFactor { mean: 0.0, min: f64::INFINITY, max: 0.0 };
     if whole <= 0.0 {
         return AreaFactor { mean: 0.0, min: 0.0, max: 0.0 };
     }
+    let mut result = AreaFactor { mean: 0.0, min: f64::INFINITY, max: 0.0 };
     let mut in_front = 0.0;
     for k in 1..count.saturating_sub(1) {
         let piece = [front[0], front[k], front[k + 1]];
         let part = front_part(&piece, receiver_normal, &sender, depth);
-        in_front += area(&piece);
-        result.mean += area(&piece) / whole * part.mean;
+        let piece_area = area(&piece);
+        in_front += piece_area;
+        result.mean += piece_area / whole * part.mean;
         result.min = result.min.min(part.min);
         result.max = result.max.max(part.max);
     }
