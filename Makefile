@@ -56,7 +56,7 @@ all: $(OUT)/image.png
 # Cargo decides what to rebuild; a binary it leaves alone keeps its time
 # stamp, so the stages downstream of it do not run again.
 $(BINS) &: FORCE
-	@cargo build --release --quiet --bins
+	@cargo build --release --quiet $(addprefix -p ,$(STAGES)) --bins
 
 # params_file(stage, flags): the stage's effective parameters as RON,
 # rewritten only when they change, so a knob reruns only what it affects.
