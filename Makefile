@@ -58,6 +58,11 @@ all: $(OUT)/image.png
 $(BINS) &: FORCE
 	@cargo build --release --quiet $(addprefix -p ,$(STAGES)) --bins
 
+# The benchmark drivers (bench-solve, bench-scale, sweep).
+BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep)
+$(BENCH_BINS) &: FORCE
+	@cargo build --release --quiet -p bench --bins
+
 # params_file(stage, flags): the stage's effective parameters as RON,
 # rewritten only when they change, so a knob reruns only what it affects.
 define params_file
@@ -83,12 +88,12 @@ fuzz: $(BINS)
 
 # Medians of 5 solves of the Cornell box at about 10k leaf elements, and
 # obvhs's raw traversal rate measured in the same run (see README).
-bench: $(BINS) | out
+bench: $(BINS) $(BENCH_BINS) | out
 	$(BIN)/bench-solve -o out/bench-solve.ron
 
 # Clustering at scale: plant rooms of 10k, 100k and 1M triangles (see README).
 .PHONY: bench-scale
-bench-scale: $(BINS) | out
+bench-scale: $(BINS) $(BENCH_BINS) | out
 	$(BIN)/bench-scale --sizes $(or $(SIZES),10k,100k,1m) -o out/bench-scale.ron
 
 out:
