@@ -36,6 +36,7 @@ pub mod mesh;
 pub mod png;
 pub mod report;
 pub mod ron_io;
+pub mod samples;
 pub mod solution;
 pub mod stage;
 pub mod threshold;
