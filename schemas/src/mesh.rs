@@ -146,6 +146,14 @@ pub struct Material {
     pub alpha_map: Option<String>,
     /// Normal map file, if any.
     pub normal_map: Option<String>,
+    /// Whether the surface reflects on both faces (leaves, paper, thin
+    /// panels): `mesh-prep` gives every triangle of a two-sided material a
+    /// *twin*, the same three vertices wound the other way, so each face is
+    /// a one-sided surface with its own radiosity and every solver needs
+    /// nothing more than one-sided surfaces (see [`Manifest::check_mesh`]).
+    /// Emission stays one-sided: an emitting material cannot be two-sided.
+    #[serde(default)]
+    pub two_sided: bool,
 }
 
 impl Material {
@@ -162,6 +170,7 @@ impl Material {
             diffuse_map: None,
             alpha_map: None,
             normal_map: None,
+            two_sided: false,
         }
     }
 }
@@ -242,8 +251,12 @@ pub struct MeshStatistics {
     pub input_triangles: usize,
     /// Triangles dropped because their area is (numerically) zero.
     pub degenerate_dropped: usize,
-    /// Triangles dropped because they repeat another (same three vertices).
+    /// Triangles dropped because they repeat another (same three vertices
+    /// in the same order, or either order for a two-sided triangle).
     pub duplicates_dropped: usize,
+    /// Twins added for two-sided materials (counted in `triangles`).
+    #[serde(default)]
+    pub two_sided_twins: usize,
     /// Vertices merged into another at the same position.
     pub vertices_welded: usize,
     /// Triangles kept.
@@ -286,7 +299,7 @@ pub struct Manifest {
 
 impl Schema for Manifest {
     const NAME: &'static str = "manifest";
-    const VERSION: u32 = 2;
+    const VERSION: u32 = 3;
 }
 
 impl RonArtifact for Manifest {
@@ -297,8 +310,11 @@ impl RonArtifact for Manifest {
 
 impl Manifest {
     /// Checks that `mesh` fits this manifest: every material and object
-    /// index in range of its lists. (That both come from one run is
-    /// checked by [`crate::stage::read_prepared`].)
+    /// index in range of its lists, and every triangle of a two-sided
+    /// material paired with its twin (the same vertices wound the other
+    /// way, the same material), which is what makes the material two-sided
+    /// for every solver. (That both come from one run is checked by
+    /// [`crate::stage::read_prepared`].)
     pub fn check_mesh(&self, mesh_path: &Path, mesh: &Mesh) -> Result<()> {
         for (i, t) in mesh.triangles.iter().enumerate() {
             for (field, index, count) in [("material", t.material, self.materials.len()), ("object", t.object, self.objects.len())] {
@@ -307,8 +323,27 @@ impl Manifest {
                 }
             }
         }
+        let two_sided = |t: &Triangle| self.materials[t.material as usize].two_sided;
+        let wound: std::collections::HashSet<([u32; 3], u32)> =
+            mesh.triangles.iter().filter(|t| two_sided(t)).map(|t| (cyclic(t.vertices), t.material)).collect();
+        if let Some((i, t)) = mesh.triangles.iter().enumerate().find(|(_, t)| two_sided(t) && !wound.contains(&(cyclic(reversed(t.vertices)), t.material))) {
+            let name = &self.materials[t.material as usize].name;
+            return Err(Error::invalid(mesh_path, None, format!("triangle {i}: material '{name}' is two-sided, but the triangle has no twin (its vertices wound the other way)")));
+        }
         Ok(())
     }
+}
+
+/// The same triangle wound the other way: its twin, facing the other side.
+pub fn reversed(v: [u32; 3]) -> [u32; 3] {
+    [v[0], v[2], v[1]]
+}
+
+/// The vertices rotated to start at the smallest index: equal for the same
+/// triangle whichever corner it starts at, different for its twin.
+pub fn cyclic(v: [u32; 3]) -> [u32; 3] {
+    let first = (0..3).min_by_key(|&i| v[i]).unwrap_or(0);
+    [v[first], v[(first + 1) % 3], v[(first + 2) % 3]]
 }
 
 #[cfg(test)]
@@ -333,5 +368,31 @@ mod tests {
         assert_eq!(refusal("empty", |m| m.triangles.clear()), "layer 'triangle' holds no triangle");
         assert_eq!(refusal("vertex", |m| m.triangles[0].vertices[2] = 3), "triangle 0: field v2 names vertex 3, but the mesh has 3");
         assert_eq!(refusal("nan", |m| m.positions[1][1] = f32::NAN), "vertex 1: field P.Y is NaN");
+    }
+
+    #[test]
+    fn a_two_sided_triangle_needs_its_twin() {
+        let mut manifest: Manifest = Manifest {
+            header: Manifest::header(Provenance::in_memory("test")),
+            world_from_mesh_translation: [0.0; 3],
+            camera: Camera { eye: [0.0, 0.0, 1.0], target: [0.0; 3], up: [0.0, 1.0, 0.0], vertical_fov_deg: 40.0, width: 4, height: 4 },
+            materials: vec![Material { two_sided: true, ..Material::diffuse("leaf", [0.5; 3], [0.0; 3]) }],
+            objects: vec!["o".into()],
+            goniometric_lights: Vec::new(),
+            effects: Effects::default(),
+            statistics: MeshStatistics::default(),
+        };
+        let front = Triangle { vertices: [0, 1, 2], material: 0, object: 0, area: 0.5, normal: [0.0, 0.0, 1.0] };
+        let mut mesh = Mesh { header: Mesh::header(Provenance::in_memory("test")), positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], triangles: vec![front] };
+        let path = Path::new("mesh.exr");
+        let message = manifest.check_mesh(path, &mesh).unwrap_err().to_string();
+        assert_eq!(message, "mesh.exr: triangle 0: material 'leaf' is two-sided, but the triangle has no twin (its vertices wound the other way)");
+        // The same winding started at another corner is the same face, not its twin.
+        mesh.triangles.push(Triangle { vertices: [1, 2, 0], ..front });
+        assert!(manifest.check_mesh(path, &mesh).is_err());
+        mesh.triangles[1] = Triangle { vertices: [2, 1, 0], normal: [0.0, 0.0, -1.0], ..front };
+        manifest.check_mesh(path, &mesh).unwrap();
+        manifest.materials[0].two_sided = false;
+        manifest.check_mesh(path, &mesh).unwrap();
     }
 }

@@ -89,8 +89,12 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     for warning in &warnings {
         eprintln!("mesh-prep: warning: {warning}");
     }
+    let twins = match statistics.two_sided_twins {
+        0 => String::new(),
+        n => format!(", {n} of them two-sided twins"),
+    };
     eprintln!(
-        "mesh-prep: {} triangles, {} vertices ({} degenerate and {} duplicate triangles dropped, {} vertices welded)",
+        "mesh-prep: {} triangles{twins}, {} vertices ({} degenerate and {} duplicate triangles dropped, {} vertices welded)",
         statistics.triangles, statistics.vertices, statistics.degenerate_dropped, statistics.duplicates_dropped, statistics.vertices_welded
     );
     let mut outputs = Outputs::new();
@@ -103,6 +107,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("vertices".to_string(), statistics.vertices as f64),
             ("degenerate_dropped".to_string(), statistics.degenerate_dropped as f64),
             ("duplicates_dropped".to_string(), statistics.duplicates_dropped as f64),
+            ("two_sided_twins".to_string(), statistics.two_sided_twins as f64),
             ("vertices_welded".to_string(), statistics.vertices_welded as f64),
         ]);
         outputs.write(report, |p| run.write_report(p, &params, counters, vec![], warnings))?;

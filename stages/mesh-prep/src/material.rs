@@ -39,6 +39,7 @@ pub fn from_mtl(m: &MtlMaterial) -> Material {
         diffuse_map: name(&m.diffuse_texture),
         alpha_map: name(&m.dissolve_texture),
         normal_map: name(&m.normal_texture),
+        two_sided: false,
     }
 }
 
@@ -54,6 +55,9 @@ pub fn apply(material: &mut Material, o: &MaterialOverride) {
     set(&mut material.specular_reflectance, o.specular_reflectance);
     set(&mut material.specular_transmittance, o.specular_transmittance);
     set(&mut material.diffuse_transmittance, o.diffuse_transmittance);
+    if let Some(two_sided) = o.two_sided {
+        material.two_sided = two_sided;
+    }
     for (target, value) in [
         (&mut material.alpha_map, &o.alpha_map),
         (&mut material.normal_map, &o.normal_map),
@@ -91,6 +95,12 @@ pub fn check(m: &Material) -> Option<String> {
     if let Some(x) = m.emission.iter().find(|x| !x.is_finite() || **x < 0.0) {
         return Some(format!("material '{}': emission {x} is not a finite non-negative number", m.name));
     }
+    if m.two_sided && m.emission.iter().any(|&e| e > 0.0) {
+        return Some(format!(
+            "material '{}': an emitter cannot be two-sided (emission is one-sided, from the front face); model a panel that lights both ways as two emitters",
+            m.name
+        ));
+    }
     None
 }
 
@@ -116,5 +126,9 @@ mod tests {
         m.specular_reflectance = [0.0; 3];
         m.diffuse[1] = f64::NAN;
         assert!(check(&m).unwrap().contains("outside [0, 1]"));
+        let mut lamp = Material { two_sided: true, emission: [1.0, 0.0, 0.0], ..default_material() };
+        assert!(check(&lamp).unwrap().contains("cannot be two-sided"));
+        lamp.emission = [0.0; 3];
+        assert_eq!(check(&lamp), None);
     }
 }

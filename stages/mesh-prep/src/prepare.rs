@@ -11,7 +11,7 @@ use crate::scene::{Light, MeshFile, Scene};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
-use schemas::mesh::{Camera, Effects, GoniometricLight, Material, MeshStatistics, Triangle};
+use schemas::mesh::{cyclic, reversed, Camera, Effects, GoniometricLight, Material, MeshStatistics, Triangle};
 use schemas::Error;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -213,7 +213,8 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
     if raw.is_empty() {
         return Err(Error::invalid(scene_path, None, "the scene has no triangles"));
     }
-    let built = build_mesh(&raw, params);
+    let two_sided: Vec<bool> = materials.iter().map(|m| m.two_sided).collect();
+    let built = build_mesh(&raw, &two_sided, params);
     let Some(built) = built else {
         return Err(Error::invalid(scene_path, None, "every triangle of the scene is degenerate"));
     };
@@ -311,8 +312,11 @@ struct Built {
     statistics: MeshStatistics,
 }
 
-/// Recentres, welds and filters the raw triangles. `None` if none is left.
-fn build_mesh(raw: &[RawTriangle], params: &Params) -> Option<Built> {
+/// Recentres, welds and filters the raw triangles, and gives every kept
+/// triangle of a two-sided material (`two_sided[material]`) its twin, the
+/// same vertices wound the other way, appended after the input's
+/// triangles. `None` if none is left.
+fn build_mesh(raw: &[RawTriangle], two_sided: &[bool], params: &Params) -> Option<Built> {
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for p in raw.iter().flat_map(|t| t.corners) {
         lo = lo.min(p);
@@ -345,11 +349,18 @@ fn build_mesh(raw: &[RawTriangle], params: &Params) -> Option<Built> {
             continue;
         }
         // The same three vertices in the same cyclic order: a duplicate.
-        // Reversed order is the back of the surface, and is kept.
-        let first = (0..3).min_by_key(|&i| v[i]).unwrap_or(0);
-        if !seen.insert([v[first], v[(first + 1) % 3], v[(first + 2) % 3]]) {
+        // Reversed order is the back of the surface, and is kept, except
+        // for a two-sided triangle, whose back is its twin: one whose
+        // front or back is already taken is a duplicate, and it takes both.
+        let (face, back) = (cyclic(v), cyclic(reversed(v)));
+        let both = two_sided[t.material as usize];
+        if seen.contains(&face) || (both && seen.contains(&back)) {
             statistics.duplicates_dropped += 1;
             continue;
+        }
+        seen.insert(face);
+        if both {
+            seen.insert(back);
         }
         triangles.push(Triangle {
             vertices: v,
@@ -362,6 +373,13 @@ fn build_mesh(raw: &[RawTriangle], params: &Params) -> Option<Built> {
     if triangles.is_empty() {
         return None;
     }
+    let twins: Vec<Triangle> = triangles
+        .iter()
+        .filter(|t| two_sided[t.material as usize])
+        .map(|t| Triangle { vertices: reversed(t.vertices), normal: t.normal.map(|n| -n), ..*t })
+        .collect();
+    statistics.two_sided_twins = twins.len();
+    triangles.extend(twins);
     statistics.triangles = triangles.len();
     statistics.vertices = positions.len();
     statistics.bounds_min = (lo - origin).to_array();

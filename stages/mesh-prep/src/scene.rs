@@ -7,7 +7,7 @@
 //! | `meshes` | list of `Obj(file, scale, translate)` | OBJ files, relative to the scene file; world = scale * p + translate | required |
 //! | `camera` | `Camera(eye, target, up, vertical_fov_deg, width, height)` | pinhole camera, world frame | required |
 //! | `lights` | list of `Area(..)` / `Goniometric(..)` | lights added to the meshes' emitters | `[]` |
-//! | `materials` | map name -> `Override(..)` | per-material changes to the MTL values | `{}` |
+//! | `materials` | map name -> `Override(..)` | per-material changes to the MTL values (`diffuse`, `emission`, ..., `two_sided: Some(true)`) | `{}` |
 
 use schemas::mesh::Camera;
 use serde::Deserialize;
@@ -105,4 +105,7 @@ pub struct MaterialOverride {
     pub normal_map: Option<String>,
     /// Diffuse texture file.
     pub diffuse_map: Option<String>,
+    /// Both faces reflect (leaves, paper): `true` gives each triangle a
+    /// reversed twin ([`schemas::mesh::Material::two_sided`]).
+    pub two_sided: Option<bool>,
 }

@@ -1,6 +1,20 @@
 //! Ray casting over the scene's triangles with obvhs's compressed wide BVH
 //! (CWBVH, Ylitie et al. 2017), f32 in the mesh frame (which `mesh-prep`
 //! centres on the origin, so f32 keeps its precision).
+//!
+//! # Twins
+//!
+//! Two triangles with the same three corners wound opposite ways are
+//! *twins*: the two faces of one two-sided surface (`mesh-prep` makes them
+//! for two-sided materials; a model may also hold both windings). A ray
+//! meets both at the same `t`, the front of one and the back of the other,
+//! so which it reports would be a tie decided by traversal order. Rays
+//! therefore ignore the back face of a triangle that has a twin (they see
+//! the twin's front there, the face whose radiosity belongs to that side),
+//! and skipping a triangle skips its twin too (a segment that starts on one
+//! face must not be stopped by the other face at `t = 0`). Triangles
+//! without a twin are hit from both sides, as before: their back faces
+//! occlude.
 
 use glam::{DVec3, Vec3A};
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
@@ -8,6 +22,7 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+use std::collections::HashMap;
 use std::time::Duration;
 
 /// The nearest surface along a ray.
@@ -26,6 +41,30 @@ pub struct SceneRays {
     ordered: Vec<Triangle>,
     /// Mesh triangle index of each BVH primitive.
     mesh_index: Vec<u32>,
+    /// Per BVH primitive: the front normal (unnormalised) of a triangle
+    /// that has a twin, whose back face rays ignore; `None` otherwise.
+    culled_normal: Vec<Option<Vec3A>>,
+    /// Per mesh triangle: its twin's mesh index, if it has one.
+    twin: Vec<Option<u32>>,
+}
+
+/// Each triangle's twin (see the module documentation): the triangle with
+/// the same corners, bit for bit in f32, wound the other way.
+pub fn twins(triangles: &[Triangle]) -> Vec<Option<u32>> {
+    let bits = |p: Vec3A| p.to_array().map(f32::to_bits);
+    // A corner cycle, rotated to start at its smallest corner: the same
+    // for one winding whichever corner it starts at.
+    let cycle = |c: [[u32; 3]; 3]| {
+        let first = (0..3).min_by_key(|&i| c[i]).unwrap_or(0);
+        [c[first], c[(first + 1) % 3], c[(first + 2) % 3]]
+    };
+    let corners: Vec<[[u32; 3]; 3]> = triangles.iter().map(|t| [bits(t.v0), bits(t.v1), bits(t.v2)]).collect();
+    let mut first_of: HashMap<[[u32; 3]; 3], u32> = HashMap::with_capacity(triangles.len());
+    for (i, c) in corners.iter().enumerate() {
+        first_of.entry(cycle(*c)).or_insert(i as u32);
+    }
+    let twin_of = |(i, c): (usize, &[[u32; 3]; 3])| first_of.get(&cycle([c[0], c[2], c[1]])).copied().filter(|&j| j as usize != i);
+    corners.iter().enumerate().map(twin_of).collect()
 }
 
 fn vec3a(p: DVec3) -> Vec3A {
@@ -39,9 +78,31 @@ impl SceneRays {
         let tris: Vec<Triangle> =
             triangles.iter().map(|t| Triangle { v0: vec3a(t[0]), v1: vec3a(t[1]), v2: vec3a(t[2]) }).collect();
         let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
-        let ordered = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
+        let twin = twins(&tris);
+        let ordered: Vec<Triangle> = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
         let mesh_index = bvh.primitive_indices.clone();
-        SceneRays { bvh, ordered, mesh_index }
+        let culled_normal =
+            mesh_index.iter().zip(&ordered).map(|(&i, t)| twin[i as usize].map(|_| (t.v1 - t.v0).cross(t.v2 - t.v0))).collect();
+        SceneRays { bvh, ordered, mesh_index, culled_normal, twin }
+    }
+
+    /// The mesh triangle `i`'s twin, if it has one.
+    pub fn twin(&self, i: u32) -> Option<u32> {
+        self.twin[i as usize]
+    }
+
+    /// `t` of the ray's hit on BVH primitive `id`, or infinity where the
+    /// primitive is skipped (it or its twin is in `skip`) or shows the ray
+    /// a twin's back face.
+    fn intersect(&self, ray: &Ray, id: usize, skip: [u32; 2]) -> f32 {
+        let mesh = self.mesh_index[id];
+        let skipped = skip.contains(&mesh) || self.twin[mesh as usize].is_some_and(|t| skip.contains(&t));
+        let back_of_twin = self.culled_normal[id].is_some_and(|n| ray.direction.dot(n) > 0.0);
+        if skipped || back_of_twin {
+            f32::INFINITY
+        } else {
+            self.ordered[id].intersect(ray)
+        }
     }
 
     /// The nearest hit along `origin + t direction` for `t` in
@@ -49,13 +110,7 @@ impl SceneRays {
     pub fn closest_hit(&self, origin: DVec3, direction: DVec3, t_min: f32, t_max: f32, skip: [u32; 2]) -> Option<Hit> {
         let ray = Ray::new(vec3a(origin), vec3a(direction), t_min, t_max);
         let mut hit = RayHit::none();
-        let found = self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
-            if skip.contains(&self.mesh_index[id]) {
-                f32::INFINITY
-            } else {
-                self.ordered[id].intersect(ray)
-            }
-        });
+        let found = self.bvh.ray_traverse(ray, &mut hit, |ray, id| self.intersect(ray, id, skip));
         found.then(|| Hit { triangle: self.mesh_index[hit.primitive_id as usize], t: hit.t })
     }
 
@@ -82,13 +137,7 @@ impl SceneRays {
             return true;
         }
         let ray = Ray::new(vec3a(from), vec3a(d / length), (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32);
-        self.bvh.ray_traverse_miss(ray, |ray, id| {
-            if skip.contains(&self.mesh_index[id]) {
-                f32::INFINITY
-            } else {
-                self.ordered[id].intersect(ray)
-            }
-        })
+        self.bvh.ray_traverse_miss(ray, |ray, id| self.intersect(ray, id, skip))
     }
 }
 
@@ -115,5 +164,31 @@ mod tests {
         assert!(!rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 3.0), [u32::MAX; 2]));
         assert!(rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 0.9), [u32::MAX; 2]));
         assert!(rays.closest_hit(dvec3(5.0, 5.0, 0.0), DVec3::Z, 0.0, f32::INFINITY, [u32::MAX; 2]).is_none());
+    }
+
+    #[test]
+    fn a_ray_sees_the_face_of_a_twin_pair_that_faces_it() {
+        let front = quad(1.0, 1.0);
+        let back = front.map(|[a, b, c]| [b, a, c]);
+        // Twins listed in both orders, after an unpaired triangle, so that
+        // neither the index order nor the BVH order can decide the tie.
+        let mut tris = vec![[dvec3(5.0, 5.0, 0.0), dvec3(6.0, 5.0, 0.0), dvec3(5.0, 6.0, 0.0)], front[0], back[0]];
+        tris.extend([back[1], front[1]]);
+        let rays = SceneRays::new(&tris);
+        assert_eq!([0, 1, 2, 3, 4].map(|i| rays.twin(i)), [None, Some(2), Some(1), Some(4), Some(3)]);
+        for x in [-0.5, 0.5] {
+            let up = rays.closest_hit(dvec3(x, 0.3, 0.0), DVec3::Z, 0.0, f32::INFINITY, [u32::MAX; 2]).unwrap();
+            assert!([2, 3].contains(&up.triangle), "from below the back twins face the ray: {up:?}");
+            // Tilted: obvhs's Moller-Trumbore can miss on a -0.0 barycentric.
+            let down = rays.closest_hit(dvec3(x, 0.3, 2.0), dvec3(0.01, 0.02, -1.0).normalize(), 0.0, f32::INFINITY, [u32::MAX; 2]).unwrap();
+            assert!([1, 4].contains(&down.triangle), "from above the front ones do: {down:?}");
+            // Skipping one face skips its twin: a segment that starts a
+            // hair behind its own surface (rounding) is not stopped by the
+            // other face, which faces it.
+            let own = if x < 0.0 { [4, u32::MAX] } else { [1, u32::MAX] };
+            let below = dvec3(x, 0.3, 1.0 - 1e-4);
+            assert!(rays.segment_clear(below, below + DVec3::Z, own));
+            assert!(!rays.segment_clear(below, below + DVec3::Z, [u32::MAX; 2]), "the pair occludes");
+        }
     }
 }

@@ -13,18 +13,7 @@ use schemas::solution::{Element, Link, Node, Solution, NONE};
 use std::path::Path;
 
 fn material(name: &str, diffuse: f64, emission: f64) -> Material {
-    let black = [0.0; 3];
-    Material {
-        name: name.into(),
-        diffuse: [diffuse; 3],
-        emission: [emission; 3],
-        specular_reflectance: black,
-        specular_transmittance: black,
-        diffuse_transmittance: black,
-        diffuse_map: None,
-        alpha_map: None,
-        normal_map: None,
-    }
+    Material::diffuse(name, [diffuse; 3], [emission; 3])
 }
 
 /// A 2 m floor (material 0, rho 0.5) under a 0.4 m square emitter facing
