@@ -5,7 +5,8 @@
 //! Names: `cornell-box` (the classic box), and with a triangle count
 //! (`10k`, `100k`, `1m`, or a plain number): `cornell-box-4k` (the box,
 //! tessellated), `plants-100k`, `sphere-20k`, `box-100k` (see
-//! [`crate::procedural`]).
+//! [`crate::procedural`]); `simple-environment` (paper 002's simple
+//! environment, [`crate::procedural::SimpleEnvironment`]).
 
 use crate::text::TextSource;
 use crate::procedural;
@@ -41,7 +42,7 @@ impl FromStr for Builtin {
     type Err = String;
 
     fn from_str(name: &str) -> Result<Self, Self::Err> {
-        let known = "cornell-box, cornell-box-<n>, plants-<n>, sphere-<n>, box-<n> (n like 10k, 100k, 1m)";
+        let known = "cornell-box, cornell-box-<n>, simple-environment, plants-<n>, sphere-<n>, box-<n> (n like 10k, 100k, 1m)";
         let (kind, count) = match name.rsplit_once('-') {
             Some((kind, count)) if parse_count(count).is_some() => (kind, parse_count(count)),
             _ => (name, None),
@@ -57,6 +58,7 @@ impl FromStr for Builtin {
                     file("cornell_box.mtl", CORNELL_MTL.into()),
                 ]
             }
+            ("simple-environment", None) => generated(procedural::simple_environment(), "simple"),
             ("plants", Some(n)) => generated(procedural::plants(n), "plants"),
             ("sphere", Some(n)) => generated(procedural::sphere(n), "sphere"),
             ("box", Some(n)) => generated(procedural::closed_box(n), "box"),

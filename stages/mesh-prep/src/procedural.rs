@@ -12,6 +12,9 @@
 //!   0.8, an emitting square in the ceiling.
 //! - `cornell-box` with a size: the built-in Cornell box with every
 //!   triangle split 1:4 until it has at least that many.
+//! - `simple-environment`: paper 002's "simple" environment (Sec. 2.3,
+//!   Table 1), a light, a receiver A opposite it and a receiver B beside
+//!   the light that only A lights ([`SimpleEnvironment`]).
 
 use radiometry::sampling::Stream;
 use std::f64::consts::PI;
@@ -102,6 +105,84 @@ fn scene_text(obj_file: &str, eye: [f64; 3], target: [f64; 3], up: [f64; 3], fov
         "Scene(\n  meshes: [Obj(file: \"{obj_file}\")],\n  camera: Camera(eye: ({}, {}, {}), target: ({}, {}, {}), up: ({}, {}, {}), vertical_fov_deg: {fov}, width: 256, height: 256),\n)\n",
         eye[0], eye[1], eye[2], target[0], target[1], target[2], up[0], up[1], up[2]
     )
+}
+
+/// Paper 002's "simple" environment (Sec. 2.2-2.3, Figure 1, Table 1): a
+/// square diffuse light LS on the floor plane facing up, a receiver A on
+/// the ceiling plane directly opposite it facing down, and a receiver B on
+/// the floor plane beside LS facing up. LS and B are coplanar, so B gets no
+/// light from LS directly, only what A reflects: the paper's one-bounce
+/// configuration (as in the end-to-end tests' `one_bounce` scene, at the
+/// paper's sizes). World frame: metres, z up; planes z = 0 and z = `height`.
+///
+/// Table 1 gives areas, power, "aspect ratio 2.2", "offset of LS 1.2" and
+/// 200 x 200 pixels; the paper is ambiguous about the rest, so this is a
+/// fixed choice:
+/// - LS is a 3 x 3 square (area 9) centred on the origin; A and B are 5 x 5
+///   squares (area 25).
+/// - "Aspect ratio" is read as Howell's dimensionless ratio for parallel
+///   plates (side over separation, X = a / c, [SiHo72] being the paper's
+///   source of configuration factors): A's side 5 over the planes'
+///   separation, so `height` = 5 / 2.2.
+/// - "Offset of LS" is read as the gap between LS's edge and B's edge in
+///   their common plane: B spans x in [1.5 + 1.2, 1.5 + 1.2 + 5].
+/// - A is centred over LS ("directly opposing" it, Sec. 2.2).
+/// - Power 12 per channel over area 9: exitance 12 / 9 W/m² per channel.
+///   LS is black (it reflects nothing of what A sends back).
+/// - Reflectances, which the paper does not give: 0.8 grey for A and B
+///   (white paint), so that the reflected light the paper studies is as
+///   large as a plain diffuse surface makes it.
+/// - Camera (200 x 200, 70 degrees vertical field of view): between the
+///   planes at mid-height, 3.5 m in front of A's and B's near edges
+///   (y = -2.5), looking along +y at the middle of LS, the gap and B, so
+///   both receivers' fronts fill the view from their near edges back.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimpleEnvironment {
+    /// LS's corners, counter-clockwise seen from its front (+z), m.
+    pub light: [[f64; 3]; 4],
+    /// A's corners, counter-clockwise seen from its front (-z), m.
+    pub a: [[f64; 3]; 4],
+    /// B's corners, counter-clockwise seen from its front (+z), m.
+    pub b: [[f64; 3]; 4],
+    /// LS's emitted radiosity (exitance), W/m² per channel.
+    pub emission: f64,
+    /// A's diffuse reflectance.
+    pub rho_a: f64,
+    /// B's diffuse reflectance.
+    pub rho_b: f64,
+    /// The separation of the two planes, m.
+    pub height: f64,
+}
+
+const SIMPLE_HEIGHT: f64 = 5.0 / 2.2;
+
+/// The simple environment's fixed geometry ([`SimpleEnvironment`]).
+pub const SIMPLE_ENVIRONMENT: SimpleEnvironment = SimpleEnvironment {
+    light: [[-1.5, -1.5, 0.0], [1.5, -1.5, 0.0], [1.5, 1.5, 0.0], [-1.5, 1.5, 0.0]],
+    a: [[-2.5, -2.5, SIMPLE_HEIGHT], [-2.5, 2.5, SIMPLE_HEIGHT], [2.5, 2.5, SIMPLE_HEIGHT], [2.5, -2.5, SIMPLE_HEIGHT]],
+    b: [[2.7, -2.5, 0.0], [7.7, -2.5, 0.0], [7.7, 2.5, 0.0], [2.7, 2.5, 0.0]],
+    emission: 12.0 / 9.0,
+    rho_a: 0.8,
+    rho_b: 0.8,
+    height: SIMPLE_HEIGHT,
+};
+
+/// The simple environment as `(scene, obj, mtl)`: objects `LS`, `A`, `B`
+/// (materials `light`, `upper`, `lower`), LS's exitance set in the scene
+/// file (MTL's `Ke` is radiance).
+pub fn simple_environment() -> (String, String, String) {
+    let s = SIMPLE_ENVIRONMENT;
+    let mut obj = ObjWriter::default();
+    for (name, material, corners) in [("LS", "light", s.light), ("A", "upper", s.a), ("B", "lower", s.b)] {
+        obj.object(name, material);
+        obj.polygon(&corners);
+    }
+    let mtl = format!("newmtl light\nKd 0 0 0\n\nnewmtl upper\nKd {a} {a} {a}\n\nnewmtl lower\nKd {b} {b} {b}\n", a = s.rho_a, b = s.rho_b);
+    let (mid, e) = (0.5 * s.height, s.emission);
+    let scene = format!(
+        "Scene(\n  meshes: [Obj(file: \"simple.obj\")],\n  camera: Camera(eye: (2.6, -6.0, {mid:?}), target: (2.6, 0.0, {mid:?}), up: (0.0, 0.0, 1.0), vertical_fov_deg: 70.0, width: 200, height: 200),\n  materials: {{ \"light\": (emission: Some(({e:?}, {e:?}, {e:?}))) }},\n)\n"
+    );
+    (scene, obj.finish("simple.mtl"), mtl)
 }
 
 /// The closed box of `triangles` triangles: `(scene, obj, mtl)`.
@@ -209,6 +290,10 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
 fn normalize(a: [f64; 3]) -> [f64; 3] {
     let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
     a.map(|x| x / l)
@@ -313,6 +398,23 @@ mod tests {
             let inward: f64 = (0..3).map(|k| n[k] * (centre[k] - middle[k])).sum();
             assert!(inward > 0.0, "face at {o:?} faces out");
         }
+    }
+
+    /// Table 1's figures, from the corners: areas 9, 25, 25, power 12,
+    /// aspect ratio 2.2 (A's side over the separation), offset 1.2 (LS's
+    /// edge to B's); LS and B share a plane, so B sees none of LS.
+    #[test]
+    fn simple_environment_has_table_1_figures() {
+        let s = SIMPLE_ENVIRONMENT;
+        // A planar quadrilateral's area: half the length of its diagonals' cross product.
+        let area = |c: [[f64; 3]; 4]| 0.5 * cross(sub(c[2], c[0]), sub(c[3], c[1])).iter().map(|x| x * x).sum::<f64>().sqrt();
+        let normal_z = |c: [[f64; 3]; 4]| cross(sub(c[1], c[0]), sub(c[2], c[0]))[2].signum();
+        assert!((area(s.light) - 9.0).abs() < 1e-12 && (area(s.a) - 25.0).abs() < 1e-12 && (area(s.b) - 25.0).abs() < 1e-12);
+        assert!((s.emission * area(s.light) - 12.0).abs() < 1e-12);
+        assert_eq!((normal_z(s.light), normal_z(s.a), normal_z(s.b)), (1.0, -1.0, 1.0));
+        assert!(((s.a[2][0] - s.a[0][0]) / (s.a[0][2] - s.light[0][2]) - 2.2).abs() < 1e-12);
+        assert!((s.b[0][0] - s.light[1][0] - 1.2).abs() < 1e-12);
+        assert!(s.light.iter().chain(&s.b).all(|p| p[2] == 0.0) && s.a.iter().all(|p| p[2] == s.height));
     }
 
     #[test]
