@@ -1,1 +1,642 @@
-//! x
+//! # photon-trace: paper 001's progressive hybrid solver
+//!
+//! "A progressive global illumination solution considering perceptual
+//! factors" (paper 001, `shared/papers/001_*.txt`) in three stages, each
+//! leaving a displayable solution:
+//!
+//! 1. **Stochastic** ([`tracing`]): photons from every emitter, bucketed
+//!    into the vertices of the leaf mesh ([`mesh`]), every hit deposited,
+//!    the estimates filtered over a kd-tree of the vertices with a radius
+//!    that shrinks as each vertex's variance falls ([`filter`]), until
+//!    `preview_photons`.
+//! 2. **Deterministic direct light** ([`direct`]): Lambert's formula with
+//!    ray-cast visibility for area lights, `I cos / r²` for goniometric
+//!    ones, at every vertex, on a mesh split where the perceived brightness
+//!    (Stevens' power law over direct plus the stage-1 indirect estimate,
+//!    [`perceptual`]) differs across a leaf by more than a threshold.
+//! 3. **Stochastic indirect**: photons again, their first hits no longer
+//!    deposited (the direct light is exact now), into fresh tallies on the
+//!    split mesh ([`tally`]), until every vertex's estimated relative error
+//!    is under `target_error`, or `max_photons`, or `time_budget_s`.
+//!
+//! Stage 3 starts its tallies afresh: the stage-1 deposits are hat-weighted
+//! projections onto the leaves as they were then, and splitting a leaf
+//! changes its corners' hat functions, so those sums no longer estimate
+//! anything on the new mesh (the paper, too, "replaces the finished direct
+//! computations with additional stochastic particle tracing"). Stage 1 is
+//! short by default; it serves the first images and the adaptation of
+//! stage 2.
+//!
+//! Radiosity at a vertex is `B = M + rho (E_direct + E_indirect)` (stage 1:
+//! `M + rho E`), per channel; an element's radiosity in `solution.exr` is
+//! the mean of its corners' (the mean of the linear interpolant), so
+//! grid-gather renders it as any solution.
+//!
+//! Reproducible: photons come in rounds of `batches_per_round` batches of
+//! `batch_photons`; batch `i` of stage `s` draws from its own stream
+//! `(seed, s, i)`; batches are traced in parallel and added in index
+//! order; every stop test runs between rounds. So a run gives the same
+//! bits at any thread count, unless it stops on `time_budget_s`.
+
+pub mod direct;
+pub mod filter;
+pub mod mesh;
+pub mod perceptual;
+pub mod tally;
+pub mod tracing;
+
+use direct::{AreaLight, DirectScene};
+use filter::{Estimates, VertexTree};
+use glam::DVec3;
+use mesh::{Elements, PointKey, Vertices};
+use radiometry::color::luminance;
+use radiometry::geometry::{mesh_triangles, TriangleGeometry};
+use radiometry::photometry::{DirectLight, Luminaire};
+use radiometry::rays::SceneRays;
+use radiometry::sampling::Stream;
+use rayon::prelude::*;
+use schemas::mesh::{Manifest, Mesh};
+use schemas::solution::Element;
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::time::Instant;
+use tally::Tally;
+use tracing::{Deposit, Emitters, Scene};
+
+/// The solver's parameters (the stage's `--params` file).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// Seed of every photon and shadow ray.
+    pub seed: u64,
+    /// Photons per batch (the unit of the variance estimate).
+    pub batch_photons: usize,
+    /// Batches per round (traced in parallel; stop tests between rounds).
+    pub batches_per_round: usize,
+    /// Photons of stage 1 (every hit deposited), a whole number of rounds
+    /// (rounded up).
+    pub preview_photons: u64,
+    /// Stage 3 stops once every vertex's estimated relative standard error
+    /// of radiosity is under this (see [`Params::relative_floor`]).
+    pub target_error: f64,
+    /// Stage 3 stops after this many photons whatever the error.
+    pub max_photons: u64,
+    /// Stage 3 stops after this many seconds of the whole run (makes the
+    /// result depend on the machine); none by default.
+    pub time_budget_s: Option<f64>,
+    /// A vertex's error is relative to its radiosity, or to this fraction of
+    /// the scene's area-mean radiosity where that is larger (dark corners
+    /// would otherwise never converge).
+    pub relative_floor: f64,
+    /// Corners (and filter neighbours) whose normals differ by more than
+    /// this, degrees, are not one vertex (do not filter into each other).
+    pub crease_angle_deg: f64,
+    /// Largest filter radius, as a fraction of the scene's bounding-box
+    /// diagonal; 0 turns filtering off.
+    pub filter_radius: f64,
+    /// Shadow rays per vertex and emitting triangle in the direct pass.
+    pub visibility_rays: usize,
+    /// Split a leaf when its corners' Stevens brightness differs by more
+    /// than this (brightness 1 = the adaptation luminance).
+    pub brightness_threshold: f64,
+    /// Exponent of Stevens' power law.
+    pub stevens_exponent: f64,
+    /// Splitting passes at most (each splits every leaf over the threshold
+    /// once).
+    pub max_splits: u32,
+    /// Smallest element area, as a fraction of the scene's total area.
+    pub min_area: f64,
+    /// Bounces after which a photon is dropped.
+    pub max_bounces: u32,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            seed: 1,
+            batch_photons: 4096,
+            batches_per_round: 16,
+            preview_photons: 65_536,
+            target_error: 0.005,
+            max_photons: 1 << 24,
+            time_budget_s: None,
+            relative_floor: 0.1,
+            crease_angle_deg: 45.0,
+            filter_radius: 0.05,
+            visibility_rays: 16,
+            brightness_threshold: 0.05,
+            stevens_exponent: 1.0 / 3.0,
+            max_splits: 6,
+            min_area: 1e-4,
+            max_bounces: 1000,
+        }
+    }
+}
+
+impl Params {
+    /// What is wrong with these parameters, if anything.
+    pub fn problem(&self) -> Option<String> {
+        let positive = [
+            ("target_error", self.target_error),
+            ("relative_floor", self.relative_floor),
+            ("brightness_threshold", self.brightness_threshold),
+            ("stevens_exponent", self.stevens_exponent),
+            ("min_area", self.min_area),
+        ];
+        if let Some((name, value)) = positive.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+            return Some(format!("{name} must be a positive number, not {value}"));
+        }
+        if !(self.filter_radius.is_finite() && self.filter_radius >= 0.0) {
+            return Some(format!("filter_radius must be a number >= 0, not {}", self.filter_radius));
+        }
+        if !(self.crease_angle_deg.is_finite() && (0.0..=180.0).contains(&self.crease_angle_deg)) {
+            return Some(format!("crease_angle_deg must be in 0..180, not {}", self.crease_angle_deg));
+        }
+        if let Some(t) = self.time_budget_s.filter(|t| !(t.is_finite() && *t > 0.0)) {
+            return Some(format!("time_budget_s must be a positive number, not {t}"));
+        }
+        let counts = [
+            ("batch_photons", self.batch_photons as u64),
+            ("preview_photons", self.preview_photons),
+            ("max_photons", self.max_photons),
+            ("visibility_rays", self.visibility_rays as u64),
+            ("max_bounces", u64::from(self.max_bounces)),
+        ];
+        if let Some((name, _)) = counts.iter().find(|(_, v)| *v == 0) {
+            return Some(format!("{name} must be at least 1, not 0"));
+        }
+        if self.batches_per_round < 2 {
+            return Some(format!("batches_per_round must be at least 2 (the variance needs two batches), not {}", self.batches_per_round));
+        }
+        None
+    }
+}
+
+/// The stage a solution comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Stage 1: photons, every hit.
+    Stochastic,
+    /// Stage 2 done: exact direct light plus the stage-1 indirect estimate.
+    Direct,
+    /// Stage 3: exact direct light plus photons' indirect light.
+    Indirect,
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Stage::Stochastic => "stochastic",
+            Stage::Direct => "direct",
+            Stage::Indirect => "indirect",
+        })
+    }
+}
+
+/// A displayable state of the solution.
+pub struct Snapshot {
+    /// Its stage.
+    pub stage: Stage,
+    /// Photons traced in that stage so far.
+    pub photons: u64,
+    /// Seconds since the solve started (volatile).
+    pub seconds: f64,
+    /// Largest estimated relative error of a vertex's radiosity.
+    pub max_error: f64,
+    /// The elements with their radiosity.
+    pub elements: Vec<Element>,
+}
+
+/// One point of the error-against-time curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Progress {
+    /// Stage.
+    pub stage: Stage,
+    /// Photons traced in that stage so far.
+    pub photons: u64,
+    /// Seconds since the solve started (volatile).
+    pub seconds: f64,
+    /// Largest estimated relative error of a vertex's radiosity.
+    pub max_error: f64,
+    /// Area-weighted mean over vertices of that error.
+    pub mean_error: f64,
+}
+
+/// Work done.
+#[derive(Clone, Debug, Default)]
+pub struct Work {
+    /// Photons of stage 1.
+    pub stage1_photons: u64,
+    /// Photons of stage 3.
+    pub stage3_photons: u64,
+    /// Photon rays cast.
+    pub photon_rays: u64,
+    /// Shadow rays of the direct pass.
+    pub direct_rays: u64,
+    /// Photons dropped at the bounce limit.
+    pub capped_photons: u64,
+    /// Leaves split by the perceptual criterion.
+    pub splits: u64,
+    /// Elements, leaves and vertices of the final mesh.
+    pub elements: usize,
+    /// Leaves.
+    pub leaves: usize,
+    /// Vertices.
+    pub vertices: usize,
+    /// Seconds to the end of stage 1's first round (first displayable
+    /// solution), of stage 1, of stage 2, of stage 3 (volatile).
+    pub first_image_s: f64,
+    /// End of stage 1.
+    pub stage1_s: f64,
+    /// End of stage 2.
+    pub direct_s: f64,
+    /// End of stage 3.
+    pub final_s: f64,
+    /// Whether stage 3 reached the target error.
+    pub converged: bool,
+    /// Why stage 3 stopped.
+    pub stopped_by: &'static str,
+    /// The error against time, a point per round (power-of-two round
+    /// numbers, and the last of each stage).
+    pub curve: Vec<Progress>,
+}
+
+/// The result: the leaf mesh's radiosity as elements, and the work done.
+pub struct Solved {
+    /// Elements with radiosity.
+    pub elements: Vec<Element>,
+    /// Per vertex: unfiltered and filtered indirect (stage 3) irradiance,
+    /// W/m² luminance, for tests of the filter.
+    pub vertex_irradiance: Vec<(f64, f64)>,
+    /// Work done.
+    pub work: Work,
+}
+
+/// What the caller hears while the solve runs.
+pub struct Observer<'a> {
+    /// Called after every round and at each stage's end.
+    pub progress: &'a mut dyn FnMut(&Progress),
+    /// Snapshot every this many photons of a stochastic stage (0: none),
+    /// rounded to whole rounds.
+    pub snapshot_every: u64,
+    /// Called with each snapshot: at every `snapshot_every` photons, at the
+    /// end of stage 1 and of stage 2. An error ends the solve.
+    pub snapshot: &'a mut dyn FnMut(&Snapshot) -> Result<(), String>,
+}
+
+/// The scene, read-only, with what every stage derives from it.
+struct Setup<'a> {
+    mesh: &'a Mesh,
+    manifest: &'a Manifest,
+    geometry: Vec<TriangleGeometry>,
+    rays: SceneRays,
+    luminaires: Vec<Luminaire>,
+    emitters: Emitters,
+    area_lights: Vec<AreaLight>,
+    total_area: f64,
+    diagonal: f64,
+}
+
+/// The leaf mesh in its current state, with everything per vertex.
+struct State {
+    elements: Elements,
+    vertices: Vertices,
+    tree: VertexTree,
+}
+
+impl State {
+    fn new(setup: &Setup, elements: Elements, cos_crease: f64) -> Self {
+        let vertices = Vertices::new(setup.mesh, &setup.geometry, &elements, cos_crease);
+        let tree = VertexTree::new(&vertices.position);
+        State { elements, vertices, tree }
+    }
+
+    fn material<'a>(&self, setup: &Setup<'a>, v: usize) -> &'a schemas::mesh::Material {
+        &setup.manifest.materials[self.vertices.material[v] as usize]
+    }
+}
+
+/// Radiosity `M + rho E` per channel.
+fn radiosity(m: &schemas::mesh::Material, e: [f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|c| m.emission[c] + m.diffuse[c] * e[c])
+}
+
+/// Solves the scene (module documentation). Errors are messages about the
+/// scene (no emitter) or from the snapshot writer.
+pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut Observer) -> Result<Solved, String> {
+    let started = Instant::now();
+    let geometry = mesh_triangles(mesh);
+    let luminaires = Luminaire::all(&manifest.goniometric_lights)?;
+    let Some(emitters) = Emitters::new(mesh, manifest, &geometry, &luminaires) else {
+        return Err("the scene has no emitter: no material emits and no goniometric light has flux; nothing to trace".into());
+    };
+    let corners: Vec<[DVec3; 3]> = geometry.iter().map(|g| g.corners).collect();
+    let area_lights = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .filter(|(t, tri)| geometry[*t].area > 0.0 && manifest.materials[tri.material as usize].emission.iter().any(|&m| m > 0.0))
+        .map(|(t, tri)| AreaLight { triangle: t as u32, exitance: manifest.materials[tri.material as usize].emission })
+        .collect();
+    let (lo, hi) = corners.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let setup = Setup {
+        mesh,
+        manifest,
+        total_area: geometry.iter().map(|g| g.area).sum(),
+        diagonal: (hi - lo).length(),
+        rays: SceneRays::new(&corners),
+        geometry,
+        luminaires,
+        emitters,
+        area_lights,
+    };
+    let cos_crease = params.crease_angle_deg.to_radians().cos();
+    let mut work = Work::default();
+    let clock = || started.elapsed().as_secs_f64();
+
+    // Stage 1: every hit.
+    let mut state = State::new(&setup, Elements::new(mesh), cos_crease);
+    let mut all = Tally::new(&state.vertices.hat_area, params.batch_photons);
+    let mut indirect = Tally::new(&state.vertices.hat_area, params.batch_photons);
+    let no_direct = vec![[0.0; 3]; state.vertices.len()];
+    let mut round = 0u64;
+    loop {
+        let batch = trace_round(&setup, &state, params, 1, round, Deposit::All, &mut work);
+        for b in &batch {
+            all.add(b, true);
+            indirect.add(b, false);
+        }
+        round += 1;
+        if round == 1 {
+            work.first_image_s = clock();
+        }
+        let done = all.photons() >= params.preview_photons;
+        let (mean, errors) = estimate(&setup, &state, &no_direct, &all, params);
+        let p = progress(Stage::Stochastic, all.photons(), clock(), &state, &errors);
+        report_round(&mut work, observer, &p, round, done);
+        if snapshot_due(observer, params, round, done) || done {
+            let b = vertex_radiosity(&setup, &state, &no_direct, &filtered(&setup, &state, &mean, &errors, params));
+            let elements = element_radiosity(&state, &b);
+            (observer.snapshot)(&Snapshot { stage: Stage::Stochastic, photons: all.photons(), seconds: clock(), max_error: p.max_error, elements })?;
+        }
+        if done {
+            break;
+        }
+    }
+    work.stage1_photons = all.photons();
+    work.stage1_s = clock();
+
+    // Stage 2: direct light on a perceptually split mesh. The stage-1
+    // indirect estimate (filtered) sets the adaptation; split leaves carry
+    // it down by linear interpolation of their corners.
+    let (mean, errors) = estimate(&setup, &state, &no_direct, &indirect, params);
+    let indirect_now = filtered(&setup, &state, &mean, &errors, params);
+    let mut corner_indirect: Vec<[[f64; 3]; 3]> = state.vertices.of_element.iter().map(|c| c.map(|v| if v == u32::MAX { [0.0; 3] } else { indirect_now[v as usize] })).collect();
+    let direct_scene = DirectScene {
+        geometry: &setup.geometry,
+        rays: &setup.rays,
+        area_lights: &setup.area_lights,
+        luminaires: DirectLight { lights: &setup.luminaires, rays: &setup.rays },
+        visibility_rays: params.visibility_rays,
+        seed: params.seed,
+    };
+    let mut cache: HashMap<(PointKey, u32), [f64; 3]> = HashMap::new();
+    let mut direct = direct_at_vertices(&direct_scene, &state.vertices, &mut cache, &mut work);
+    for _ in 0..params.max_splits {
+        let vertex_indirect = vertex_values(&state, &corner_indirect);
+        let luminance_at: Vec<f64> = (0..state.vertices.len())
+            .map(|v| {
+                let e = [0, 1, 2].map(|c| direct[v][c] + vertex_indirect[v][c]);
+                perceptual::surface_luminance(radiosity(state.material(&setup, v), e))
+            })
+            .collect();
+        let adaptation = area_mean(&state.vertices.hat_area, &luminance_at);
+        let smallest = params.min_area * setup.total_area;
+        let to_split: Vec<usize> = (0..state.elements.elements.len())
+            .filter(|&e| {
+                let el = &state.elements.elements[e];
+                let corners = state.vertices.of_element[e];
+                el.is_leaf()
+                    && f64::from(el.area) / 4.0 >= smallest
+                    && perceptual::should_split(corners.map(|v| luminance_at[v as usize]), adaptation, params.stevens_exponent, params.brightness_threshold)
+            })
+            .collect();
+        if to_split.is_empty() {
+            break;
+        }
+        let mut elements = state.elements;
+        for &e in &to_split {
+            let first = elements.split(e);
+            let c = corner_indirect[e];
+            let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+            let (m01, m12, m20) = (mid(c[0], c[1]), mid(c[1], c[2]), mid(c[2], c[0]));
+            corner_indirect.extend([[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m12, m20, m01]]);
+            debug_assert_eq!(corner_indirect.len(), first + 4);
+        }
+        work.splits += to_split.len() as u64;
+        state = State::new(&setup, elements, cos_crease);
+        direct = direct_at_vertices(&direct_scene, &state.vertices, &mut cache, &mut work);
+    }
+    {
+        let vertex_indirect = vertex_values(&state, &corner_indirect);
+        let b: Vec<[f64; 3]> = (0..state.vertices.len())
+            .map(|v| radiosity(state.material(&setup, v), [0, 1, 2].map(|c| direct[v][c] + vertex_indirect[v][c])))
+            .collect();
+        work.direct_s = clock();
+        let p = Progress { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, mean_error: f64::NAN };
+        (observer.progress)(&p);
+        let elements = element_radiosity(&state, &b);
+        (observer.snapshot)(&Snapshot { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, elements })?;
+    }
+
+    // Stage 3: indirect light only, into fresh tallies on the split mesh.
+    let mut indirect = Tally::new(&state.vertices.hat_area, params.batch_photons);
+    let mut round = 0u64;
+    let (mean, errors) = loop {
+        let batch = trace_round(&setup, &state, params, 3, round, Deposit::Indirect, &mut work);
+        for b in &batch {
+            indirect.add(b, false);
+        }
+        round += 1;
+        let (mean, errors) = estimate(&setup, &state, &direct, &indirect, params);
+        let p = progress(Stage::Indirect, indirect.photons(), clock(), &state, &errors);
+        let stop = if p.max_error <= params.target_error {
+            Some("target_error")
+        } else if indirect.photons() >= params.max_photons {
+            Some("max_photons")
+        } else if params.time_budget_s.is_some_and(|t| clock() >= t) {
+            Some("time_budget_s")
+        } else {
+            None
+        };
+        report_round(&mut work, observer, &p, round, stop.is_some());
+        if let Some(why) = stop {
+            work.converged = why == "target_error";
+            work.stopped_by = why;
+            break (mean, errors);
+        }
+        if snapshot_due(observer, params, round, false) {
+            let b = vertex_radiosity(&setup, &state, &direct, &filtered(&setup, &state, &mean, &errors, params));
+            let elements = element_radiosity(&state, &b);
+            (observer.snapshot)(&Snapshot { stage: Stage::Indirect, photons: indirect.photons(), seconds: clock(), max_error: p.max_error, elements })?;
+        }
+    };
+    work.stage3_photons = indirect.photons();
+    work.final_s = clock();
+    let smoothed = filtered(&setup, &state, &mean, &errors, params);
+    let vertex_irradiance = (0..state.vertices.len()).map(|v| (luminance(mean[v]), luminance(smoothed[v]))).collect();
+    let elements = element_radiosity(&state, &vertex_radiosity(&setup, &state, &direct, &smoothed));
+    work.elements = elements.len();
+    work.leaves = elements.iter().filter(|e| e.is_leaf()).count();
+    work.vertices = state.vertices.len();
+    Ok(Solved { elements, vertex_irradiance, work })
+}
+
+/// Traces one round of `params.batches_per_round` batches of stage
+/// `stage`, in parallel, returned in batch order.
+fn trace_round(setup: &Setup, state: &State, params: &Params, stage: u64, round: u64, deposit: Deposit, work: &mut Work) -> Vec<tracing::Batch> {
+    let scene = Scene {
+        mesh: setup.mesh,
+        manifest: setup.manifest,
+        geometry: &setup.geometry,
+        rays: &setup.rays,
+        luminaires: &setup.luminaires,
+        emitters: &setup.emitters,
+        elements: &state.elements,
+        vertices: &state.vertices,
+        max_bounces: params.max_bounces,
+    };
+    let n = params.batches_per_round as u64;
+    let batches: Vec<tracing::Batch> = (0..n)
+        .into_par_iter()
+        .map(|i| scene.trace(params.batch_photons, deposit, &mut Stream::new(params.seed, stage, round * n + i)))
+        .collect();
+    for b in &batches {
+        work.photon_rays += b.rays;
+        work.capped_photons += b.capped;
+    }
+    batches
+}
+
+/// Per vertex: the mean irradiance of `tally`, and the estimated relative
+/// standard error of the radiosity it gives with `direct` added: the
+/// irradiance's standard error times the reflectance the estimate's colour
+/// sees, over the radiosity or `relative_floor` times the area-mean
+/// radiosity, whichever is larger.
+fn estimate(setup: &Setup, state: &State, direct: &[[f64; 3]], tally: &Tally, params: &Params) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let v = &state.vertices;
+    let n = v.len();
+    let mean: Vec<[f64; 3]> = (0..n).map(|i| tally.mean(i)).collect();
+    let b: Vec<f64> = (0..n).map(|i| luminance(radiosity(state.material(setup, i), [0, 1, 2].map(|c| direct[i][c] + mean[i][c])))).collect();
+    let floor = params.relative_floor * area_mean(&v.hat_area, &b);
+    let errors = (0..n)
+        .map(|i| {
+            let rho = state.material(setup, i).diffuse;
+            let e = luminance(mean[i]);
+            let seen = if e > 0.0 { luminance([0, 1, 2].map(|c| rho[c] * mean[i][c])) / e } else { luminance(rho) };
+            if seen <= 0.0 || v.hat_area[i] <= 0.0 {
+                return 0.0;
+            }
+            seen * tally.standard_error(i) / b[i].max(floor).max(f64::MIN_POSITIVE)
+        })
+        .collect();
+    (mean, errors)
+}
+
+/// The irradiance `mean` filtered with each vertex's radius from its error
+/// ([`filter`]).
+fn filtered(setup: &Setup, state: &State, mean: &[[f64; 3]], errors: &[f64], params: &Params) -> Vec<[f64; 3]> {
+    let v = &state.vertices;
+    let max_radius = params.filter_radius * setup.diagonal;
+    let radius: Vec<f64> = (0..v.len()).map(|i| filter::radius(v.hat_area[i], errors[i], params.target_error, max_radius)).collect();
+    let estimates = Estimates { position: &v.position, normal: &v.normal, hat_area: &v.hat_area, irradiance: mean, radius: &radius };
+    filter::filter(&state.tree, &estimates, params.crease_angle_deg.to_radians().cos())
+}
+
+/// Per vertex: radiosity from `direct` plus the irradiance `e`.
+fn vertex_radiosity(setup: &Setup, state: &State, direct: &[[f64; 3]], e: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    (0..state.vertices.len()).map(|v| radiosity(state.material(setup, v), [0, 1, 2].map(|c| direct[v][c] + e[v][c]))).collect()
+}
+
+/// The direct irradiance of every vertex, from `cache` where known.
+fn direct_at_vertices(scene: &DirectScene, vertices: &Vertices, cache: &mut HashMap<(PointKey, u32), [f64; 3]>, work: &mut Work) -> Vec<[f64; 3]> {
+    let mut known: Vec<Option<[f64; 3]>> = vertices.key.iter().map(|k| cache.get(k).copied()).collect();
+    work.direct_rays += scene.fill(vertices, &mut known);
+    let values: Vec<[f64; 3]> = known.into_iter().map(|e| e.unwrap_or([0.0; 3])).collect();
+    for (k, e) in vertices.key.iter().zip(&values) {
+        cache.insert(*k, *e);
+    }
+    values
+}
+
+/// Per vertex, the mean of the values its leaves' corners hold.
+fn vertex_values(state: &State, per_corner: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
+    let mut sum = vec![[0.0; 3]; state.vertices.len()];
+    let mut count = vec![0u32; state.vertices.len()];
+    for (e, corners) in state.vertices.of_element.iter().enumerate() {
+        for k in 0..3 {
+            if corners[k] != u32::MAX {
+                let v = corners[k] as usize;
+                for c in 0..3 {
+                    sum[v][c] += per_corner[e][k][c];
+                }
+                count[v] += 1;
+            }
+        }
+    }
+    sum.into_iter().zip(count).map(|(s, n)| if n > 0 { s.map(|x| x / f64::from(n)) } else { s }).collect()
+}
+
+/// `sum A_v x_v / sum A_v`.
+fn area_mean(area: &[f64], x: &[f64]) -> f64 {
+    let total: f64 = area.iter().sum();
+    if total <= 0.0 {
+        return 0.0;
+    }
+    area.iter().zip(x).map(|(a, x)| a * x).sum::<f64>() / total
+}
+
+fn progress(stage: Stage, photons: u64, seconds: f64, state: &State, errors: &[f64]) -> Progress {
+    let max_error = errors.iter().copied().fold(0.0, f64::max);
+    Progress { stage, photons, seconds, max_error, mean_error: area_mean(&state.vertices.hat_area, errors) }
+}
+
+fn report_round(work: &mut Work, observer: &mut Observer, p: &Progress, round: u64, last: bool) {
+    (observer.progress)(p);
+    if round.is_power_of_two() || last {
+        work.curve.push(*p);
+    }
+}
+
+fn snapshot_due(observer: &Observer, params: &Params, round: u64, last: bool) -> bool {
+    if observer.snapshot_every == 0 || last {
+        return false;
+    }
+    let per_round = (params.batches_per_round * params.batch_photons) as u64;
+    let every = observer.snapshot_every.div_ceil(per_round).max(1);
+    round % every == 0
+}
+
+/// The elements with radiosity: a leaf's is the mean of its corners'
+/// vertex radiosity (the mean of their linear interpolant), an inner
+/// element's the area-weighted mean of its children's.
+fn element_radiosity(state: &State, b: &[[f64; 3]]) -> Vec<Element> {
+    let mut elements = state.elements.elements.clone();
+    let mut value = vec![[0.0f64; 3]; elements.len()];
+    for (e, corners) in state.vertices.of_element.iter().enumerate() {
+        if elements[e].is_leaf() {
+            value[e] = [0, 1, 2].map(|c| corners.iter().map(|&v| b[v as usize][c]).sum::<f64>() / 3.0);
+        }
+    }
+    for e in (0..elements.len()).rev() {
+        if !elements[e].is_leaf() {
+            let first = elements[e].first_child as usize;
+            // The four children have equal areas (1:4 rule).
+            value[e] = [0, 1, 2].map(|c| (first..first + 4).map(|k| value[k][c]).sum::<f64>() / 4.0);
+        }
+    }
+    for (el, v) in elements.iter_mut().zip(value) {
+        el.radiosity = v.map(|x| x as f32);
+    }
+    elements
+}
