@@ -1,0 +1,130 @@
+//! The fine probe grid per surface: exact direct luminance (with ray-cast
+//! visibility) on a regular grid, the "lower resolution image" paper 002
+//! Section 3.2 reads its isolux regions from (its Figure 3: the surface
+//! seen from above, the illumination quantised to a few levels), here
+//! computed rather than looked at, with the derivatives the placement
+//! needs.
+
+use crate::direct::DirectLight;
+use crate::surfaces::Surface;
+use glam::DVec2;
+use rayon::prelude::*;
+
+/// One probe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Probe {
+    /// The mesh triangle under it; `None` outside the surface.
+    pub triangle: Option<u32>,
+    /// The direct irradiance's luminance weighting (Y of its RGB), W/m²:
+    /// isolux contours are lines of constant illuminance, whatever the
+    /// surface reflects of it.
+    pub illuminance: f64,
+    /// Visible fraction of the light sources ([`crate::direct::Irradiance`]).
+    pub visibility: f64,
+}
+
+/// The probe grid over one surface's bounding rectangle: nodes
+/// `lo + (i, j) h`, `i = 0..=nu`, `j = 0..=nv`.
+#[derive(Clone, Debug)]
+pub struct ProbeGrid {
+    /// Low corner, `(u, v)`.
+    pub lo: DVec2,
+    /// Node spacing, m.
+    pub h: f64,
+    /// Nodes along `u`.
+    pub nu: usize,
+    /// Nodes along `v`.
+    pub nv: usize,
+    /// Probes, `i + j nu`.
+    pub probes: Vec<Probe>,
+    /// Rays cast.
+    pub rays: u64,
+}
+
+impl ProbeGrid {
+    /// Probes `surface` with `resolution` cells along its longer side;
+    /// `key` offsets the probes' random streams (one range per surface).
+    pub fn new(surface: &Surface, direct: &DirectLight, resolution: usize, key: u64) -> Self {
+        let h = surface.extent() / resolution as f64;
+        let size = surface.hi - surface.lo;
+        let (nu, nv) = ((size.x / h).round() as usize + 1, (size.y / h).round() as usize + 1);
+        let evaluated: Vec<(Probe, u64)> = (0..nu * nv)
+            .into_par_iter()
+            .map(|k| {
+                let uv = surface.lo + DVec2::new((k % nu) as f64, (k / nu) as f64) * h;
+                let Some(triangle) = surface.triangle_at(uv) else {
+                    return (Probe { triangle: None, illuminance: 0.0, visibility: 1.0 }, 0);
+                };
+                let e = direct.at(surface.point(uv), surface.normal, triangle, key + k as u64);
+                (Probe { triangle: Some(triangle), illuminance: radiometry::color::luminance(e.rgb), visibility: e.visibility }, e.rays)
+            })
+            .collect();
+        let rays = evaluated.iter().map(|p| p.1).sum();
+        ProbeGrid { lo: surface.lo, h, nu, nv, probes: evaluated.into_iter().map(|p| p.0).collect(), rays }
+    }
+
+    /// The probe at node `(i, j)`.
+    pub fn at(&self, i: usize, j: usize) -> &Probe {
+        &self.probes[i + j * self.nu]
+    }
+
+    /// `(u, v)` of node `(i, j)`.
+    pub fn uv(&self, i: usize, j: usize) -> DVec2 {
+        self.lo + DVec2::new(i as f64, j as f64) * self.h
+    }
+
+    /// The curvature of the isolux line through an interior node (1/m),
+    /// from central differences of the illuminance `f`:
+    ///
+    /// ```text
+    /// kappa = |f_uu f_v² - 2 f_uv f_u f_v + f_vv f_u²| / |grad f|³
+    /// ```
+    ///
+    /// 0 where a neighbour lies outside the surface or the gradient
+    /// vanishes (no contour passes).
+    pub fn curvature(&self, i: usize, j: usize) -> f64 {
+        if i == 0 || j == 0 || i + 1 >= self.nu || j + 1 >= self.nv {
+            return 0.0;
+        }
+        let mut f = [[0.0; 3]; 3];
+        for (a, row) in f.iter_mut().enumerate() {
+            for (b, value) in row.iter_mut().enumerate() {
+                let p = self.at(i + a - 1, j + b - 1);
+                if p.triangle.is_none() {
+                    return 0.0;
+                }
+                *value = p.illuminance;
+            }
+        }
+        let h = self.h;
+        let (fu, fv) = ((f[2][1] - f[0][1]) / (2.0 * h), (f[1][2] - f[1][0]) / (2.0 * h));
+        let fuu = (f[2][1] - 2.0 * f[1][1] + f[0][1]) / (h * h);
+        let fvv = (f[1][2] - 2.0 * f[1][1] + f[1][0]) / (h * h);
+        let fuv = (f[2][2] - f[2][0] - f[0][2] + f[0][0]) / (4.0 * h * h);
+        let g2 = fu * fu + fv * fv;
+        if g2 <= 0.0 {
+            return 0.0;
+        }
+        (fuu * fv * fv - 2.0 * fuv * fu * fv + fvv * fu * fu).abs() / g2.powf(1.5)
+    }
+
+    /// Whether node `(i, j)` lies in a penumbra: the light sources partly
+    /// visible there, or a neighbour's visibility differs from its own by
+    /// more than 2% (a shadow edge passes between them).
+    pub fn in_penumbra(&self, i: usize, j: usize) -> bool {
+        let p = self.at(i, j);
+        if p.triangle.is_none() {
+            return false;
+        }
+        if p.visibility > 1e-9 && p.visibility < 1.0 - 1e-9 {
+            return true;
+        }
+        let neighbours = [(i.wrapping_sub(1), j), (i + 1, j), (i, j.wrapping_sub(1)), (i, j + 1)];
+        neighbours.iter().any(|&(a, b)| a < self.nu && b < self.nv && self.at(a, b).triangle.is_some() && (self.at(a, b).visibility - p.visibility).abs() > 0.02)
+    }
+
+    /// The smallest and largest illuminance over the surface's probes.
+    pub fn range(&self) -> (f64, f64) {
+        self.probes.iter().filter(|p| p.triangle.is_some()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.illuminance), hi.max(p.illuminance)))
+    }
+}
