@@ -195,3 +195,14 @@ pub fn with_layer_words(artifact: &ExrArtifact, name: &str, words: &[u8]) -> Exr
     let layers = artifact.layers.iter().map(|l| if l.name == name { with_table_words(l, words) } else { l.clone() }).collect();
     ExrArtifact { layers, ..artifact.clone() }
 }
+
+/// World corners of solution element `e`: its barycentric corners mapped
+/// onto its mesh triangle, plus the mesh frame's world translation.
+pub fn leaf_world_corners(mesh: &Mesh, origin: [f64; 3], e: &Element) -> [[f64; 3]; 3] {
+    let t = &mesh.triangles[e.triangle as usize];
+    let [p0, p1, p2] = t.vertices.map(|v| mesh.positions[v as usize].map(f64::from));
+    e.corners.map(|c| {
+        let uv = c.map(f64::from);
+        std::array::from_fn(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a])
+    })
+}

@@ -127,3 +127,14 @@ mod tests {
         assert!((lambert_polygon([0.0; 3], [0.0, 0.0, 1.0], &half) - 0.5 * centre).abs() < 1e-14);
     }
 }
+
+/// The mean of `f` over a triangle: its centroids after `levels` midpoint
+/// subdivisions (4^levels sub-triangles of equal area).
+pub fn mean_over_triangle(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -> f64) -> f64 {
+    if levels == 0 {
+        return f(std::array::from_fn(|a| (c[0][a] + c[1][a] + c[2][a]) / 3.0));
+    }
+    let mid = |i: usize, j: usize| std::array::from_fn::<f64, 3, _>(|a| 0.5 * (c[i][a] + c[j][a]));
+    let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
+    [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]].iter().map(|t| mean_over_triangle(t, levels - 1, f)).sum::<f64>() / 4.0
+}

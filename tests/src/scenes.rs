@@ -27,6 +27,8 @@ pub struct QuadScene {
     /// Lights besides the emitting materials, as `scene.ron` entries, e.g.
     /// `Goniometric(file: "lamp.ldt", position: (0.0, 0.0, 1.0), nadir: (0.0, 0.0, -1.0))`.
     pub lights: Vec<String>,
+    /// Names of the materials made two-sided in `scene.ron`.
+    pub two_sided: Vec<String>,
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -71,7 +73,8 @@ impl QuadScene {
         let mut overrides = String::new();
         for m in &self.materials {
             writeln!(mtl, "newmtl {}\nKd {r} {r} {r}", m.name, r = m.reflectance).unwrap();
-            writeln!(overrides, "    \"{}\": (emission: Some(({e:?}, {e:?}, {e:?}))),", m.name, e = m.emission).unwrap();
+            let two_sided = if self.two_sided.contains(&m.name) { ", two_sided: Some(true)" } else { "" };
+            writeln!(overrides, "    \"{}\": (emission: Some(({e:?}, {e:?}, {e:?})){two_sided}),", m.name, e = m.emission).unwrap();
         }
         let (eye, target) = self.camera;
         let lights: String = self.lights.iter().map(|l| format!("    {l},\n")).collect();

@@ -4,7 +4,8 @@
 //! clustering (clusters of one triangle, so that cluster nodes really sit
 //! between the triangles and the root).
 
-use end_to_end::closed_form::{clip_to_front, lambert_polygon, parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
+use end_to_end::artifacts::leaf_world_corners;
+use end_to_end::closed_form::{clip_to_front, lambert_polygon, mean_over_triangle, parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
 use end_to_end::scenes::{closed_box, one_bounce, rectangle, straddled_receiver, QuadScene};
 use end_to_end::{run_ok, s, scratch, solve_prepared};
 use schemas::mesh::{Manifest, Mesh};
@@ -232,17 +233,6 @@ impl LeafErrors {
     }
 }
 
-/// The mean of `f` over a triangle: its centroids after `levels` midpoint
-/// subdivisions (4^levels sub-triangles of equal area).
-fn mean_over_triangle(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -> f64) -> f64 {
-    if levels == 0 {
-        return f(std::array::from_fn(|a| (c[0][a] + c[1][a] + c[2][a]) / 3.0));
-    }
-    let mid = |i: usize, j: usize| std::array::from_fn::<f64, 3, _>(|a| 0.5 * (c[i][a] + c[j][a]));
-    let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
-    [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]].iter().map(|t| mean_over_triangle(t, levels - 1, f)).sum::<f64>() / 4.0
-}
-
 #[test]
 fn straddling_senders_give_every_leaf_lamberts_irradiance_of_their_front_part() {
     straddling_sender(false);
@@ -421,17 +411,6 @@ fn one_bounce_receiver_leaves_within_two_percent_of_quadrature() {
         assert!(worst[1] <= 0.02, "rho_B {rho_b}: a leaf of B is {:.2e} off the quadrature reference", worst[1]);
         assert!(worst[0] > 0.02, "rho_B {rho_b}: the absolute criterion also meets 2% ({:.2e}); the test no longer tells them apart", worst[0]);
     }
-}
-
-/// World corners of solution element `e`: its barycentric corners mapped
-/// onto its mesh triangle, plus the mesh frame's world translation.
-fn leaf_world_corners(mesh: &Mesh, origin: [f64; 3], e: &schemas::solution::Element) -> [[f64; 3]; 3] {
-    let t = &mesh.triangles[e.triangle as usize];
-    let [p0, p1, p2] = t.vertices.map(|v| mesh.positions[v as usize].map(f64::from));
-    e.corners.map(|c| {
-        let uv = c.map(f64::from);
-        std::array::from_fn(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a])
-    })
 }
 
 /// Issue 10, item 6: a one-sided lamp (0.5 m square, 0.6 m up) tilted to
