@@ -90,6 +90,13 @@ const SURFACE_CHANNELS: [&str; 3] = ["surface.object", "surface.material", "surf
 impl HdrImage {
     /// Writes the image atomically.
     pub fn write(&self, path: &Path) -> Result<()> {
+        self.write_with(path, Vec::new())
+    }
+
+    /// Writes the image atomically with `extra` channels of the same size
+    /// after its own (a stage's per-pixel extras, such as `exact`'s error
+    /// bound); readers of the image ignore them.
+    pub fn write_with(&self, path: &Path, extra: Vec<Channel>) -> Result<()> {
         let channel = |name: &str, k: usize| Channel::f32(name, "radiance, W/(m^2 sr), linear", self.rgb.iter().map(|p| p[k]).collect());
         let mut channels = vec![
             channel("R", 0),
@@ -105,6 +112,7 @@ impl HdrImage {
                 Channel::u32(flags, "bit 0: every sample hit this one surface's front face; bit 1: the surface emits", s.flags.clone()),
             ]);
         }
+        channels.extend(extra);
         let layer = Layer { name: String::new(), kind: LayerKind::Image { width: self.width, height: self.height }, channels };
         write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![layer] })
     }
