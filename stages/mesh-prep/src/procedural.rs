@@ -132,10 +132,11 @@ fn scene_text(obj_file: &str, eye: [f64; 3], target: [f64; 3], up: [f64; 3], fov
 /// - Reflectances, which the paper does not give: 0.8 grey for A and B
 ///   (white paint), so that the reflected light the paper studies is as
 ///   large as a plain diffuse surface makes it.
-/// - Camera (200 x 200, 70 degrees vertical field of view): between the
-///   planes at mid-height, 3.5 m in front of A's and B's near edges
-///   (y = -2.5), looking along +y at the middle of LS, the gap and B, so
-///   both receivers' fronts fill the view from their near edges back.
+/// - Camera (200 x 200, 80 degrees vertical field of view): between the
+///   planes at mid-height, 2 m in front of A's and B's near edges
+///   (y = -2.5), looking along +y at the middle of LS, the gap and B: the
+///   whole depth of both receivers' fronts is in view (their near corners
+///   leave it at the sides), about 27% of the pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimpleEnvironment {
     /// LS's corners, counter-clockwise seen from its front (+z), m.
@@ -180,7 +181,7 @@ pub fn simple_environment() -> (String, String, String) {
     let mtl = format!("newmtl light\nKd 0 0 0\n\nnewmtl upper\nKd {a} {a} {a}\n\nnewmtl lower\nKd {b} {b} {b}\n", a = s.rho_a, b = s.rho_b);
     let (mid, e) = (0.5 * s.height, s.emission);
     let scene = format!(
-        "Scene(\n  meshes: [Obj(file: \"simple.obj\")],\n  camera: Camera(eye: (2.6, -6.0, {mid:?}), target: (2.6, 0.0, {mid:?}), up: (0.0, 0.0, 1.0), vertical_fov_deg: 70.0, width: 200, height: 200),\n  materials: {{ \"light\": (emission: Some(({e:?}, {e:?}, {e:?}))) }},\n)\n"
+        "Scene(\n  meshes: [Obj(file: \"simple.obj\")],\n  camera: Camera(eye: (2.6, -4.5, {mid:?}), target: (2.6, 0.0, {mid:?}), up: (0.0, 0.0, 1.0), vertical_fov_deg: 80.0, width: 200, height: 200),\n  materials: {{ \"light\": (emission: Some(({e:?}, {e:?}, {e:?}))) }},\n)\n"
     );
     (scene, obj.finish("simple.mtl"), mtl)
 }
