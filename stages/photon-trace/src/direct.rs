@@ -23,7 +23,7 @@
 //! point lies on the wall's edge), and the limit from inside the floor is
 //! the value the photons' hat-weighted estimate approaches.
 
-use crate::mesh::Vertices;
+use crate::mesh::PointKey;
 use glam::DVec3;
 use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon, WeightedVisibility};
 use radiometry::geometry::TriangleGeometry;
@@ -92,25 +92,29 @@ impl DirectScene<'_> {
         (e.map(|x| x + goniometric), rays + cast)
     }
 
-    /// Direct irradiance at every vertex of `vertices` whose entry in
-    /// `known` is `None`; the others keep their value. Returns the rays
-    /// cast.
-    pub fn fill(&self, vertices: &Vertices, known: &mut [Option<[f64; 3]>]) -> u64 {
-        let computed: Vec<(usize, [f64; 3], u64)> = (0..vertices.len())
-            .into_par_iter()
-            .filter(|&v| known[v].is_none())
-            .map(|v| {
-                let (point, t) = (vertices.key[v].0, vertices.key[v].1);
-                let key = point.iter().fold(u64::from(t), |h, &(i, w)| mix64(h ^ mix64(u64::from(i) ^ w.rotate_left(17))));
-                let (e, rays) = self.irradiance(vertices.inside[v], vertices.normal[v], vertices.triangle[v], key);
-                (v, e, rays)
-            })
-            .collect();
-        let mut rays = 0;
-        for (v, e, r) in computed {
-            known[v] = Some(e);
-            rays += r;
-        }
-        rays
+    /// Direct irradiance at every query, in parallel; and the rays cast.
+    pub fn at(&self, queries: &[Query]) -> (Vec<[f64; 3]>, u64) {
+        let computed: Vec<([f64; 3], u64)> = queries.par_iter().map(|q| self.irradiance(q.point, q.normal, q.triangle, stream_key(&q.key))).collect();
+        let rays = computed.iter().map(|(_, r)| r).sum();
+        (computed.into_iter().map(|(e, _)| e).collect(), rays)
     }
+}
+
+/// A point to light: where, facing where, on which triangle, and its
+/// identity (which seeds its shadow rays).
+#[derive(Clone, Copy, Debug)]
+pub struct Query {
+    /// The point, m.
+    pub point: DVec3,
+    /// Unit normal.
+    pub normal: DVec3,
+    /// Mesh triangle (skipped by its shadow rays).
+    pub triangle: u32,
+    /// Identity: the exact point and the triangle.
+    pub key: (PointKey, u32),
+}
+
+/// The stream key of a point identity.
+fn stream_key(key: &(PointKey, u32)) -> u64 {
+    key.0.iter().fold(u64::from(key.1), |h, &(i, w)| mix64(h ^ mix64(u64::from(i) ^ w.rotate_left(17))))
 }

@@ -45,7 +45,7 @@ pub mod perceptual;
 pub mod tally;
 pub mod tracing;
 
-use direct::{AreaLight, DirectScene};
+use direct::{AreaLight, DirectScene, Query};
 use filter::{Estimates, VertexTree};
 use glam::DVec3;
 use mesh::{Elements, PointKey, Vertices};
@@ -106,6 +106,10 @@ pub struct Params {
     pub max_splits: u32,
     /// Smallest element area, as a fraction of the scene's total area.
     pub min_area: f64,
+    /// Before stage 1, elements are split 1:4 until none is larger than
+    /// this fraction of the scene's total area, so photons have vertices to
+    /// land on and the splitting criterion samples every surface.
+    pub initial_area: f64,
     /// Bounces after which a photon is dropped.
     pub max_bounces: u32,
 }
@@ -128,6 +132,7 @@ impl Default for Params {
             stevens_exponent: 1.0 / 3.0,
             max_splits: 6,
             min_area: 1e-4,
+            initial_area: 1e-2,
             max_bounces: 1000,
         }
     }
@@ -142,6 +147,7 @@ impl Params {
             ("brightness_threshold", self.brightness_threshold),
             ("stevens_exponent", self.stevens_exponent),
             ("min_area", self.min_area),
+            ("initial_area", self.initial_area),
         ];
         if let Some((name, value)) = positive.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
             return Some(format!("{name} must be a positive number, not {value}"));
@@ -355,7 +361,16 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     let clock = || started.elapsed().as_secs_f64();
 
     // Stage 1: every hit.
-    let mut state = State::new(&setup, Elements::new(mesh), cos_crease);
+    let mut elements = Elements::new(mesh);
+    let coarsest = params.initial_area * setup.total_area;
+    let mut e = 0;
+    while e < elements.elements.len() {
+        if f64::from(elements.elements[e].area) > coarsest {
+            elements.split(e);
+        }
+        e += 1;
+    }
+    let mut state = State::new(&setup, elements, cos_crease);
     let mut all = Tally::new(&state.vertices.hat_area, params.batch_photons);
     let mut indirect = Tally::new(&state.vertices.hat_area, params.batch_photons);
     let no_direct = vec![[0.0; 3]; state.vertices.len()];
@@ -402,24 +417,47 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     };
     let mut cache: HashMap<(PointKey, u32), [f64; 3]> = HashMap::new();
     let mut direct = direct_at_vertices(&direct_scene, &state.vertices, &mut cache, &mut work);
+    let smallest = params.min_area * setup.total_area;
     for _ in 0..params.max_splits {
         let vertex_indirect = vertex_values(&state, &corner_indirect);
-        let luminance_at: Vec<f64> = (0..state.vertices.len())
-            .map(|v| {
-                let e = [0, 1, 2].map(|c| direct[v][c] + vertex_indirect[v][c]);
-                perceptual::surface_luminance(radiosity(state.material(&setup, v), e))
-            })
-            .collect();
+        let luminance_of = |v: usize, e: [f64; 3], i: [f64; 3]| {
+            perceptual::surface_luminance(radiosity(state.material(&setup, v), [0, 1, 2].map(|c| e[c] + i[c])))
+        };
+        let luminance_at: Vec<f64> = (0..state.vertices.len()).map(|v| luminance_of(v, direct[v], vertex_indirect[v])).collect();
         let adaptation = area_mean(&state.vertices.hat_area, &luminance_at);
-        let smallest = params.min_area * setup.total_area;
-        let to_split: Vec<usize> = (0..state.elements.elements.len())
-            .filter(|&e| {
-                let el = &state.elements.elements[e];
-                let corners = state.vertices.of_element[e];
-                el.is_leaf()
-                    && f64::from(el.area) / 4.0 >= smallest
-                    && perceptual::should_split(corners.map(|v| luminance_at[v as usize]), adaptation, params.stevens_exponent, params.brightness_threshold)
+        let candidates: Vec<usize> =
+            (0..state.elements.elements.len()).filter(|&e| state.elements.elements[e].is_leaf() && f64::from(state.elements.elements[e].area) / 4.0 >= smallest).collect();
+        // The direct light at the edge midpoints, the vertices a split
+        // would make: a leaf is judged on its corners and those, so light
+        // that peaks inside an edge is seen.
+        let midpoint_keys: Vec<[(PointKey, u32); 3]> = candidates.iter().map(|&e| midpoints(&setup, &state.elements, e).map(|(key, _)| key)).collect();
+        let mut queries = Vec::new();
+        let mut queued = std::collections::HashSet::new();
+        for &e in &candidates {
+            for (key, query) in midpoints(&setup, &state.elements, e) {
+                if !cache.contains_key(&key) && queued.insert(key) {
+                    queries.push(query);
+                }
+            }
+        }
+        let (values, rays) = direct_scene.at(&queries);
+        work.direct_rays += rays;
+        for (q, value) in queries.iter().zip(values) {
+            cache.insert(q.key, value);
+        }
+        let to_split: Vec<usize> = candidates
+            .iter()
+            .zip(&midpoint_keys)
+            .filter(|(&e, keys)| {
+                let corners = state.vertices.of_element[e].map(|v| v as usize);
+                let ci = corner_indirect[e];
+                let mid = |a: usize, b: usize| [0, 1, 2].map(|c| 0.5 * (ci[a][c] + ci[b][c]));
+                let indirect_mid = [mid(0, 1), mid(1, 2), mid(2, 0)];
+                let mut l: Vec<f64> = corners.iter().map(|&v| luminance_at[v]).collect();
+                l.extend((0..3).map(|k| luminance_of(corners[0], cache[&keys[k]], indirect_mid[k])));
+                perceptual::should_split(&l, adaptation, params.stevens_exponent, params.brightness_threshold)
             })
+            .map(|(&e, _)| e)
             .collect();
         if to_split.is_empty() {
             break;
@@ -560,13 +598,32 @@ fn vertex_radiosity(setup: &Setup, state: &State, direct: &[[f64; 3]], e: &[[f64
 
 /// The direct irradiance of every vertex, from `cache` where known.
 fn direct_at_vertices(scene: &DirectScene, vertices: &Vertices, cache: &mut HashMap<(PointKey, u32), [f64; 3]>, work: &mut Work) -> Vec<[f64; 3]> {
-    let mut known: Vec<Option<[f64; 3]>> = vertices.key.iter().map(|k| cache.get(k).copied()).collect();
-    work.direct_rays += scene.fill(vertices, &mut known);
-    let values: Vec<[f64; 3]> = known.into_iter().map(|e| e.unwrap_or([0.0; 3])).collect();
-    for (k, e) in vertices.key.iter().zip(&values) {
-        cache.insert(*k, *e);
+    let queries: Vec<Query> = (0..vertices.len())
+        .filter(|&v| !cache.contains_key(&vertices.key[v]))
+        .map(|v| Query { point: vertices.inside[v], normal: vertices.normal[v], triangle: vertices.triangle[v], key: vertices.key[v] })
+        .collect();
+    let (values, rays) = scene.at(&queries);
+    work.direct_rays += rays;
+    for (q, value) in queries.iter().zip(values) {
+        cache.insert(q.key, value);
     }
-    values
+    vertices.key.iter().map(|k| cache[k]).collect()
+}
+
+/// The midpoints of leaf `e`'s edges (01, 12, 20) as direct-light queries
+/// with their identities: each moved a ten-thousandth of the way towards
+/// the leaf's centroid, as vertices are ([`mesh::Vertices::inside`]).
+fn midpoints(setup: &Setup, elements: &Elements, e: usize) -> [((PointKey, u32), Query); 3] {
+    let t = elements.elements[e].triangle as usize;
+    let g = &setup.geometry[t];
+    let c = elements.corners[e];
+    let centroid = g.point([(c[0][0] + c[1][0] + c[2][0]) / 3.0, (c[0][1] + c[1][1] + c[2][1]) / 3.0]);
+    [(0, 1), (1, 2), (2, 0)].map(|(a, b)| {
+        let uv = [0.5 * (c[a][0] + c[b][0]), 0.5 * (c[a][1] + c[b][1])];
+        let key = (mesh::point_key(setup.mesh, t, uv), t as u32);
+        let p = g.point(uv);
+        (key, Query { point: p + 1e-4 * (centroid - p), normal: g.normal, triangle: t as u32, key })
+    })
 }
 
 /// Per vertex, the mean of the values its leaves' corners hold.

@@ -87,6 +87,9 @@ struct Args {
     /// Smallest element area, a fraction of the scene's total area.
     #[arg(long)]
     min_area: Option<f64>,
+    /// Before stage 1, split elements until none is larger than this fraction of the total area.
+    #[arg(long)]
+    initial_area: Option<f64>,
     /// Bounces after which a photon is dropped.
     #[arg(long)]
     max_bounces: Option<u32>,
@@ -109,6 +112,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.stevens_exponent = args.stevens_exponent.unwrap_or(p.stevens_exponent);
     p.max_splits = args.max_splits.unwrap_or(p.max_splits);
     p.min_area = args.min_area.unwrap_or(p.min_area);
+    p.initial_area = args.initial_area.unwrap_or(p.initial_area);
     p.max_bounces = args.max_bounces.unwrap_or(p.max_bounces);
     match p.problem() {
         Some(problem) => Err(bad_parameter(problem)),

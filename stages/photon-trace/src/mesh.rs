@@ -101,20 +101,25 @@ impl Elements {
     /// The exact identity of corner `k` of element `e` (see the module
     /// documentation).
     pub fn point_key(&self, mesh: &Mesh, e: usize, k: usize) -> PointKey {
-        let tri = &mesh.triangles[self.elements[e].triangle as usize];
-        let [u, v] = self.corners[e][k];
-        let weights = [1.0 - u - v, u, v];
-        let mut key = [(u32::MAX, 0u64); 3];
-        let mut n = 0;
-        for (vertex, w) in tri.vertices.iter().zip(weights) {
-            if w != 0.0 {
-                key[n] = (*vertex, w.to_bits());
-                n += 1;
-            }
-        }
-        key.sort_unstable();
-        key
+        point_key(mesh, self.elements[e].triangle as usize, self.corners[e][k])
     }
+}
+
+/// The exact identity of the point with barycentric `uv` (dyadic) in
+/// triangle `t` (see the module documentation).
+pub fn point_key(mesh: &Mesh, t: usize, uv: [f64; 2]) -> PointKey {
+    let tri = &mesh.triangles[t];
+    let weights = [1.0 - uv[0] - uv[1], uv[0], uv[1]];
+    let mut key = [(u32::MAX, 0u64); 3];
+    let mut n = 0;
+    for (vertex, w) in tri.vertices.iter().zip(weights) {
+        if w != 0.0 {
+            key[n] = (*vertex, w.to_bits());
+            n += 1;
+        }
+    }
+    key.sort_unstable();
+    key
 }
 
 /// The vertices of the leaf mesh.

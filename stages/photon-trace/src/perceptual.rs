@@ -42,11 +42,12 @@ pub fn surface_luminance(b: [f64; 3]) -> f64 {
     luminance(b) / std::f64::consts::PI
 }
 
-/// Whether a leaf whose corners have luminances `corners` should be split:
-/// its corners' brightness differs by more than `threshold`.
-pub fn should_split(corners: [f64; 3], adaptation: f64, exponent: f64, threshold: f64) -> bool {
-    let q = corners.map(|l| brightness(l, adaptation, exponent));
-    let (lo, hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+/// Whether a leaf whose points (corners, and the edge midpoints a split
+/// would make) have luminances `points` should be split: their brightness
+/// differs by more than `threshold`.
+pub fn should_split(points: &[f64], adaptation: f64, exponent: f64, threshold: f64) -> bool {
+    let q = points.iter().map(|&l| brightness(l, adaptation, exponent));
+    let (lo, hi) = q.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), b| (lo.min(b), hi.max(b)));
     hi - lo > threshold
 }
 
@@ -59,9 +60,9 @@ mod tests {
         // Eight times the adaptation luminance looks twice as bright.
         assert!((brightness(8.0, 1.0, 1.0 / 3.0) - 2.0).abs() < 1e-12);
         // A 1:2 luminance step at the adaptation level: 2^(1/3) - 1 = 0.26.
-        assert!(should_split([1.0, 2.0, 1.0], 1.0, 1.0 / 3.0, 0.2));
+        assert!(should_split(&[1.0, 2.0, 1.0], 1.0, 1.0 / 3.0, 0.2));
         // The same direct step on top of indirect light 10 at both corners:
         // 12^(1/3) - 11^(1/3) = 0.066, under the threshold.
-        assert!(!should_split([11.0, 12.0, 11.0], 1.0, 1.0 / 3.0, 0.2));
+        assert!(!should_split(&[11.0, 12.0, 11.0], 1.0, 1.0 / 3.0, 0.2));
     }
 }
