@@ -14,6 +14,7 @@
 //! | emission (exitance M, W/m², front face) | `<emitter type="area">` nested in the shape, `radiance` = M / pi | yes: Lambertian, one-sided |
 //! | ideal mirror ks (no diffuse part) | `<bsdf type="conductor">`, `material` `none`, `specular_reflectance` ks | yes: `none` disables Fresnel |
 //! | diffuse rho + mirror ks | `<bsdf type="blendbsdf">`, weight w = max ks: diffuse rho/(1-w), conductor ks/w | yes where max rho <= 1 - max ks, else the mirror part is not exported |
+//! | two-sided material (a triangle and its reversed twin) | the triangle once, its BSDF inside `<bsdf type="twosided">` | yes: both faces reflect alike, as the twins do |
 //! | specular or diffuse transmission, texture, alpha and normal maps, goniometric lights | nothing | not exported: listed in the report's `skipped` and on stderr |
 //! | manifest camera | `perspective`, `fov_axis` y, `<lookat origin target up>`, `hdrfilm` rgb float32, box filter | yes |
 //!
@@ -53,7 +54,8 @@ pub mod ply;
 pub mod xml;
 
 use radiometry::color::max_channel;
-use schemas::mesh::{Manifest, Material, Mesh, MeshStatistics};
+use schemas::mesh::{cyclic, reversed, Manifest, Material, Mesh, MeshStatistics};
+use std::collections::HashSet;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use xml::{attribute, comment};
@@ -284,8 +286,16 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
         let mut local = vec![u32::MAX; mesh.positions.len()];
         let mut positions: Vec<[f32; 3]> = Vec::new();
         let mut faces: Vec<[u32; 3]> = Vec::with_capacity(triangles.len());
+        let mut faced = HashSet::new();
         for &t in triangles {
-            let face = mesh.triangles[t].vertices.map(|v| {
+            let vertices = mesh.triangles[t].vertices;
+            // A two-sided triangle's twin is the same surface for Mitsuba's
+            // `twosided` BSDF; exported twice, the two would z-fight.
+            if material.two_sided && faced.contains(&cyclic(reversed(vertices))) {
+                continue;
+            }
+            faced.insert(cyclic(vertices));
+            let face = vertices.map(|v| {
                 let slot = &mut local[v as usize];
                 if *slot == u32::MAX {
                     *slot = positions.len() as u32;
@@ -302,7 +312,13 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
         let _ = writeln!(shapes, "    <shape type=\"ply\" id={}>", attribute(&format!("m{m:03}-{}", safe_name(&material.name))));
         let _ = writeln!(shapes, "        <string name=\"filename\" value={}/>", attribute(&format!("{mesh_folder}/{file_name}")));
         let _ = writeln!(shapes, "        <boolean name=\"face_normals\" value=\"true\"/>");
-        write_bsdf(&mut shapes, &bsdf, "        ");
+        if material.two_sided {
+            let _ = writeln!(shapes, "        <bsdf type=\"twosided\">");
+            write_bsdf(&mut shapes, &bsdf, "            ");
+            let _ = writeln!(shapes, "        </bsdf>");
+        } else {
+            write_bsdf(&mut shapes, &bsdf, "        ");
+        }
         if max_channel(material.emission) > 0.0 {
             let radiance = scaled(material.emission, 1.0 / std::f64::consts::PI);
             let _ = writeln!(shapes, "        <emitter type=\"area\">");

@@ -160,6 +160,32 @@ fn export_round_trip_keeps_triangles_areas_reflectances_and_emitters() {
     assert!(exported.skipped.is_empty(), "{:?}", exported.skipped);
 }
 
+/// A two-sided material (here the Cornell box's first non-emitting one,
+/// its triangles given reversed twins as mesh-prep gives them) is exported
+/// once per surface, not once per face, with its BSDF inside Mitsuba's
+/// `twosided` adapter.
+#[test]
+fn a_two_sided_material_is_exported_once_inside_a_twosided_bsdf() {
+    let (mut mesh, mut manifest) = cornell();
+    let m = manifest.materials.iter().position(|m| m.emission == [0.0; 3]).unwrap();
+    manifest.materials[m].two_sided = true;
+    let fronts: Vec<_> = mesh.triangles.iter().filter(|t| t.material as usize == m).copied().collect();
+    let twins = fronts.iter().map(|t| schemas::mesh::Triangle { vertices: schemas::mesh::reversed(t.vertices), normal: t.normal.map(|n| -n), ..*t });
+    mesh.triangles.extend(twins.collect::<Vec<_>>());
+    manifest.check_mesh(Path::new("mesh.exr"), &mesh).unwrap();
+    let exported = export(&mesh, &manifest, &Params::default(), "scene", "");
+    let ply = exported.meshes.iter().find(|p| p.material == m).unwrap();
+    assert_eq!(ply.triangles, fronts.len(), "each twin pair once");
+    let scene = parse_xml(&exported.xml);
+    let shape = scene.all("shape").find(|s| s.property("string", "filename", &defaults(&scene)) == format!("scene/{}", ply.file_name)).unwrap();
+    let outer = shape.one("bsdf");
+    assert_eq!(outer.attribute("type"), "twosided");
+    let rho = triple(&outer.one("bsdf").property("rgb", "reflectance", &defaults(&scene)));
+    assert_eq!(rho, manifest.materials[m].diffuse);
+    let others = scene.all("shape").filter(|s| !std::ptr::eq(*s, shape));
+    assert!(others.map(|s| s.one("bsdf").attribute("type").to_string()).all(|t| t != "twosided"));
+}
+
 /// Pixel coordinates (continuous, top-left origin) of `point` through the
 /// exported sensor, as Mitsuba 3 computes them: `look_at` gives camera
 /// axes (left = up x dir, up' = dir x left, dir), the perspective
