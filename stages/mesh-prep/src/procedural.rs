@@ -291,10 +291,6 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 fn normalize(a: [f64; 3]) -> [f64; 3] {
     let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
     a.map(|x| x / l)
@@ -366,6 +362,10 @@ fn split(corners: &[[f64; 3]], levels: u32, emit: &mut dyn FnMut(&[[f64; 3]])) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
 
     #[test]
     fn tessellation_keeps_area_and_multiplies_faces() {
