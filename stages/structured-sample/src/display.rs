@@ -58,17 +58,73 @@ pub fn conical(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> 
     (weight > 0.0).then(|| sum.map(|a| a / weight))
 }
 
+/// The conical filter with a first-order correction: the plane
+/// `L(p) = c + g . (p - at)` fitted to the samples within `r` by least
+/// squares with the cone's weights `1 - d_i / r`, its value `c` at `at`.
+/// On a set symmetric about `at` it equals [`conical`]; unlike it, it
+/// reproduces a linear luminance on any set, so the one-sided
+/// neighbourhoods at a surface's edges are not biased towards the
+/// interior. Falls back to [`conical`] where the samples within `r` lie
+/// on a line or fewer than three do.
+pub fn conical_linear(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> {
+    // Normal equations of the weighted fit in (1, du, dv), in units of r.
+    let mut m = [[0.0; 3]; 3];
+    let mut rhs = [[0.0; 3]; 3];
+    let mut count = 0;
+    for s in samples {
+        let d = (s.uv - at) / r;
+        let distance = d.length();
+        if distance < 1.0 {
+            let w = 1.0 - distance;
+            let basis = [1.0, d.x, d.y];
+            for a in 0..3 {
+                for b in 0..3 {
+                    m[a][b] += w * basis[a] * basis[b];
+                }
+                for (k, l) in s.luminance.iter().enumerate() {
+                    rhs[k][a] += w * basis[a] * l;
+                }
+            }
+            count += 1;
+        }
+    }
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    if count < 3 || det.abs() <= 1e-9 * m[0][0].powi(3) {
+        return conical(samples, at, r);
+    }
+    // c by Cramer's rule: the first column replaced by the right-hand side.
+    Some(rhs.map(|y| (y[0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (y[1] * m[2][2] - m[1][2] * y[2]) + m[0][2] * (y[1] * m[2][1] - m[1][1] * y[2])) / det))
+}
+
+/// Which cone a display grid uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+pub enum Filter {
+    /// Paper 002's conical filter, [`conical`].
+    Conical,
+    /// The conical filter with a first-order correction, [`conical_linear`].
+    ConicalLinear,
+}
+
+impl Filter {
+    fn apply(self, samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> {
+        match self {
+            Filter::Conical => conical(samples, at, r),
+            Filter::ConicalLinear => conical_linear(samples, at, r),
+        }
+    }
+}
+
 /// The tag-aware filter at `at` (see the module documentation).
-pub fn tag_aware(samples: &[FilterSample], at: DVec2, r: f64, r_shadow: f64) -> [f64; 3] {
+pub fn tag_aware(filter: Filter, samples: &[FilterSample], at: DVec2, r: f64, r_shadow: f64) -> [f64; 3] {
     let near_shadow = samples.iter().any(|s| s.tag == Tag::ShadowBoundary && (s.uv - at).length() < r);
     if near_shadow {
-        if let Some(l) = conical(samples, at, r_shadow) {
+        if let Some(l) = filter.apply(samples, at, r_shadow) {
             return l;
         }
     }
     let mut radius = r;
     loop {
-        if let Some(l) = conical(samples, at, radius) {
+        if let Some(l) = filter.apply(samples, at, radius) {
             return l;
         }
         if samples.is_empty() || !radius.is_finite() {
@@ -91,10 +147,10 @@ pub struct DisplayGrid {
 impl DisplayGrid {
     /// The grid over `[lo, hi]` with cells of side `h`, every vertex
     /// filtered from `samples` by [`tag_aware`].
-    pub fn new(lo: DVec2, hi: DVec2, h: f64, samples: &[FilterSample], r: f64, r_shadow: f64) -> Self {
+    pub fn new(filter: Filter, lo: DVec2, hi: DVec2, h: f64, samples: &[FilterSample], r: f64, r_shadow: f64) -> Self {
         let size = hi - lo;
         let (nu, nv) = ((size.x / h).ceil() as usize + 1, (size.y / h).ceil() as usize + 1);
-        let values = (0..nu * nv).map(|k| tag_aware(samples, lo + DVec2::new((k % nu) as f64, (k / nu) as f64) * h, r, r_shadow)).collect();
+        let values = (0..nu * nv).map(|k| tag_aware(filter, samples, lo + DVec2::new((k % nu) as f64, (k / nu) as f64) * h, r, r_shadow)).collect();
         DisplayGrid { lo, h, nu, nv, values }
     }
 
@@ -149,6 +205,18 @@ mod tests {
     }
 
     #[test]
+    fn the_corrected_cone_reproduces_a_linear_function_at_an_edge() {
+        let f = |p: DVec2| 2.0 + 0.7 * p.x - 1.3 * p.y;
+        // Only the quarter x, y >= 0: a corner vertex sees a one-sided set.
+        let samples: Vec<FilterSample> = lattice(f, 0.1, 10, |_| Tag::Smooth).into_iter().filter(|s| s.uv.x >= 0.0 && s.uv.y >= 0.0).collect();
+        let at = DVec2::ZERO;
+        let corrected = conical_linear(&samples, at, 0.35).unwrap()[0];
+        assert!((corrected - f(at)).abs() < 1e-12, "{corrected}");
+        let plain = conical(&samples, at, 0.35).unwrap()[0];
+        assert!((plain - f(at)).abs() > 0.01, "the plain cone is biased at a corner: {plain}");
+    }
+
+    #[test]
     fn the_tag_aware_filter_keeps_a_shadow_edge_sharp() {
         // A step at x = 0: lit (1) left, shadowed (0) right, shadow samples
         // densely across it.
@@ -157,7 +225,7 @@ mod tests {
         samples.extend((-10..=10).flat_map(|i| (-5..=5).map(move |j| DVec2::new(0.02 * i as f64 + 0.01, 0.2 * j as f64))).map(|uv| FilterSample { uv, luminance: [step(uv); 3], tag: Tag::ShadowBoundary }));
         let at = DVec2::new(-0.06, 0.0);
         let blurred = conical(&samples, at, 0.5).unwrap()[0];
-        let sharp = tag_aware(&samples, at, 0.5, 0.05)[0];
+        let sharp = tag_aware(Filter::Conical, &samples, at, 0.5, 0.05)[0];
         assert!((sharp - 1.0).abs() < 1e-12, "{sharp}");
         assert!(blurred < 0.8, "the plain cone blurs the edge: {blurred}");
     }
@@ -166,7 +234,7 @@ mod tests {
     fn the_grid_interpolates_bilinearly_between_its_vertices() {
         let f = |p: DVec2| 1.0 + p.x + 2.0 * p.y;
         let samples = lattice(f, 0.05, 40, |_| Tag::Smooth);
-        let grid = DisplayGrid::new(DVec2::splat(-1.0), DVec2::splat(1.0), 0.25, &samples, 0.12, 0.05);
+        let grid = DisplayGrid::new(Filter::Conical, DVec2::splat(-1.0), DVec2::splat(1.0), 0.25, &samples, 0.12, 0.05);
         let p = DVec2::new(0.1, -0.3);
         assert!((grid.at(p)[0] - f(p)).abs() < 1e-12);
     }

@@ -85,8 +85,8 @@ pub struct Params {
     pub screen_spacing: u32,
     /// Rays per light-source triangle for the direct light's visibility.
     pub visibility_rays: usize,
-    /// Stop shooting when the largest unshot power is under this fraction
-    /// of the emitted power.
+    /// Stop shooting when the unshot power (all polygons together) is
+    /// under this fraction of the emitted power.
     pub threshold: f64,
     /// Most shots.
     pub max_shots: usize,
@@ -94,6 +94,9 @@ pub struct Params {
     pub bounces: u32,
     /// Display grid cells along a surface's longer side.
     pub display_resolution: usize,
+    /// The display filter: paper 002's cone, or the cone with a
+    /// first-order correction ([`display::Filter`]).
+    pub filter: display::Filter,
     /// Radius `r` of the conical filter.
     pub filter_radius: f64,
     /// Radius of the cone near shadow-boundary samples.
@@ -113,7 +116,7 @@ impl Default for Params {
         Params {
             probe_resolution: 96,
             levels: 8,
-            contour_spacing: 0.08,
+            contour_spacing: 0.12,
             turn_angle_deg: 25.0,
             lattice_spacing: 0.25,
             shadow_spacing: 0.02,
@@ -124,7 +127,8 @@ impl Default for Params {
             max_shots: 10_000,
             bounces: 0,
             display_resolution: 64,
-            filter_radius: 0.15,
+            filter: display::Filter::ConicalLinear,
+            filter_radius: 0.2,
             shadow_filter_radius: 0.04,
             width: None,
             height: None,
@@ -359,7 +363,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
                 .map(|((_, c), sample)| FilterSample { uv: c.uv, luminance: [0, 1, 2].map(|k| sample.luminance[k] - surface.emission[k] / PI), tag: c.reason.tag() })
                 .collect();
             let extent = surface.extent();
-            DisplayGrid::new(surface.lo, surface.hi, extent / params.display_resolution as f64, &filter, params.filter_radius * extent, params.shadow_filter_radius * extent)
+            DisplayGrid::new(params.filter, surface.lo, surface.hi, extent / params.display_resolution as f64, &filter, params.filter_radius * extent, params.shadow_filter_radius * extent)
         })
         .collect();
     let film = render::render(&pinhole, &rays, &surfaces, &surface_of, &display, size, params.spp_side, progress.step);

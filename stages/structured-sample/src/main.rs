@@ -75,6 +75,9 @@ struct Args {
     /// Display grid cells along a surface's longer side.
     #[arg(long)]
     display_resolution: Option<usize>,
+    /// Display filter: conical (paper 002's) or conical-linear (first-order corrected).
+    #[arg(long, value_enum)]
+    filter: Option<structured_sample::display::Filter>,
     /// Conical filter radius, fraction of the extent.
     #[arg(long)]
     filter_radius: Option<f64>,
@@ -110,6 +113,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.max_shots = args.max_shots.unwrap_or(p.max_shots);
     p.bounces = args.bounces.unwrap_or(p.bounces);
     p.display_resolution = args.display_resolution.unwrap_or(p.display_resolution);
+    p.filter = args.filter.unwrap_or(p.filter);
     p.filter_radius = args.filter_radius.unwrap_or(p.filter_radius);
     p.shadow_filter_radius = args.shadow_filter_radius.unwrap_or(p.shadow_filter_radius);
     p.width = args.width.or(p.width);

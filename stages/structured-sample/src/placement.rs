@@ -5,10 +5,14 @@
 //!   probe grid's illuminance is cut at `levels` evenly spaced levels
 //!   (its Figure 3 quantises the same way) and samples are placed where a
 //!   contour crosses a grid edge, spaced along the contour by
-//!   `s = s_c / (1 + s_c kappa / theta)`: `s_c` on a straight contour, one
-//!   sample per `theta` of turning on a curved one. Evenly spaced levels
-//!   lie closer together where the gradient is large, so the samples
-//!   concentrate there;
+//!   `s = s_c / (1 + s_c kappa / theta) * clamp((g_mean / g)², 1/16, 4)`:
+//!   `s_c` on a straight contour of average steepness, one sample per
+//!   `theta` of turning on a curved one. Evenly spaced levels lie closer
+//!   together where the gradient `g` is large; the last factor (a choice:
+//!   the paper's guideline "samples are placed to correspond with the
+//!   curvature" says nothing of the spacing along a straight contour)
+//!   makes them denser along the contour there too, so the samples follow
+//!   the change of the light in both directions;
 //! - "across the umbra and penumbra regions with varying density": dense
 //!   (`shadow_spacing`) in the penumbra, sparse (`umbra_spacing`) in the
 //!   umbra, which "does not contribute much";
@@ -81,6 +85,7 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
         }
     }
     let levels = isolux_levels(grid, params.levels);
+    let g_mean = grid.mean_gradient();
     let mut contour = Vec::new();
     for j in 0..grid.nv {
         for i in 0..grid.nu {
@@ -99,8 +104,11 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
                     }
                     let w = fa / (fa - fb);
                     let kappa = (1.0 - w) * grid.curvature(a.0, a.1) + w * grid.curvature(b.0, b.1);
+                    let g = (1.0 - w) * grid.gradient(a.0, a.1) + w * grid.gradient(b.0, b.1);
+                    let steepness = if g > 0.0 && g_mean > 0.0 { (g_mean / g).powi(2).clamp(1.0 / 16.0, 4.0) } else { 1.0 };
                     let uv = grid.uv(a.0, a.1).lerp(grid.uv(b.0, b.1), w);
-                    contour.push(Candidate { uv, reason: Reason::IsoluxContour, level: level as u32, spacing: s_c / (1.0 + s_c * kappa / theta), priority: kappa });
+                    let spacing = s_c / (1.0 + s_c * kappa / theta) * steepness;
+                    contour.push(Candidate { uv, reason: Reason::IsoluxContour, level: level as u32, spacing, priority: kappa });
                 }
             }
         }

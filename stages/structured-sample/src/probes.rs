@@ -108,6 +108,34 @@ impl ProbeGrid {
         (fuu * fv * fv - 2.0 * fuv * fu * fv + fvv * fu * fu).abs() / g2.powf(1.5)
     }
 
+    /// `|grad f|` of the illuminance at an interior node (W/m³) by central
+    /// differences; 0 at the border and where a neighbour lies outside.
+    pub fn gradient(&self, i: usize, j: usize) -> f64 {
+        if i == 0 || j == 0 || i + 1 >= self.nu || j + 1 >= self.nv {
+            return 0.0;
+        }
+        let f = |a: usize, b: usize| self.at(a, b).triangle.map(|_| self.at(a, b).illuminance);
+        match (f(i + 1, j), f(i - 1, j), f(i, j + 1), f(i, j - 1)) {
+            (Some(e), Some(w), Some(n), Some(s)) => ((e - w).powi(2) + (n - s).powi(2)).sqrt() / (2.0 * self.h),
+            _ => 0.0,
+        }
+    }
+
+    /// The mean of [`Self::gradient`] over the interior nodes inside the
+    /// surface.
+    pub fn mean_gradient(&self) -> f64 {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for j in 1..self.nv.saturating_sub(1) {
+            for i in 1..self.nu.saturating_sub(1) {
+                if self.at(i, j).triangle.is_some() {
+                    sum += self.gradient(i, j);
+                    n += 1;
+                }
+            }
+        }
+        if n > 0 { sum / n as f64 } else { 0.0 }
+    }
+
     /// Whether node `(i, j)` lies in a penumbra: the light sources partly
     /// visible there, or a neighbour's visibility differs from its own by
     /// more than 2% (a shadow edge passes between them).

@@ -19,8 +19,9 @@
 //! - a sample of reflectance `rho` gains `rho dE` of radiosity, and every
 //!   polygon it is a vertex of gains the vertex average of those gains as
 //!   unshot radiosity;
-//! - shooting stops when the largest unshot power is under `threshold` of
-//!   the power the light sources emit, or after `max_shots`.
+//! - shooting stops when the unshot power of all polygons together is
+//!   under `threshold` of the power the light sources emit, or after
+//!   `max_shots`.
 //!
 //! `bounces` > 0 limits the light to that many reflections off secondary
 //! emitters (the unshot light is kept per generation, and the last
@@ -60,7 +61,7 @@ pub struct ShootingWork {
     pub shots: usize,
     /// Visibility rays cast.
     pub rays: u64,
-    /// Largest unshot power left, as a fraction of the emitted power.
+    /// Unshot power left, as a fraction of the emitted power.
     pub remaining: f64,
     /// Whether it fell under the threshold (else `max_shots` stopped it).
     pub converged: bool,
@@ -71,8 +72,8 @@ pub struct ShootingWork {
 /// The shooting's knobs.
 #[derive(Clone, Copy, Debug)]
 pub struct ShootingParams {
-    /// Stop when the largest unshot power is under this fraction of the
-    /// emitted power.
+    /// Stop when the unshot power is under this fraction of the emitted
+    /// power.
     pub threshold: f64,
     /// At most this many shots.
     pub max_shots: usize,
@@ -104,7 +105,8 @@ pub fn shoot(polygons: &[Polygon], samples: &mut [Collector], rays: &SceneRays, 
             work.converged = true;
             break;
         };
-        work.remaining = if emitted_power > 0.0 { power(p, g, &unshot) / emitted_power } else { 0.0 };
+        let total: f64 = (0..polygons.len()).flat_map(|p| (0..generations).map(move |g| (p, g))).map(|(p, g)| power(p, g, &unshot)).sum();
+        work.remaining = if emitted_power > 0.0 { total / emitted_power } else { 0.0 };
         if work.remaining < params.threshold || power(p, g, &unshot) <= 0.0 {
             work.converged = true;
             break;
