@@ -1,0 +1,41 @@
+# The structured-sampling pipeline (paper 002 Sec. 3): mesh-prep ->
+# structured-sample (samples.exr, and its display: grid resampling with the
+# conical filter, image.exr) -> tonemap, into $(OUT)/structured/.
+# `make structured SCENE=simple-environment` renders
+# $(OUT)/structured/image.png; where the exact stage's pipeline is present
+# (pipelines/exact.mk, target $(OUT)/exact/image.exr) it also writes
+# $(OUT)/structured/compare.ron, paper 002's "% of visible pixels over
+# tau" per object against the exact image, with its difference picture.
+# STRUCTURED_BOUNCES=1 (with EXACT_BOUNCES=1) is the paper's one-bounce
+# configuration; the default, 0, shoots until the unshot power is under
+# the threshold, as the exact stage's default iterates every bounce.
+
+STRUCTURED_OUT := $(OUT)/structured
+STRUCTURED_BOUNCES ?= 0
+STRUCTURED_FLAGS ?=
+
+.PHONY: structured
+structured: $(STRUCTURED_OUT)/image.png $(if $(wildcard pipelines/exact.mk),$(STRUCTURED_OUT)/compare.ron)
+
+$(STRUCTURED_OUT) $(STRUCTURED_OUT)/params:
+	@mkdir -p $@
+
+$(BIN)/structured-sample: FORCE
+	@cargo build --release --quiet -p structured-sample --bins
+
+$(STRUCTURED_OUT)/params/structured-sample.ron: $(BIN)/structured-sample FORCE | $(STRUCTURED_OUT)/params
+	@$(BIN)/structured-sample --print-params --bounces $(STRUCTURED_BOUNCES) $(STRUCTURED_FLAGS) \
+	  $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT)) > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
+
+$(STRUCTURED_OUT)/samples.exr $(STRUCTURED_OUT)/image.exr &: $(BIN)/structured-sample $(STRUCTURED_OUT)/params/structured-sample.ron $(OUT)/mesh.exr $(OUT)/manifest.ron | $(STRUCTURED_OUT)
+	$(BIN)/structured-sample --params $(STRUCTURED_OUT)/params/structured-sample.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron \
+	  -o $(STRUCTURED_OUT)/samples.exr --image $(STRUCTURED_OUT)/image.exr --report $(STRUCTURED_OUT)/structured-sample.report.ron
+
+$(STRUCTURED_OUT)/image.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(STRUCTURED_OUT)/image.exr
+	$(BIN)/tonemap --params $(OUT)/params/tonemap.ron $(STRUCTURED_OUT)/image.exr -o $@ --report $(STRUCTURED_OUT)/tonemap.report.ron
+
+# The measure of paper 002 Sec. 4.1 (as pipelines/exact.mk takes it for
+# the preview): emitters and silhouettes left out.
+$(STRUCTURED_OUT)/compare.ron: $(BIN)/compare $(STRUCTURED_OUT)/image.exr $(OUT)/exact/image.exr
+	$(BIN)/compare $(STRUCTURED_OUT)/image.exr $(OUT)/exact/image.exr --tau 0.02,0.05,0.1,0.15 --exclude-emitters --exclude-edges 1 \
+	  --manifest $(OUT)/manifest.ron --diff $(STRUCTURED_OUT)/difference.png -o $@
