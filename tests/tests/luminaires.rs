@@ -158,6 +158,28 @@ fn bad_luminaire_placements_are_refused_naming_the_scene_and_field() {
     luminaire_refused("luminaire_position_nan", &LAMP.replace("(1.0, 1.0, 1.5)", "(NaN, 1.0, 1.5)"), None, &["scene.ron", "lights[0]", "position"]);
     luminaire_refused("luminaire_nadir_zero", &with("nadir: (0.0, 0.0, 0.0)"), None, &["scene.ron", "lights[0]", "nadir"]);
     luminaire_refused("luminaire_missing_file", &LAMP.replace("lamp.ldt", "missing.ldt"), None, &["scene.ron", "lights[0]", "missing.ldt", "does not exist"]);
+    luminaire_refused("luminaire_c0_along_nadir", &with("nadir: (0.0, 0.0, -1.0), c0: Some((0.0, 0.0, 2.0))"), None, &["scene.ron", "lights[0]", "c0", "parallel"]);
+}
+
+/// The scene's `c0` sets the table's C = 0 half-plane, made perpendicular
+/// to the nadir; an IES file with `TILT=INCLUDE` is read with a warning
+/// that its tilt factors are not applied.
+#[test]
+fn c0_orients_the_table_and_an_ignored_tilt_is_said() {
+    let dir = scratch("luminaire_c0");
+    let scene = luminaire_room(&dir, &LAMP.replace("nadir: (0.0, 0.0, -1.0)", "nadir: (0.0, 0.0, -1.0), c0: Some((0.0, 3.0, 1.0))"));
+    let manifest = dir.join("manifest.ron");
+    let out = run_ok("mesh-prep", &[s(&scene), "--mesh", s(&dir.join("mesh.exr")), "--manifest", s(&manifest)]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("TILT"));
+    let light = &read_ron::<Manifest>(&manifest).unwrap().value.goniometric_lights[0];
+    assert_eq!(light.c0, [0.0, 1.0, 0.0]);
+
+    let tilted = Path::new(env!("CARGO_MANIFEST_DIR")).join("../stages/mesh-prep/tests/data/photometry/lidrs_iesna2002_example_typec_tilt_include.ies");
+    std::fs::copy(tilted, dir.join("tilted.ies")).unwrap();
+    let scene = luminaire_room(&dir, &LAMP.replace("lamp.ldt", "tilted.ies"));
+    let out = run_ok("mesh-prep", &[s(&scene), "--mesh", s(&dir.join("mesh.exr")), "--manifest", s(&manifest)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.lines().any(|l| l.contains("warning") && l.contains("tilted.ies") && l.contains("TILT=INCLUDE")), "{stderr}");
 }
 
 #[test]

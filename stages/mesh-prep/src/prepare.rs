@@ -191,8 +191,9 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
                 raw.push(RawTriangle { corners: [c, c + u, c + u + v], material, object });
                 raw.push(RawTriangle { corners: [c, c + u + v, c + v], material, object });
             }
-            Light::Goniometric { file, position, nadir, scale } => {
-                goniometric_lights.push(crate::photometry::read_light(source, scene_path, k, file, *position, *nadir, *scale)?);
+            Light::Goniometric { file, position, nadir, c0, scale } => {
+                let placement = crate::photometry::Placement { file: file.clone(), position: *position, nadir: *nadir, c0: *c0, scale: *scale };
+                goniometric_lights.push(crate::photometry::read_light(source, scene_path, k, &placement, &mut warnings)?);
             }
         }
     }

@@ -75,6 +75,10 @@ pub enum Light {
         /// Direction the luminaire's nadir points to.
         #[serde(default = "down")]
         nadir: [f64; 3],
+        /// Direction of the table's C = 0 half-plane (made perpendicular
+        /// to the nadir); default: the mesh frame's x axis made so.
+        #[serde(default)]
+        c0: Option<[f64; 3]>,
         /// Multiplier on the file's intensities.
         #[serde(default = "one")]
         scale: f64,

@@ -30,6 +30,22 @@ use schemas::mesh::GoniometricLight;
 use schemas::Error;
 use std::path::Path;
 
+/// Where a scene places a goniometric light: the `Goniometric` entry's
+/// fields.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Placement {
+    /// Photometric file, relative to the scene file's folder.
+    pub file: String,
+    /// Position, world frame, m.
+    pub position: [f64; 3],
+    /// Direction the luminaire's nadir (gamma = 0) points to.
+    pub nadir: [f64; 3],
+    /// Direction of the C = 0 half-plane, if the scene gives one.
+    pub c0: Option<[f64; 3]>,
+    /// Multiplier on the file's intensities.
+    pub scale: f64,
+}
+
 fn err(path: &Path, line: usize, message: impl Into<String>) -> Error {
     Error::parse(path, Some(line), message)
 }
@@ -145,9 +161,15 @@ pub fn parse(path: &Path, text: &str) -> Result<Distribution, Error> {
 /// as an input), validates the placement (`scale` finite and > 0,
 /// `position` finite, `nadir` finite and non-zero: errors name the scene
 /// file and the field) and the file (errors name it and its line), and
-/// records the C0 direction the solvers use: the mesh-frame x axis made
-/// perpendicular to the nadir ([`frame_with_normal`]; the scene gives none).
-pub fn read_light(source: &dyn TextSource, scene_path: &Path, k: usize, file: &str, position: [f64; 3], nadir: [f64; 3], scale: f64) -> Result<GoniometricLight, Error> {
+/// records the C0 direction the solvers use: the scene's `c0` made
+/// perpendicular to the nadir, or, where the scene gives none, the
+/// mesh-frame x axis made perpendicular to it ([`frame_with_normal`]).
+/// An IES file's `TILT=INCLUDE` factors are not applied (they scale the
+/// output of a luminaire aimed away from its measured orientation): that
+/// gets a line in `warnings`.
+pub fn read_light(source: &dyn TextSource, scene_path: &Path, k: usize, light: &Placement, warnings: &mut Vec<String>) -> Result<GoniometricLight, Error> {
+    let Placement { file, position, nadir, c0, scale } = light;
+    let (position, nadir, scale) = (*position, *nadir, *scale);
     let field = |name: &str, message: String| Error::invalid(scene_path, None, format!("lights[{k}] (Goniometric '{file}'): {name}: {message}"));
     if !(scale.is_finite() && scale > 0.0) {
         return Err(field("scale", format!("{scale} must be finite and > 0")));
@@ -167,7 +189,19 @@ pub fn read_light(source: &dyn TextSource, scene_path: &Path, k: usize, file: &s
     if !(flux_lm.is_finite() && (scale * distribution.i_max() / K_M).is_finite()) {
         return Err(field("scale", format!("{scale} x the table of '{}' overflows", path.display())));
     }
-    let [c0, _, _] = frame_with_normal(n0);
+    let c0 = match c0 {
+        None => frame_with_normal(n0)[0],
+        Some(c) => {
+            let c = DVec3::from(*c);
+            let across = c - c.dot(n0) * n0;
+            across.try_normalize().filter(|_| c.is_finite() && across.length() > 1e-6 * c.length()).ok_or_else(|| {
+                field("c0", format!("{:?} must be finite and not parallel to the nadir {nadir:?}", c.to_array()))
+            })?
+        }
+    };
+    if text.lines().any(|l| l.trim_start().starts_with("TILT=INCLUDE")) {
+        warnings.push(format!("{}: TILT=INCLUDE: the tilt factors are not applied; the luminaire emits as measured, untilted", path.display()));
+    }
     Ok(GoniometricLight {
         label: file.to_string(),
         position,
