@@ -25,7 +25,7 @@ const LAMP: [[f64; 3]; 4] = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.2, 0.2, 0.0
 /// mesh-prep in a scratch directory.
 fn prepared(test: &str, two_sided: bool) -> PathBuf {
     let dir = scratch(test);
-    let mut scene = QuadScene { camera: ([1.2, 0.4, -0.6], [0.0, 0.0, 1.0]), ..Default::default() };
+    let mut scene = QuadScene { camera: ([1.2, 0.4, 0.3], [0.0, 0.0, 0.8]), ..Default::default() };
     scene.material("leaf", RHO, 0.0).material("lamp", 0.0, 1.0);
     scene.quad("leaf", "leaf", rectangle(2, 1.0, [-0.5, -0.5], [0.5, 0.5]), [0.0, 0.0, 1.0]);
     scene.quad("lamp", "lamp", LAMP, [0.0, 0.0, 1.0]);
@@ -92,8 +92,9 @@ fn a_two_sided_leaf_is_lit_from_below_on_its_underside_only_with_clusters() {
 }
 
 /// A gather of `dir`'s solution (`mode`: preview or full): the radiance
-/// (green channel) of every pixel, and whether it sees the leaf.
-fn gather(dir: &Path, mode: &str) -> Vec<(f64, bool)> {
+/// (green channel) of every pixel and whether it sees the leaf; the
+/// stage's stderr.
+fn gather(dir: &Path, mode: &str) -> (Vec<(f64, bool)>, String) {
     let image = dir.join(format!("{mode}.exr"));
     let [mesh, manifest, solution, clusters] = ["mesh.exr", "manifest.ron", "solution.exr", "clusters.exr"].map(|f| dir.join(f));
     let mut args = vec![
@@ -111,19 +112,20 @@ fn gather(dir: &Path, mode: &str) -> Vec<(f64, bool)> {
     if clusters.exists() {
         args.extend(["--clusters", s(&clusters)]);
     }
-    run_ok("grid-gather", &args);
+    let stderr = String::from_utf8_lossy(&run_ok("grid-gather", &args).stderr).into_owned();
     let manifest = read_ron::<Manifest>(&manifest).unwrap().value;
     let leaf = manifest.objects.iter().position(|o| o == "leaf").unwrap() as u32;
     let (image, _) = HdrImage::read(&image).unwrap();
     let surfaces = image.surfaces.expect("the gather writes its surface layer");
-    image.rgb.iter().zip(&surfaces.object).map(|(p, &o)| (f64::from(p[1]), o == leaf)).collect()
+    (image.rgb.iter().zip(&surfaces.object).map(|(p, &o)| (f64::from(p[1]), o == leaf)).collect(), stderr)
 }
 
 /// Seen from below, every pixel of the two-sided leaf shows its lit
 /// underside: radiance in (0, rho E_max / pi] (no pixel where a ray picked
 /// the dark top face of the coincident pair), and the brightest within 2%
 /// of that peak (the camera sees the leaf's centre); in the one-sided
-/// leaf's image those pixels show its back face: all black.
+/// leaf's image those pixels show its back face: all black, with a warning
+/// that names the two-sided option.
 #[test]
 fn a_camera_below_sees_the_lit_underside_only_when_the_leaf_is_two_sided() {
     let dir = prepared("two_sided_leaf_gathers", true);
@@ -131,7 +133,8 @@ fn a_camera_below_sees_the_lit_underside_only_when_the_leaf_is_two_sided() {
     let peak = RHO * lambert_polygon([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], &LAMP) / std::f64::consts::PI;
     let mut seen = Vec::new();
     for mode in ["preview", "full"] {
-        let image = gather(&dir, mode);
+        let (image, stderr) = gather(&dir, mode);
+        assert!(!stderr.contains("back faces"), "{stderr}");
         seen = image.iter().map(|(_, leaf)| *leaf).collect();
         let pixels: Vec<f64> = image.iter().filter(|(_, leaf)| *leaf).map(|(p, _)| *p).collect();
         let (lo, hi) = pixels.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &p| (lo.min(p), hi.max(p)));
@@ -142,7 +145,8 @@ fn a_camera_below_sees_the_lit_underside_only_when_the_leaf_is_two_sided() {
     }
     let one_sided = prepared("one_sided_leaf_gathers", false);
     solve_prepared(&one_sided, &[], Some(1));
-    let image = gather(&one_sided, "preview");
+    let (image, stderr) = gather(&one_sided, "preview");
+    assert!(stderr.contains("warning") && stderr.contains("back faces") && stderr.contains("two_sided"), "the black leaf gets a word: {stderr}");
     assert!(image.iter().zip(&seen).all(|((p, _), &leaf)| !leaf || *p == 0.0), "the one-sided leaf's back face is black");
 }
 
@@ -150,7 +154,7 @@ fn a_camera_below_sees_the_lit_underside_only_when_the_leaf_is_two_sided() {
 #[test]
 fn a_two_sided_emitter_is_refused() {
     let dir = scratch("two_sided_emitter");
-    let mut scene = QuadScene { camera: ([1.2, 0.4, -0.6], [0.0, 0.0, 1.0]), ..Default::default() };
+    let mut scene = QuadScene { camera: ([1.2, 0.4, 0.3], [0.0, 0.0, 0.8]), ..Default::default() };
     scene.material("lamp", 0.0, 1.0).quad("lamp", "lamp", LAMP, [0.0, 0.0, 1.0]);
     scene.two_sided.push("lamp".into());
     let path = scene.write(&dir);

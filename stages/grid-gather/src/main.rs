@@ -303,11 +303,28 @@ fn run(args: &Args) -> Result<ExitCode> {
     if let (Some(path), Some(d)) = (&args.diagnostics, &diagnostics) {
         outputs.write(path, |p| write_diagnostics(p, GatherDiagnostics::header(run.provenance(&params)), d))?;
     }
+    let warnings = back_face_warning(&rendered.counters).into_iter().collect::<Vec<_>>();
+    for warning in &warnings {
+        eprintln!("{STAGE}: warning: {warning}");
+    }
     if let Some(report) = &args.stage.report {
-        outputs.write(report, |p| run.write_report(p, &params, rendered.counters, rendered.skipped, Vec::new()))?;
+        outputs.write(report, |p| run.write_report(p, &params, rendered.counters, rendered.skipped, warnings))?;
     }
     outputs.keep()?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// A warning when more than 1% of the camera's hits are back faces, which
+/// show black: the camera sits outside a wall, or thin surfaces (leaves,
+/// paper) are one-sided where they should be two-sided.
+fn back_face_warning(counters: &std::collections::BTreeMap<String, f64>) -> Option<String> {
+    let (hits, back) = (counters.get("ray_hits")?, counters.get("back_face_hits")?);
+    (*back > 0.01 * hits).then(|| {
+        format!(
+            "{:.1}% of the camera's hits are back faces, shown black: a camera outside a wall, or thin surfaces (leaves, paper) that need `two_sided: Some(true)` in the scene's material overrides",
+            100.0 * back / hits
+        )
+    })
 }
 
 fn main() -> ExitCode {
