@@ -13,6 +13,11 @@
 //! the bound in extra channels, so `tonemap` and `compare` read it as
 //! they read grid-gather's ([`render`] on how pixels are sampled).
 //!
+//! "Exact" is for the mesh as mesh.exr stores it (f32 positions, in the
+//! mesh frame mesh-prep recentred): every figure is computed in f64 from
+//! those positions, and the bound covers the quadrature and iteration, not
+//! the scene file's rounding to f32 (about 6e-8 of the scene's size).
+//!
 //! | parameter | meaning | default |
 //! |---|---|---|
 //! | `bounces` | 0: direct light; 1: the paper's one bounce; n: n bounces, iterated between two planes | 1 |
