@@ -4,10 +4,13 @@
 //! line, library and material names with spaces, Latin-1 bytes (see
 //! [`crate::text::read_text`]), lines continued with a backslash.
 //!
-//! Read statements (others, like `vt`, `vn`, `l`, `p`, `s`, are ignored):
+//! Read statements (others, like `l`, `p`, `s`, are ignored):
 //! `v x y z` (finite; a fourth value or a colour after them is ignored),
+//! `vt u [v [w]]` (texture coordinates, finite; `v` defaults to 0, `w` is
+//! ignored), `vn x y z` (a shading normal, finite and non-zero),
 //! `f a b c ...` (position indices, 1-based or negative, each with optional
-//! `/vt/vn`; a polygon is triangulated as a fan from its first corner),
+//! `/vt/vn` indices, checked like the positions; a polygon is triangulated
+//! as a fan from its first corner),
 //! `o`/`g name` (a new object), `usemtl name`, `mtllib names`. An object is
 //! split where its material changes, as tobj did, so the objects and their
 //! order are what earlier versions wrote. A `#` starts a comment in a line
@@ -31,6 +34,12 @@ pub struct ObjObject {
     /// Triangles as position indices into [`ObjFile::positions`], OBJ
     /// winding.
     pub triangles: Vec<[usize; 3]>,
+    /// Per triangle, its corners' indices into [`ObjFile::uvs`], where all
+    /// three corners name one.
+    pub uv_triangles: Vec<Option<[usize; 3]>>,
+    /// Per triangle, its corners' indices into [`ObjFile::normals`], where
+    /// all three corners name one.
+    pub normal_triangles: Vec<Option<[usize; 3]>>,
     /// Line of each triangle's face statement.
     pub lines: Vec<usize>,
 }
@@ -38,7 +47,7 @@ pub struct ObjObject {
 impl ObjObject {
     /// An object without faces or material yet.
     fn named(name: &str) -> Self {
-        ObjObject { name: name.to_string(), material: None, triangles: Vec::new(), lines: Vec::new() }
+        ObjObject { name: name.to_string(), material: None, triangles: Vec::new(), uv_triangles: Vec::new(), normal_triangles: Vec::new(), lines: Vec::new() }
     }
 }
 
@@ -49,6 +58,10 @@ pub struct ObjFile {
     pub path: PathBuf,
     /// Vertex positions, file units.
     pub positions: Vec<[f64; 3]>,
+    /// Texture coordinates `(u, v)`.
+    pub uvs: Vec<[f64; 2]>,
+    /// Shading normals, unit length.
+    pub normals: Vec<[f64; 3]>,
     /// Objects in file order.
     pub objects: Vec<ObjObject>,
     /// Materials in library order.
@@ -66,7 +79,7 @@ pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> 
     let mut notes = Vec::new();
     let text = read_text(source, path, &mut notes)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mut positions = Vec::new();
+    let (mut positions, mut uvs, mut normals) = (Vec::new(), Vec::new(), Vec::new());
     let mut materials: Vec<MtlMaterial> = Vec::new();
     let mut objects: Vec<Pending> = Vec::new();
     let mut current: Pending = (ObjObject::named("unnamed_object"), None);
@@ -74,14 +87,24 @@ pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> 
         let (line, rest) = (statement.line, statement.rest.as_str());
         let error = |message: String| Error::parse(path, Some(line), message);
         match statement.keyword.as_str() {
-            "v" => positions.push(vertex(statement.arguments()).map_err(error)?),
+            "v" => positions.push(numbers::<3>(statement.arguments(), 3, "vertex").map_err(error)?),
+            "vt" => {
+                let [u, v] = numbers::<2>(statement.arguments(), 1, "texture coordinate").map_err(error)?;
+                uvs.push([u, v]);
+            }
+            "vn" => normals.push(normal(statement.arguments()).map_err(error)?),
             "f" => {
-                let corners = statement.arguments().split_whitespace().map(|c| corner(c, positions.len())).collect::<Result<Vec<usize>, String>>().map_err(error)?;
+                let defined = [positions.len(), uvs.len(), normals.len()];
+                let corners = statement.arguments().split_whitespace().map(|c| corner(c, defined)).collect::<Result<Vec<Corner>, String>>().map_err(error)?;
                 if corners.len() < 3 {
                     return Err(error("face needs at least three vertices".into()));
                 }
                 for k in 1..corners.len() - 1 {
-                    current.0.triangles.push([corners[0], corners[k], corners[k + 1]]);
+                    let fan = [&corners[0], &corners[k], &corners[k + 1]];
+                    current.0.triangles.push(fan.map(|c| c.position));
+                    let all = |i: usize| fan.iter().map(|c| c.attributes[i]).collect::<Option<Vec<usize>>>().map(|v| [v[0], v[1], v[2]]);
+                    current.0.uv_triangles.push(all(0));
+                    current.0.normal_triangles.push(all(1));
                     current.0.lines.push(line);
                 }
             }
@@ -122,7 +145,7 @@ pub fn read_obj(source: &dyn TextSource, path: &Path) -> Result<ObjFile, Error> 
         }
         resolved.push(object);
     }
-    Ok(ObjFile { path: path.to_path_buf(), positions, objects: resolved, materials, notes })
+    Ok(ObjFile { path: path.to_path_buf(), positions, uvs, normals, objects: resolved, materials, notes })
 }
 
 /// An object being read, with the material name it uses and the line that
@@ -158,31 +181,74 @@ fn libraries(source: &dyn TextSource, base: &Path, rest: &str) -> Result<Vec<Pat
     Err(format!("material library '{}' does not exist{whole}", base.join(first).display()))
 }
 
-/// The three finite coordinates of a `v` statement.
-fn vertex(rest: &str) -> Result<[f64; 3], String> {
-    let mut coordinates = [0.0f64; 3];
+/// The first `N` finite numbers of a statement (`what`), of which at least
+/// `required` must be there; those missing after them are 0 and any more
+/// are ignored.
+fn numbers<const N: usize>(rest: &str, required: usize, what: &str) -> Result<[f64; N], String> {
+    let mut values = [0.0f64; N];
     let mut words = rest.split_whitespace();
-    for c in &mut coordinates {
-        let word = words.next().ok_or("vertex needs three coordinates")?;
-        *c = word.parse().map_err(|_| format!("vertex coordinate '{word}' is not a number"))?;
+    for (k, c) in values.iter_mut().enumerate() {
+        let Some(word) = words.next() else {
+            if k < required {
+                return Err(format!("{what} needs {}", plural(required, "coordinate")));
+            }
+            break;
+        };
+        *c = word.parse().map_err(|_| format!("{what} coordinate '{word}' is not a number"))?;
         if !c.is_finite() {
-            return Err(format!("vertex coordinate '{word}' is not finite"));
+            return Err(format!("{what} coordinate '{word}' is not finite"));
         }
     }
-    Ok(coordinates)
+    Ok(values)
 }
 
-/// The 0-based position index of a face corner `v`, `v/vt`, `v//vn` or
-/// `v/vt/vn`, given `defined` positions so far (negative indices count
-/// back from the last).
-fn corner(text: &str, defined: usize) -> Result<usize, String> {
-    let index = text.split('/').next().unwrap_or("");
-    let i: i64 = index.parse().map_err(|_| format!("face vertex '{text}' is not an index"))?;
-    let resolved = if i > 0 { i - 1 } else { defined as i64 + i };
-    if i == 0 || resolved < 0 || resolved >= defined as i64 {
-        return Err(format!("face vertex {i} does not exist ({defined} vertices defined so far)"));
+/// A `vn` statement's normal, made unit length.
+fn normal(rest: &str) -> Result<[f64; 3], String> {
+    let n = numbers::<3>(rest, 3, "normal")?;
+    let length = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(length > 0.0 && length.is_finite()) {
+        return Err("normal has zero length".into());
     }
-    Ok(resolved as usize)
+    Ok(n.map(|x| x / length))
+}
+
+/// One face corner: its 0-based position index, and its texture
+/// coordinate and normal indices where it names them.
+struct Corner {
+    position: usize,
+    /// `[vt, vn]`.
+    attributes: [Option<usize>; 2],
+}
+
+/// A face corner `v`, `v/vt`, `v//vn` or `v/vt/vn`, given how many
+/// positions, texture coordinates and normals are `defined` so far
+/// (negative indices count back from the last).
+fn corner(text: &str, defined: [usize; 3]) -> Result<Corner, String> {
+    let mut parts = text.split('/');
+    let mut index = |k: usize, what: &str| -> Result<Option<usize>, String> {
+        let word = parts.next().unwrap_or("");
+        if word.is_empty() && k > 0 {
+            return Ok(None);
+        }
+        let i: i64 = word.parse().map_err(|_| format!("face {what} '{text}' is not an index"))?;
+        let resolved = if i > 0 { i - 1 } else { defined[k] as i64 + i };
+        if i == 0 || resolved < 0 || resolved >= defined[k] as i64 {
+            return Err(format!("face {what} {i} does not exist ({} defined so far)", plural(defined[k], what)));
+        }
+        Ok(Some(resolved as usize))
+    };
+    let position = index(0, "vertex")?.unwrap_or_default();
+    let attributes = [index(1, "texture coordinate")?, index(2, "normal")?];
+    Ok(Corner { position, attributes })
+}
+
+/// `n` things, in words (`3 vertices`, `1 normal`).
+fn plural(n: usize, what: &str) -> String {
+    match (n, what) {
+        (1, _) => format!("1 {what}"),
+        (_, "vertex") => format!("{n} vertices"),
+        _ => format!("{n} {what}s"),
+    }
 }
 
 #[cfg(test)]
@@ -202,7 +268,11 @@ mod tests {
         assert_eq!(error_of("v 0 0 0\nv 1 0 x\n"), "s/a.obj:2: vertex coordinate 'x' is not a number");
         assert_eq!(error_of("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"), "s/a.obj:4: face vertex 4 does not exist (3 vertices defined so far)");
         assert_eq!(error_of("v 0 0 0\nf 1 1\n"), "s/a.obj:2: face needs at least three vertices");
-        assert_eq!(error_of("v 0 0\n"), "s/a.obj:1: vertex needs three coordinates");
+        assert_eq!(error_of("v 0 0\n"), "s/a.obj:1: vertex needs 3 coordinates");
+        assert_eq!(error_of("vt\n"), "s/a.obj:1: texture coordinate needs 1 coordinate");
+        assert_eq!(error_of("vn 0 0 0\n"), "s/a.obj:1: normal has zero length");
+        assert_eq!(error_of(&format!("{TRIANGLE}vt 0 0\nf 1/1 2/2 3/1\n")), "s/a.obj:6: face texture coordinate 2 does not exist (1 texture coordinate defined so far)");
+        assert_eq!(error_of(&format!("{TRIANGLE}f 1//1 2 3\n")), "s/a.obj:5: face normal 1 does not exist (0 normals defined so far)");
         assert_eq!(error_of(&format!("{TRIANGLE}usemtl\n")), "s/a.obj:5: usemtl needs a material name");
     }
 
@@ -215,13 +285,16 @@ mod tests {
     #[test]
     fn quads_are_triangulated_with_materials() {
         let source = Memory::text(&[
-            ("s/a.obj", "mtllib m.mtl\no quad\nusemtl red\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf -4/1 -3/2/1 -2//3 -1\n"),
+            ("s/a.obj", "mtllib m.mtl\no quad\nusemtl red\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 2\nf -4/1 -3/2/1 -2/3/1 -1\nf 1/-3 2/-2 3/-1\n"),
             ("s/m.mtl", "newmtl red\nKd 0.5 0.1 0.1\nKe 1 2 3\n"),
         ]);
         let obj = read_obj(&source, Path::new("s/a.obj")).unwrap();
         assert_eq!(obj.objects.len(), 1);
-        assert_eq!(obj.objects[0].triangles, [[0, 1, 2], [0, 2, 3]]);
-        assert_eq!(obj.objects[0].lines, [8, 8]);
+        assert_eq!(obj.objects[0].triangles, [[0, 1, 2], [0, 2, 3], [0, 1, 2]]);
+        assert_eq!(obj.objects[0].uv_triangles, [Some([0, 1, 2]), None, Some([0, 1, 2])], "a corner without a texture coordinate leaves its triangle without");
+        assert_eq!(obj.objects[0].normal_triangles, [None; 3]);
+        assert_eq!(obj.normals, [[0.0, 0.0, 1.0]], "normals are made unit length");
+        assert_eq!(obj.objects[0].lines, [12, 12, 13]);
         assert_eq!(obj.materials[0].emissive, Some([1.0, 2.0, 3.0]));
         assert!(obj.notes.is_empty(), "{:?}", obj.notes);
     }
