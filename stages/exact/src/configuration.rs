@@ -103,7 +103,9 @@ impl Configuration {
         let mut surface_of = Vec::with_capacity(mesh.triangles.len());
         for (index, t) in mesh.triangles.iter().enumerate() {
             let c = corners(mesh, t);
-            let normal = (c[1] - c[0]).cross(c[2] - c[0]).normalize();
+            let Some(normal) = (c[1] - c[0]).cross(c[2] - c[0]).try_normalize() else {
+                return Err(format!("triangle {index} (object '{}') spans no area", object_name(t.object)));
+            };
             let ids = (t.object, t.material);
             let k = match surfaces.iter().position(|s| s.ids == ids) {
                 Some(k) => k,
