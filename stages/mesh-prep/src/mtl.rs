@@ -14,17 +14,47 @@
 //! | `d` | dissolve (opacity), one value (`d -halo f` reads `f`) |
 //! | `illum` | illumination model, an integer 0 to 10 |
 //! | `map_Kd`, `map_d`, `norm`, `bump`, `map_Bump` | a texture: options (`-o u v w`, `-bm f`, ...), then the file name (the rest of the line) |
+//!
+//! Texture options kept ([`TextureRef`]): `-s u v` and `-o u v` (the
+//! texture coordinates used are `s * uv + o`), `-clamp on|off` (off,
+//! the default, repeats), `-bm f` (the bump or normal map's strength) and
+//! `-imfchan r|g|b|m|l|z` (the channel a scalar map such as `map_d` reads).
+//! The others (`-blendu`, `-blendv`, `-boost`, `-cc`, `-mm`, `-texres`,
+//! `-type`, `-t`, and a third `-s`/`-o` value, for 3D textures) do not
+//! change what a diffuse solution sees or cannot be honoured; they are
+//! named in the texture's `ignored`, which mesh-prep turns into a note.
 
 use schemas::Error;
 use std::path::{Path, PathBuf};
 
-/// A texture a material names.
+/// A texture a material names, with the options that say how to read it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TextureRef {
     /// The file name as the MTL writes it (relative to the MTL's folder).
     pub name: String,
     /// Line of the statement that names it.
     pub line: usize,
+    /// `-s`: texture coordinates are scaled by this, then offset.
+    pub scale: [f64; 2],
+    /// `-o`: offset added to the scaled texture coordinates.
+    pub offset: [f64; 2],
+    /// `-clamp on`: coordinates clamp to [0, 1] instead of repeating.
+    pub clamp: bool,
+    /// `-bm`: strength of a bump or normal map.
+    pub bump_multiplier: f64,
+    /// `-imfchan`: the channel a scalar texture reads (`r`, `g`, `b`, `m`
+    /// matte, `l` luminance, `z` depth), if given.
+    pub channel: Option<char>,
+    /// Options given but not honoured, as written (`-cc on`).
+    pub ignored: Vec<String>,
+}
+
+impl TextureRef {
+    /// A texture named `name` on line `line`, with every option at its
+    /// default.
+    pub fn named(name: &str, line: usize) -> Self {
+        TextureRef { name: name.into(), line, scale: [1.0; 2], offset: [0.0; 2], clamp: false, bump_multiplier: 1.0, channel: None, ignored: Vec::new() }
+    }
 }
 
 /// One `newmtl` entry.
@@ -155,12 +185,14 @@ fn colour(keyword: &str, rest: &str) -> Result<[f64; 3], String> {
 /// A texture statement: options, then the file name (the rest of the line).
 fn texture(keyword: &str, rest: &str, line: usize) -> Result<TextureRef, String> {
     let mut remaining = rest;
+    let mut options = Vec::new();
     loop {
         let (word, after) = split_word(remaining);
-        let Some(&(_, arity)) = TEXTURE_OPTIONS.iter().find(|(name, _)| *name == word) else {
+        let Some(&(option, arity)) = TEXTURE_OPTIONS.iter().find(|(name, _)| *name == word) else {
             break;
         };
         remaining = after;
+        let mut values = Vec::new();
         for taken in 0..arity {
             let (value, after) = split_word(remaining);
             // -o, -s and -t take up to three numbers: stop at the first word
@@ -171,13 +203,49 @@ fn texture(keyword: &str, rest: &str, line: usize) -> Result<TextureRef, String>
             if value.is_empty() {
                 return Err(format!("{keyword}: option {word} needs a value"));
             }
+            values.push(value);
             remaining = after;
         }
+        options.push((option, values));
     }
     if remaining.is_empty() {
         return Err(format!("{keyword} needs a file name"));
     }
-    Ok(TextureRef { name: remaining.to_string(), line })
+    let mut texture = TextureRef::named(remaining, line);
+    for (option, values) in options {
+        let numbers = || values.iter().map(|v| number(&format!("{keyword} {option}"), v)).collect::<Result<Vec<f64>, String>>();
+        match option {
+            "-s" | "-o" => {
+                let v = numbers()?;
+                let target = if option == "-s" { &mut texture.scale } else { &mut texture.offset };
+                // One value is u alone (v keeps its default), as the format says.
+                target[0] = v[0];
+                if let Some(&second) = v.get(1) {
+                    target[1] = second;
+                }
+                if v.len() == 3 {
+                    texture.ignored.push(format!("{option}'s third value {} (3D textures)", values[2]));
+                }
+            }
+            "-clamp" => {
+                texture.clamp = match values[0].to_ascii_lowercase().as_str() {
+                    "on" => true,
+                    "off" => false,
+                    other => return Err(format!("{keyword}: -clamp '{other}' is neither on nor off")),
+                }
+            }
+            "-bm" => texture.bump_multiplier = numbers()?[0],
+            "-imfchan" => {
+                let c = values[0].to_ascii_lowercase();
+                texture.channel = Some(match c.as_str() {
+                    "r" | "g" | "b" | "m" | "l" | "z" => c.chars().next().unwrap_or('m'),
+                    other => return Err(format!("{keyword}: -imfchan '{other}' is not one of r, g, b, m, l, z")),
+                });
+            }
+            _ => texture.ignored.push(format!("{option} {}", values.join(" "))),
+        }
+    }
+    Ok(texture)
 }
 
 #[cfg(test)]
@@ -211,10 +279,23 @@ mod tests {
     fn names_with_spaces_and_texture_options() {
         let m = parse("newmtl Brushed Steel #2\nmap_kd -o 0.5 0.5 -bm 1.0 textures/steel plate.png\nmap_Bump -bm 0.3 n.png\nd -halo 0.8\n").unwrap();
         assert_eq!(m[0].name, "Brushed Steel #2");
-        assert_eq!(m[0].diffuse_texture, Some(TextureRef { name: "textures/steel plate.png".into(), line: 2 }));
-        assert_eq!(m[0].normal_texture.as_ref().map(|t| t.name.as_str()), Some("n.png"));
+        let steel = TextureRef { offset: [0.5, 0.5], ..TextureRef::named("textures/steel plate.png", 2) };
+        assert_eq!(m[0].diffuse_texture, Some(steel));
+        assert_eq!(m[0].normal_texture, Some(TextureRef { bump_multiplier: 0.3, ..TextureRef::named("n.png", 3) }));
         assert_eq!(m[0].dissolve, Some(0.8));
         assert_eq!(parse("newmtl a\nmap_Kd -clamp on\n").unwrap_err(), "m.mtl:2: map_Kd needs a file name");
+    }
+
+    #[test]
+    fn texture_options_are_kept_or_listed_as_ignored() {
+        let m = parse("newmtl a\nmap_Kd -s 2 4 1 -clamp ON -cc on -imfchan l -o 0.25 wood.png\nmap_d -imfchan m -mm 0 1 mask.png\n").unwrap();
+        let wood = m[0].diffuse_texture.as_ref().unwrap();
+        assert_eq!((wood.scale, wood.offset, wood.clamp, wood.channel), ([2.0, 4.0], [0.25, 0.0], true, Some('l')));
+        assert_eq!(wood.ignored, ["-s's third value 1 (3D textures)", "-cc on"]);
+        assert_eq!(m[0].dissolve_texture.as_ref().unwrap().ignored, ["-mm 0 1"]);
+        assert_eq!(parse("newmtl a\nmap_Kd -clamp maybe w.png\n").unwrap_err(), "m.mtl:2: map_Kd: -clamp 'maybe' is neither on nor off");
+        assert_eq!(parse("newmtl a\nmap_Kd -s x w.png\n").unwrap_err(), "m.mtl:2: map_Kd -s: 'x' is not a number");
+        assert_eq!(parse("newmtl a\nmap_d -imfchan q w.png\n").unwrap_err(), "m.mtl:2: map_d: -imfchan 'q' is not one of r, g, b, m, l, z");
     }
 
     #[test]

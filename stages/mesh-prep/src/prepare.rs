@@ -295,6 +295,9 @@ fn record_textures(source: &dyn TextSource, materials: &[MtlMaterial], warnings:
     for m in materials {
         let base = m.file.parent().unwrap_or(Path::new(""));
         for texture in [&m.diffuse_texture, &m.dissolve_texture, &m.normal_texture].into_iter().flatten() {
+            if !texture.ignored.is_empty() {
+                warnings.push(format!("{}:{}: texture '{}': options not honoured: {}", m.file.display(), texture.line, texture.name, texture.ignored.join(", ")));
+            }
             match locate(source, base, &texture.name) {
                 Some(path) => {
                     source.read_bytes(&path)?;
