@@ -39,6 +39,7 @@ pub mod ron_io;
 pub mod samples;
 pub mod solution;
 pub mod stage;
+pub mod surface;
 pub mod threshold;
 
 pub use error::{Error, Result};
