@@ -53,7 +53,8 @@ fn scene_with_library_elsewhere(dir: &Path, library: &str, texture: &str) -> Pat
     let mtl = format!("newmtl wall\nKd 0.5\nmap_Kd -bm 1 {texture}\n");
     let ldt = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../stages/mesh-prep/tests/data/photometry/lidrs_example_prolicht_E30-0019.ldt")).unwrap();
     let lights = format!("{}, Goniometric(file: \"../{library}/lamp.ldt\", position: (0.5, 0.8, 0.5))", ceiling_light(true));
-    write_scene(dir, "room.obj", &lights, &[("scene/room.obj", obj.as_bytes()), (&mtl_path, mtl.as_bytes()), (&texture_path, b"png"), (&ldt_path, &ldt)])
+    let png = schemas::png::encode_png(1, 1, &[[128, 128, 128]]).unwrap();
+    write_scene(dir, "room.obj", &lights, &[("scene/room.obj", obj.as_bytes()), (&mtl_path, mtl.as_bytes()), (&texture_path, &png), (&ldt_path, &ldt)])
 }
 
 /// mesh-prep's arguments for `scene` with every output in `dir/out`.
@@ -163,7 +164,7 @@ fn the_depfile_names_the_scene_obj_mtl_elsewhere_texture_and_luminaire() {
     assert_eq!(warnings_of(&dir, &scene), Vec::<String>::new());
     let esc = |p: &Path| s(p).replace(' ', "\\ ").replace('$', "$$");
     let (scene_dir, out) = (dir.join("scene"), dir.join("out"));
-    let read = ["room.obj", "../shared lib/walls.mtl", "../shared lib/tex$1.png", "../shared lib/lamp.ldt"].map(|p| scene_dir.join(p));
+    let read = ["room.obj", "../shared lib/walls.mtl", "../shared lib/lamp.ldt", "../shared lib/tex$1.png"].map(|p| scene_dir.join(p));
     let read: Vec<PathBuf> = std::iter::once(scene.clone()).chain(read).collect();
     let mut expected = format!("# Written by mesh-prep: the files its outputs were made from.\n{} {}:", esc(&out.join("mesh.exr")), esc(&out.join("manifest.ron")));
     for p in &read {

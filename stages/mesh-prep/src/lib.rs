@@ -21,6 +21,7 @@ pub mod photometry;
 pub mod prepare;
 pub mod procedural;
 pub mod scene;
+pub mod surface;
 pub mod text;
 
 pub use prepare::{prepare, Params, Prepared};

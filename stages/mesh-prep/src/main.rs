@@ -31,6 +31,11 @@ struct Args {
     /// Output: the manifest (RON: camera, materials, effects, statistics).
     #[arg(long, required_unless_present = "print_params")]
     manifest: Option<PathBuf>,
+    /// Output: the surface detail (EXR: corner texture coordinates and
+    /// shading normals, tangents, the materials' textures decoded), for
+    /// the stages that simulate textures, alpha masks and normal maps.
+    #[arg(long, value_name = "SURFACE.exr")]
+    surface: Option<PathBuf>,
     /// Output: a dependency file in make syntax: the mesh and manifest
     /// depend on every file this run read (scene, OBJ, MTL, textures,
     /// photometric files), for the Makefile to include.
@@ -61,7 +66,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(mesh_path), Some(manifest_path)) = (args.mesh, args.manifest) else {
         unreachable!("clap requires --mesh and --manifest without --print-params")
     };
-    let outputs = [Some(mesh_path.as_path()), Some(manifest_path.as_path()), args.stage.report.as_deref(), args.depfile.as_deref()];
+    let outputs = [Some(mesh_path.as_path()), Some(manifest_path.as_path()), args.surface.as_deref(), args.stage.report.as_deref(), args.depfile.as_deref()];
     check_outputs(&[args.scene.as_deref()], &outputs)?;
     let mut run = Run::start("mesh-prep", env!("CARGO_PKG_VERSION"));
     let (source, scene_path): (&dyn mesh_prep::obj::TextSource, PathBuf) = match (&args.builtin, &args.scene) {
@@ -84,7 +89,10 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     // Every file the scene named (OBJ, MTL, textures, photometry) is an
     // input too: none may be overwritten.
     check_outputs(&read.iter().map(|p| Some(Path::new(*p))).collect::<Vec<_>>(), &outputs)?;
-    let depfile_text = mesh_prep::depfile::rule(&[&mesh_path.display().to_string(), &manifest_path.display().to_string()], &read);
+    let mut targets = vec![mesh_path.display().to_string(), manifest_path.display().to_string()];
+    targets.extend(args.surface.as_ref().map(|p| p.display().to_string()));
+    let depfile_text = mesh_prep::depfile::rule(&targets.iter().map(String::as_str).collect::<Vec<_>>(), &read);
+    let surface = args.surface.as_ref().map(|_| prepared.surface_artifact(provenance.clone()));
     let (mesh, manifest) = prepared.into_artifacts(provenance);
     for warning in &warnings {
         eprintln!("mesh-prep: warning: {warning}");
@@ -100,6 +108,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let mut outputs = Outputs::new();
     outputs.write(&mesh_path, |p| mesh.write(p))?;
     outputs.write(&manifest_path, |p| schemas::ron_io::write_ron(p, &manifest))?;
+    if let (Some(path), Some(surface)) = (&args.surface, &surface) {
+        outputs.write(path, |p| surface.write(p))?;
+    }
     if let Some(report) = &args.stage.report {
         let counters = BTreeMap::from([
             ("input_triangles".to_string(), statistics.input_triangles as f64),

@@ -5,6 +5,7 @@
 use crate::lighting::{self, Emitter};
 use crate::material::{self, default_material};
 use crate::mtl::MtlMaterial;
+use crate::surface::{Corners, MapSource, Maps};
 use crate::obj::{read_obj, TextSource};
 use crate::text::locate;
 use crate::scene::{Light, MeshFile, Scene};
@@ -64,8 +65,11 @@ pub struct Prepared {
     /// What preparation did.
     pub statistics: MeshStatistics,
     /// What the user should hear of, one line each (non-UTF-8 text, unknown
-    /// materials, missing textures, emitters that light nothing).
+    /// materials, texture options not honoured, emitters that light nothing).
     pub warnings: Vec<String>,
+    /// The surface artifact's tables (texture coordinates, shading normals,
+    /// tangents, textures).
+    pub surface: crate::surface::Built,
 }
 
 impl Prepared {
@@ -85,17 +89,33 @@ impl Prepared {
         };
         (mesh, manifest)
     }
+
+    /// The surface artifact, stamped with `provenance`.
+    pub fn surface_artifact(&self, provenance: schemas::header::Provenance) -> schemas::surface::Surface {
+        use schemas::header::Schema;
+        let s = &self.surface;
+        schemas::surface::Surface {
+            header: schemas::surface::Surface::header(provenance),
+            uvs: s.uvs.clone(),
+            shading_normals: s.shading_normals.clone(),
+            tangents: s.tangents.clone(),
+            material_maps: s.material_maps.clone(),
+            textures: s.textures.clone(),
+        }
+    }
 }
 
 /// Largest world coordinate accepted, m: far beyond any scene, and far
 /// inside single precision (3.4e38), which the mesh is stored in.
 const MAX_COORDINATE: f64 = 1e30;
 
-/// A triangle before welding: world corners, material, object.
+/// A triangle before welding: world corners, material, object, and its
+/// corners' texture coordinates and shading normals.
 struct RawTriangle {
     corners: [DVec3; 3],
     material: u32,
     object: u32,
+    attributes: Corners,
 }
 
 /// Where an object or material comes from: the file and line that define
@@ -124,6 +144,7 @@ impl Origin {
 pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params: &Params) -> Result<Prepared, Error> {
     let base = scene_path.parent().unwrap_or(Path::new(""));
     let mut materials = Vec::new();
+    let mut maps: Vec<Maps> = Vec::new();
     let mut material_origins = Vec::new();
     let mut objects = Vec::new();
     let mut object_origins = Vec::new();
@@ -138,8 +159,8 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
         }
         let obj = read_obj(source, &path)?;
         warnings.extend(obj.notes.iter().cloned());
-        record_textures(source, &obj.materials, &mut warnings)?;
         let offset = materials.len() as u32;
+        maps.extend(texture_maps(source, &obj.materials, &mut warnings)?);
         materials.extend(obj.materials.iter().map(material::from_mtl));
         material_origins.extend(obj.materials.iter().map(|m| Origin { file: m.file.clone(), line: Some(m.line) }));
         for object in &obj.objects {
@@ -147,6 +168,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
                 Some(m) => offset + m as u32,
                 None => *default_index.get_or_insert_with(|| {
                     materials.push(default_material());
+                    maps.push(Maps::default());
                     material_origins.push(Origin { file: path.clone(), line: None });
                     materials.len() as u32 - 1
                 }),
@@ -154,7 +176,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
             let object_index = objects.len() as u32;
             objects.push(object.name.clone());
             object_origins.push(Origin { file: path.clone(), line: object.lines.first().copied() });
-            for (t, line) in object.triangles.iter().zip(&object.lines) {
+            for (k, (t, line)) in object.triangles.iter().zip(&object.lines).enumerate() {
                 let corners = t.map(|i| DVec3::from(obj.positions[i]) * *scale + DVec3::from(*translate));
                 if let Some(c) = corners.iter().find(|c| !c.is_finite() || c.abs().max_element() > MAX_COORDINATE) {
                     let what = format!(
@@ -164,7 +186,12 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
                     );
                     return Err(Error::invalid(&path, Some(*line), what));
                 }
-                raw.push(RawTriangle { corners, material, object: object_index });
+                let attributes = Corners {
+                    uv: object.uv_triangles[k].map(|c| c.map(|i| obj.uvs[i])),
+                    // A uniform positive scale and a translation leave normals as they are.
+                    normal: object.normal_triangles[k].map(|c| c.map(|i| obj.normals[i])),
+                };
+                raw.push(RawTriangle { corners, material, object: object_index, attributes });
             }
         }
     }
@@ -184,12 +211,14 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
                     return Err(refuse("edge_u and edge_v span no area (zero or parallel edges)".into()));
                 }
                 materials.push(Material { name: name.clone(), diffuse: [0.0; 3], emission: *emission, ..default_material() });
+                maps.push(Maps::default());
                 material_origins.push(Origin { file: scene_path.to_path_buf(), line: None });
                 objects.push(name);
                 object_origins.push(Origin { file: scene_path.to_path_buf(), line: None });
                 let (material, object) = (materials.len() as u32 - 1, objects.len() as u32 - 1);
-                raw.push(RawTriangle { corners: [c, c + u, c + u + v], material, object });
-                raw.push(RawTriangle { corners: [c, c + u + v, c + v], material, object });
+                let attributes = Corners::default();
+                raw.push(RawTriangle { corners: [c, c + u, c + u + v], material, object, attributes });
+                raw.push(RawTriangle { corners: [c, c + u + v, c + v], material, object, attributes });
             }
             Light::Goniometric { file, position, nadir, c0, scale } => {
                 let placement = crate::photometry::Placement { file: file.clone(), position: *position, nadir: *nadir, c0: *c0, scale: *scale };
@@ -199,8 +228,13 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
     }
     for (name, o) in &scene.materials {
         let mut found = false;
-        for (m, origin) in materials.iter_mut().zip(&mut material_origins).filter(|(m, _)| &m.name == name) {
+        for ((m, origin), maps) in materials.iter_mut().zip(&mut material_origins).zip(&mut maps).filter(|((m, _), _)| &m.name == name) {
             material::apply(m, o);
+            for (slot, file) in [&o.diffuse_map, &o.alpha_map, &o.normal_map].into_iter().enumerate() {
+                if let Some(file) = file {
+                    maps[slot] = Some(crate::surface::override_map(scene_path, file));
+                }
+            }
             *origin = Origin { file: scene_path.to_path_buf(), line: None };
             found = true;
         }
@@ -248,6 +282,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
         }
     }
     let effects = effects_of(&built.triangles, &materials, &goniometric_lights, params);
+    let surface = crate::surface::build(source, &built.positions, &built.triangles, &built.attributes, &materials, &maps, &mut warnings)?;
     Ok(Prepared {
         positions: built.positions,
         triangles: built.triangles,
@@ -259,6 +294,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
         effects,
         statistics,
         warnings,
+        surface,
     })
 }
 
@@ -287,32 +323,37 @@ fn emitters(raw: &[RawTriangle], kept: &[Triangle], materials: &[Material], obje
     Ok(out)
 }
 
-/// Reads (and so records, for the provenance and the dependency file)
-/// every texture the materials name, relative to their library's folder
-/// (found as [`locate`] finds it); a texture that does not exist gets a
-/// warning, as no stage reads textures yet.
-fn record_textures(source: &dyn TextSource, materials: &[MtlMaterial], warnings: &mut Vec<String>) -> Result<(), Error> {
+/// The maps of each MTL material: every texture it names, found relative
+/// to its library's folder as [`locate`] finds it (read later, and so
+/// recorded, if a kept triangle uses the material). A texture that does
+/// not exist is an error naming the MTL line and the material; options
+/// not honoured get a warning.
+fn texture_maps(source: &dyn TextSource, materials: &[MtlMaterial], warnings: &mut Vec<String>) -> Result<Vec<Maps>, Error> {
+    let mut all = Vec::with_capacity(materials.len());
     for m in materials {
         let base = m.file.parent().unwrap_or(Path::new(""));
-        for texture in [&m.diffuse_texture, &m.dissolve_texture, &m.normal_texture].into_iter().flatten() {
+        let mut maps = Maps::default();
+        for (slot, texture) in [&m.diffuse_texture, &m.dissolve_texture, &m.normal_texture].into_iter().enumerate() {
+            let Some(texture) = texture else { continue };
             if !texture.ignored.is_empty() {
                 warnings.push(format!("{}:{}: texture '{}': options not honoured: {}", m.file.display(), texture.line, texture.name, texture.ignored.join(", ")));
             }
-            match locate(source, base, &texture.name) {
-                Some(path) => {
-                    source.read_bytes(&path)?;
-                }
-                None => warnings.push(format!("{}:{}: texture '{}' does not exist", m.file.display(), texture.line, base.join(&texture.name).display())),
-            }
+            let path = locate(source, base, &texture.name).ok_or_else(|| {
+                Error::invalid(&m.file, Some(texture.line), format!("material '{}': texture '{}' does not exist", m.name, base.join(&texture.name).display()))
+            })?;
+            maps[slot] = Some(MapSource { path, texture: texture.clone() });
         }
+        all.push(maps);
     }
-    Ok(())
+    Ok(all)
 }
 
 struct Built {
     origin: DVec3,
     positions: Vec<[f32; 3]>,
     triangles: Vec<Triangle>,
+    /// Each kept triangle's corner attributes.
+    attributes: Vec<Corners>,
     statistics: MeshStatistics,
 }
 
@@ -345,6 +386,7 @@ fn build_mesh(raw: &[RawTriangle], two_sided: &[bool], params: &Params) -> Optio
     let min_area = params.degenerate_area * diagonal * diagonal;
     let mut seen = HashSet::new();
     let mut triangles = Vec::with_capacity(raw.len());
+    let mut attributes = Vec::with_capacity(raw.len());
     for (t, v) in raw.iter().zip(indexed) {
         let corner = |i: u32| DVec3::from(positions[i as usize].map(f64::from));
         let geometry = TriangleGeometry::new(v.map(corner));
@@ -373,6 +415,7 @@ fn build_mesh(raw: &[RawTriangle], two_sided: &[bool], params: &Params) -> Optio
             area: geometry.area as f32,
             normal: geometry.normal.as_vec3().to_array(),
         });
+        attributes.push(t.attributes);
     }
     if triangles.is_empty() {
         return None;
@@ -383,12 +426,14 @@ fn build_mesh(raw: &[RawTriangle], two_sided: &[bool], params: &Params) -> Optio
         .map(|t| Triangle { vertices: reversed(t.vertices), normal: t.normal.map(|n| -n), ..*t })
         .collect();
     statistics.two_sided_twins = twins.len();
+    let twin_attributes: Vec<Corners> = triangles.iter().zip(&attributes).filter(|(t, _)| two_sided[t.material as usize]).map(|(_, a)| a.reversed()).collect();
     triangles.extend(twins);
+    attributes.extend(twin_attributes);
     statistics.triangles = triangles.len();
     statistics.vertices = positions.len();
     statistics.bounds_min = (lo - origin).to_array();
     statistics.bounds_max = (hi - origin).to_array();
-    Some(Built { origin, positions, triangles, statistics })
+    Some(Built { origin, positions, triangles, attributes, statistics })
 }
 
 /// Which phenomena the kept triangles' materials and the lights call for.
