@@ -9,6 +9,7 @@ use schemas::image::{HdrImage, PixelSurfaces, EMITTER, NO_SURFACE, SINGLE_SURFAC
 use schemas::lightmap::{Lightmap, Region};
 use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
 use schemas::solution::{ClusterRadiosity, Element, Link, Node, Solution, NONE};
+use schemas::surface::{self, Surface, Texture, TextureKind};
 
 /// The provenance of every artifact here: one in-memory "run", so that a
 /// mesh and a manifest of this module belong together.
@@ -205,4 +206,31 @@ pub fn leaf_world_corners(mesh: &Mesh, origin: [f64; 3], e: &Element) -> [[f64; 
         let uv = c.map(f64::from);
         std::array::from_fn(|a| p0[a] + (p1[a] - p0[a]) * uv[0] + (p2[a] - p0[a]) * uv[1] + origin[a])
     })
+}
+
+/// A surface artifact for `mesh` with `materials` materials: corner
+/// coordinates and a tangent on the first triangle, shading normals on
+/// the second, and a 2 x 2 diffuse texture on material 0.
+pub fn surface(mesh: &Mesh, materials: usize) -> Surface {
+    let n = mesh.triangles[1].normal;
+    let texture = Texture {
+        kind: TextureKind::Diffuse,
+        width: 2,
+        height: 2,
+        texels: vec![[0.5, 0.25, 0.125, 1.0]; 4],
+        scale: [1.0; 2],
+        offset: [0.0; 2],
+        clamp: false,
+        strength: 1.0,
+    };
+    let mut material_maps = vec![[surface::NONE; 3]; materials];
+    material_maps[0][0] = 0;
+    Surface {
+        header: Surface::header(Provenance::in_memory("end-to-end fixture")),
+        uvs: vec![(0, [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])],
+        shading_normals: vec![(1, [n; 3])],
+        tangents: vec![(0, [1.0, 0.0, 0.0, 1.0])],
+        material_maps,
+        textures: vec![texture],
+    }
 }

@@ -1,5 +1,5 @@
 //! Fuzz targets for the pipeline's own artifacts (issue 11): every EXR
-//! kind (mesh, clusters, solution, lightmap, image) and `manifest.ron`,
+//! kind (mesh, clusters, solution, lightmap, image, surface) and `manifest.ron`,
 //! each mutated byte by byte from a valid file the `schemas` writers made,
 //! and read back by the reader every stage uses; and the records of every
 //! table layer mutated as words (`fuzz_*_tables`), which reach the
@@ -8,7 +8,7 @@
 //! `end_to_end::fuzz`). The cluster hierarchy is fuzzed with the solver
 //! walking it in hierarchical-solve's tests.
 
-use end_to_end::artifacts::{closed_box, clusters_over, image, lightmap, solution, table_words, with_layer_words};
+use end_to_end::artifacts::{closed_box, clusters_over, image, lightmap, solution, surface, table_words, with_layer_words};
 use end_to_end::fuzz::{fuzz, Kind};
 use schemas::cluster::Clusters;
 use schemas::exr_io::{read_exr, write_exr};
@@ -18,6 +18,7 @@ use schemas::lightmap::Lightmap;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::{read_ron, write_ron};
 use schemas::solution::Solution;
+use schemas::surface::Surface;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -151,3 +152,28 @@ fn fuzz_lightmap_tables() {
         let _ = Lightmap::read(path);
     });
 }
+
+/// The closed box's surface artifact, and the reader's arguments for it.
+fn box_surface() -> (Surface, usize, usize) {
+    let (mesh, manifest) = closed_box();
+    (surface(&mesh, manifest.materials.len()), mesh.triangles.len(), manifest.materials.len())
+}
+
+#[test]
+fn fuzz_surface_exr() {
+    let (s, ..) = box_surface();
+    fuzz_file("surface.exr", &written("exr", |p| s.write(p)), Kind::Binary, "exr", |path| {
+        let (_, triangles, materials) = box_surface();
+        let _ = Surface::read(path, triangles, materials);
+    });
+}
+
+#[test]
+fn fuzz_surface_tables() {
+    let (s, ..) = box_surface();
+    fuzz_tables::<Surface>("surface.exr", &["uv", "shading_normal", "tangent", "material_maps", "texture"], |p| s.write(p), |path| {
+        let (_, triangles, materials) = box_surface();
+        let _ = Surface::read(path, triangles, materials);
+    });
+}
+
