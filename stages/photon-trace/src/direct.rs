@@ -106,7 +106,9 @@ impl DirectScene<'_> {
 pub struct Query {
     /// The point, m.
     pub point: DVec3,
-    /// Unit normal.
+    /// Normal: unit, or a vertex's mean normal
+    /// ([`crate::mesh::Vertices::mean_normal`]; the values are linear in
+    /// it).
     pub normal: DVec3,
     /// Mesh triangle (skipped by its shadow rays).
     pub triangle: u32,

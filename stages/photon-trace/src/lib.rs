@@ -126,7 +126,7 @@ impl Default for Params {
             time_budget_s: None,
             relative_floor: 0.1,
             crease_angle_deg: 45.0,
-            filter_radius: 0.05,
+            filter_radius: 0.2,
             visibility_rays: 16,
             brightness_threshold: 0.05,
             stevens_exponent: 1.0 / 3.0,
@@ -360,7 +360,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     let mut work = Work::default();
     let clock = || started.elapsed().as_secs_f64();
 
-    // Stage 1: every hit.
+    // The photon mesh: the input triangles split to initial_area.
     let mut elements = Elements::new(mesh);
     let coarsest = params.initial_area * setup.total_area;
     let mut e = 0;
@@ -370,13 +370,15 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         }
         e += 1;
     }
-    let mut state = State::new(&setup, elements, cos_crease);
-    let mut all = Tally::new(&state.vertices.hat_area, params.batch_photons);
-    let mut indirect = Tally::new(&state.vertices.hat_area, params.batch_photons);
-    let no_direct = vec![[0.0; 3]; state.vertices.len()];
+    let coarse = State::new(&setup, elements, cos_crease);
+
+    // Stage 1: every hit.
+    let mut all = Tally::new(&coarse.vertices.hat_area, params.batch_photons);
+    let mut indirect = Tally::new(&coarse.vertices.hat_area, params.batch_photons);
+    let no_direct = vec![[0.0; 3]; coarse.vertices.len()];
     let mut round = 0u64;
     loop {
-        let batch = trace_round(&setup, &state, params, 1, round, Deposit::All, &mut work);
+        let batch = trace_round(&setup, &coarse, params, 1, round, Deposit::All, &mut work);
         for b in &batch {
             all.add(b, true);
             indirect.add(b, false);
@@ -386,12 +388,12 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
             work.first_image_s = clock();
         }
         let done = all.photons() >= params.preview_photons;
-        let (mean, errors) = estimate(&setup, &state, &no_direct, &all, params);
-        let p = progress(Stage::Stochastic, all.photons(), clock(), &state, &errors);
+        let (mean, errors) = estimate(&setup, &coarse, &no_direct, &all, params);
+        let p = progress(Stage::Stochastic, all.photons(), clock(), &coarse, &errors);
         report_round(&mut work, observer, &p, round, done);
         if snapshot_due(observer, params, round, done) || done {
-            let b = vertex_radiosity(&setup, &state, &no_direct, &filtered(&setup, &state, &mean, &errors, params));
-            let elements = element_radiosity(&state, &b);
+            let b = vertex_radiosity(&setup, &coarse, &no_direct, &filtered(&setup, &coarse, &mean, &errors, params));
+            let elements = element_radiosity(&coarse, &b);
             (observer.snapshot)(&Snapshot { stage: Stage::Stochastic, photons: all.photons(), seconds: clock(), max_error: p.max_error, elements })?;
         }
         if done {
@@ -401,12 +403,8 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     work.stage1_photons = all.photons();
     work.stage1_s = clock();
 
-    // Stage 2: direct light on a perceptually split mesh. The stage-1
-    // indirect estimate (filtered) sets the adaptation; split leaves carry
-    // it down by linear interpolation of their corners.
-    let (mean, errors) = estimate(&setup, &state, &no_direct, &indirect, params);
-    let indirect_now = filtered(&setup, &state, &mean, &errors, params);
-    let mut corner_indirect: Vec<[[f64; 3]; 3]> = state.vertices.of_element.iter().map(|c| c.map(|v| if v == u32::MAX { [0.0; 3] } else { indirect_now[v as usize] })).collect();
+    // Stage 2: direct light on a perceptually split mesh; the stage-1
+    // indirect estimate (filtered) sets the adaptation.
     let direct_scene = DirectScene {
         geometry: &setup.geometry,
         rays: &setup.rays,
@@ -415,26 +413,30 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         visibility_rays: params.visibility_rays,
         seed: params.seed,
     };
-    let mut cache: HashMap<(PointKey, u32), [f64; 3]> = HashMap::new();
-    let mut direct = direct_at_vertices(&direct_scene, &state.vertices, &mut cache, &mut work);
+    let mut cache: HashMap<DirectKey, [f64; 3]> = HashMap::new();
+    let coarse_direct = direct_at_vertices(&direct_scene, &coarse.vertices, &mut cache, &mut work);
+    let (mean, errors) = estimate(&setup, &coarse, &coarse_direct, &indirect, params);
+    let coarse_indirect = filtered(&setup, &coarse, &mean, &errors, params);
+    let mut fine = State::new(&setup, coarse.elements.clone(), cos_crease);
+    let mut direct = direct_at_vertices(&direct_scene, &fine.vertices, &mut cache, &mut work);
     let smallest = params.min_area * setup.total_area;
     for _ in 0..params.max_splits {
-        let vertex_indirect = vertex_values(&state, &corner_indirect);
+        let corner_indirect = interpolate(&coarse, &fine, &coarse_indirect);
+        let vertex_indirect = vertex_values(&fine, &corner_indirect);
         let luminance_of = |v: usize, e: [f64; 3], i: [f64; 3]| {
-            perceptual::surface_luminance(radiosity(state.material(&setup, v), [0, 1, 2].map(|c| e[c] + i[c])))
+            perceptual::surface_luminance(radiosity(fine.material(&setup, v), [0, 1, 2].map(|c| e[c] + i[c])))
         };
-        let luminance_at: Vec<f64> = (0..state.vertices.len()).map(|v| luminance_of(v, direct[v], vertex_indirect[v])).collect();
-        let adaptation = area_mean(&state.vertices.hat_area, &luminance_at);
+        let luminance_at: Vec<f64> = (0..fine.vertices.len()).map(|v| luminance_of(v, direct[v], vertex_indirect[v])).collect();
+        let adaptation = area_mean(&fine.vertices.hat_area, &luminance_at);
         let candidates: Vec<usize> =
-            (0..state.elements.elements.len()).filter(|&e| state.elements.elements[e].is_leaf() && f64::from(state.elements.elements[e].area) / 4.0 >= smallest).collect();
+            (0..fine.elements.elements.len()).filter(|&e| fine.elements.elements[e].is_leaf() && f64::from(fine.elements.elements[e].area) / 4.0 >= smallest).collect();
         // The direct light at the edge midpoints, the vertices a split
         // would make: a leaf is judged on its corners and those, so light
         // that peaks inside an edge is seen.
-        let midpoint_keys: Vec<[(PointKey, u32); 3]> = candidates.iter().map(|&e| midpoints(&setup, &state.elements, e).map(|(key, _)| key)).collect();
         let mut queries = Vec::new();
         let mut queued = std::collections::HashSet::new();
         for &e in &candidates {
-            for (key, query) in midpoints(&setup, &state.elements, e) {
+            for (key, query) in midpoints(&setup, &fine.elements, e) {
                 if !cache.contains_key(&key) && queued.insert(key) {
                     queries.push(query);
                 }
@@ -443,61 +445,52 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         let (values, rays) = direct_scene.at(&queries);
         work.direct_rays += rays;
         for (q, value) in queries.iter().zip(values) {
-            cache.insert(q.key, value);
+            cache.insert(direct_key(q), value);
         }
         let to_split: Vec<usize> = candidates
-            .iter()
-            .zip(&midpoint_keys)
-            .filter(|(&e, keys)| {
-                let corners = state.vertices.of_element[e].map(|v| v as usize);
+            .into_iter()
+            .filter(|&e| {
+                let corners = fine.vertices.of_element[e].map(|v| v as usize);
                 let ci = corner_indirect[e];
                 let mid = |a: usize, b: usize| [0, 1, 2].map(|c| 0.5 * (ci[a][c] + ci[b][c]));
                 let indirect_mid = [mid(0, 1), mid(1, 2), mid(2, 0)];
+                let keys = midpoints(&setup, &fine.elements, e).map(|(key, _)| key);
                 let mut l: Vec<f64> = corners.iter().map(|&v| luminance_at[v]).collect();
                 l.extend((0..3).map(|k| luminance_of(corners[0], cache[&keys[k]], indirect_mid[k])));
                 perceptual::should_split(&l, adaptation, params.stevens_exponent, params.brightness_threshold)
             })
-            .map(|(&e, _)| e)
             .collect();
         if to_split.is_empty() {
             break;
         }
-        let mut elements = state.elements;
+        let mut elements = fine.elements;
         for &e in &to_split {
-            let first = elements.split(e);
-            let c = corner_indirect[e];
-            let mid = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
-            let (m01, m12, m20) = (mid(c[0], c[1]), mid(c[1], c[2]), mid(c[2], c[0]));
-            corner_indirect.extend([[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m12, m20, m01]]);
-            debug_assert_eq!(corner_indirect.len(), first + 4);
+            elements.split(e);
         }
         work.splits += to_split.len() as u64;
-        state = State::new(&setup, elements, cos_crease);
-        direct = direct_at_vertices(&direct_scene, &state.vertices, &mut cache, &mut work);
+        fine = State::new(&setup, elements, cos_crease);
+        direct = direct_at_vertices(&direct_scene, &fine.vertices, &mut cache, &mut work);
     }
-    {
-        let vertex_indirect = vertex_values(&state, &corner_indirect);
-        let b: Vec<[f64; 3]> = (0..state.vertices.len())
-            .map(|v| radiosity(state.material(&setup, v), [0, 1, 2].map(|c| direct[v][c] + vertex_indirect[v][c])))
-            .collect();
-        work.direct_s = clock();
-        let p = Progress { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, mean_error: f64::NAN };
-        (observer.progress)(&p);
-        let elements = element_radiosity(&state, &b);
-        (observer.snapshot)(&Snapshot { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, elements })?;
-    }
+    let fine_radiosity = |indirect: &[[f64; 3]]| {
+        let i = vertex_values(&fine, &interpolate(&coarse, &fine, indirect));
+        vertex_radiosity(&setup, &fine, &direct, &i)
+    };
+    work.direct_s = clock();
+    (observer.progress)(&Progress { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, mean_error: f64::NAN });
+    let elements = element_radiosity(&fine, &fine_radiosity(&coarse_indirect));
+    (observer.snapshot)(&Snapshot { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, elements })?;
 
-    // Stage 3: indirect light only, into fresh tallies on the split mesh.
-    let mut indirect = Tally::new(&state.vertices.hat_area, params.batch_photons);
+    // Stage 3: indirect light only, added to the stage-1 indirect tally on
+    // the photon mesh.
     let mut round = 0u64;
     let (mean, errors) = loop {
-        let batch = trace_round(&setup, &state, params, 3, round, Deposit::Indirect, &mut work);
+        let batch = trace_round(&setup, &coarse, params, 3, round, Deposit::Indirect, &mut work);
         for b in &batch {
             indirect.add(b, false);
         }
         round += 1;
-        let (mean, errors) = estimate(&setup, &state, &direct, &indirect, params);
-        let p = progress(Stage::Indirect, indirect.photons(), clock(), &state, &errors);
+        let (mean, errors) = estimate(&setup, &coarse, &coarse_direct, &indirect, params);
+        let p = progress(Stage::Indirect, indirect.photons(), clock(), &coarse, &errors);
         let stop = if p.max_error <= params.target_error {
             Some("target_error")
         } else if indirect.photons() >= params.max_photons {
@@ -514,20 +507,48 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
             break (mean, errors);
         }
         if snapshot_due(observer, params, round, false) {
-            let b = vertex_radiosity(&setup, &state, &direct, &filtered(&setup, &state, &mean, &errors, params));
-            let elements = element_radiosity(&state, &b);
+            let elements = element_radiosity(&fine, &fine_radiosity(&filtered(&setup, &coarse, &mean, &errors, params)));
             (observer.snapshot)(&Snapshot { stage: Stage::Indirect, photons: indirect.photons(), seconds: clock(), max_error: p.max_error, elements })?;
         }
     };
-    work.stage3_photons = indirect.photons();
+    work.stage3_photons = indirect.photons() - work.stage1_photons;
     work.final_s = clock();
-    let smoothed = filtered(&setup, &state, &mean, &errors, params);
-    let vertex_irradiance = (0..state.vertices.len()).map(|v| (luminance(mean[v]), luminance(smoothed[v]))).collect();
-    let elements = element_radiosity(&state, &vertex_radiosity(&setup, &state, &direct, &smoothed));
+    let smoothed = filtered(&setup, &coarse, &mean, &errors, params);
+    let vertex_irradiance = (0..coarse.vertices.len()).map(|v| (luminance(mean[v]), luminance(smoothed[v]))).collect();
+    let elements = element_radiosity(&fine, &fine_radiosity(&smoothed));
     work.elements = elements.len();
     work.leaves = elements.iter().filter(|e| e.is_leaf()).count();
-    work.vertices = state.vertices.len();
+    work.vertices = fine.vertices.len();
     Ok(Solved { elements, vertex_irradiance, work })
+}
+
+/// Per leaf of `fine` (whose elements extend `coarse`'s), the values at
+/// its corners, interpolated linearly from `values` at the vertices of its
+/// ancestor among `coarse`'s leaves (inner elements get zeros).
+fn interpolate(coarse: &State, fine: &State, values: &[[f64; 3]]) -> Vec<[[f64; 3]; 3]> {
+    let n = coarse.elements.elements.len();
+    let els = &fine.elements.elements;
+    (0..els.len())
+        .map(|e| {
+            if !els[e].is_leaf() {
+                return [[0.0; 3]; 3];
+            }
+            let mut a = e;
+            while a >= n {
+                a = els[a].parent as usize;
+            }
+            let ca = coarse.elements.corners[a];
+            let corner_values = coarse.vertices.of_element[a].map(|v| values[v as usize]);
+            let (e1, e2) = ([ca[1][0] - ca[0][0], ca[1][1] - ca[0][1]], [ca[2][0] - ca[0][0], ca[2][1] - ca[0][1]]);
+            let det = e1[0] * e2[1] - e1[1] * e2[0];
+            fine.elements.corners[e].map(|uv| {
+                let d = [uv[0] - ca[0][0], uv[1] - ca[0][1]];
+                let (l1, l2) = ((d[0] * e2[1] - d[1] * e2[0]) / det, (e1[0] * d[1] - e1[1] * d[0]) / det);
+                let l = [1.0 - l1 - l2, l1, l2];
+                [0, 1, 2].map(|c| (0..3).map(|k| l[k] * corner_values[k][c]).sum())
+            })
+        })
+        .collect()
 }
 
 /// Traces one round of `params.batches_per_round` batches of stage
@@ -543,6 +564,7 @@ fn trace_round(setup: &Setup, state: &State, params: &Params, stage: u64, round:
         elements: &state.elements,
         vertices: &state.vertices,
         max_bounces: params.max_bounces,
+        t_min: (1e-6 * setup.diagonal) as f32,
     };
     let n = params.batches_per_round as u64;
     let batches: Vec<tracing::Batch> = (0..n)
@@ -597,23 +619,32 @@ fn vertex_radiosity(setup: &Setup, state: &State, direct: &[[f64; 3]], e: &[[f64
 }
 
 /// The direct irradiance of every vertex, from `cache` where known.
-fn direct_at_vertices(scene: &DirectScene, vertices: &Vertices, cache: &mut HashMap<(PointKey, u32), [f64; 3]>, work: &mut Work) -> Vec<[f64; 3]> {
-    let queries: Vec<Query> = (0..vertices.len())
-        .filter(|&v| !cache.contains_key(&vertices.key[v]))
-        .map(|v| Query { point: vertices.inside[v], normal: vertices.normal[v], triangle: vertices.triangle[v], key: vertices.key[v] })
+fn direct_at_vertices(scene: &DirectScene, vertices: &Vertices, cache: &mut HashMap<DirectKey, [f64; 3]>, work: &mut Work) -> Vec<[f64; 3]> {
+    let all: Vec<Query> = (0..vertices.len())
+        .map(|v| Query { point: vertices.inside[v], normal: vertices.mean_normal[v], triangle: vertices.triangle[v], key: vertices.key[v] })
         .collect();
+    let queries: Vec<Query> = all.iter().filter(|q| !cache.contains_key(&direct_key(q))).copied().collect();
     let (values, rays) = scene.at(&queries);
     work.direct_rays += rays;
     for (q, value) in queries.iter().zip(values) {
-        cache.insert(q.key, value);
+        cache.insert(direct_key(q), value);
     }
-    vertices.key.iter().map(|k| cache[k]).collect()
+    all.iter().map(|q| cache[&direct_key(q)]).collect()
+}
+
+/// What a direct-light value is cached under: the point's identity and
+/// the normal it was computed with (a vertex's mean normal changes when a
+/// neighbouring leaf splits, and its value with it).
+type DirectKey = ((PointKey, u32), [u64; 3]);
+
+fn direct_key(q: &Query) -> DirectKey {
+    (q.key, q.normal.to_array().map(f64::to_bits))
 }
 
 /// The midpoints of leaf `e`'s edges (01, 12, 20) as direct-light queries
 /// with their identities: each moved a ten-thousandth of the way towards
 /// the leaf's centroid, as vertices are ([`mesh::Vertices::inside`]).
-fn midpoints(setup: &Setup, elements: &Elements, e: usize) -> [((PointKey, u32), Query); 3] {
+fn midpoints(setup: &Setup, elements: &Elements, e: usize) -> [(DirectKey, Query); 3] {
     let t = elements.elements[e].triangle as usize;
     let g = &setup.geometry[t];
     let c = elements.corners[e];
@@ -622,7 +653,8 @@ fn midpoints(setup: &Setup, elements: &Elements, e: usize) -> [((PointKey, u32),
         let uv = [0.5 * (c[a][0] + c[b][0]), 0.5 * (c[a][1] + c[b][1])];
         let key = (mesh::point_key(setup.mesh, t, uv), t as u32);
         let p = g.point(uv);
-        (key, Query { point: p + 1e-4 * (centroid - p), normal: g.normal, triangle: t as u32, key })
+        let query = Query { point: p + 1e-4 * (centroid - p), normal: g.normal, triangle: t as u32, key };
+        (direct_key(&query), query)
     })
 }
 

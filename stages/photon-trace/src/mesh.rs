@@ -127,8 +127,16 @@ pub fn point_key(mesh: &Mesh, t: usize, uv: [f64; 2]) -> PointKey {
 pub struct Vertices {
     /// Position, mesh frame, m.
     pub position: Vec<DVec3>,
-    /// Unit normal: of the first leaf that made the vertex.
+    /// Unit normal: the direction of [`Vertices::mean_normal`].
     pub normal: Vec<DVec3>,
+    /// The hat-area-weighted mean of the vertex's leaves' unit normals (not
+    /// unit: shorter where the leaves bend). Lambert's factor and `I cos /
+    /// r²` are linear in the receiver's normal, so a point value with this
+    /// normal is the hat-weighted mean of the values each leaf's plane
+    /// would give, which is what the photons' estimate at the vertex
+    /// averages too (a tessellated sphere's vertex is lit as its facets
+    /// are, on average, not as the first facet alone).
+    pub mean_normal: Vec<DVec3>,
     /// Integral of the vertex's hat function, `sum A_leaf / 3` over its
     /// leaves, m².
     pub hat_area: Vec<f64>,
@@ -165,6 +173,10 @@ impl Vertices {
         let mut v = Vertices { of_element: vec![[u32::MAX; 3]; elements.elements.len()], ..Default::default() };
         let mut at_point: HashMap<PointKey, Vec<u32>> = HashMap::new();
         let mut inside_sum: Vec<DVec3> = Vec::new();
+        let mut normal_sum: Vec<DVec3> = Vec::new();
+        // Each vertex's first leaf's normal: corners join the vertex whose
+        // first normal is within the crease angle of theirs.
+        let mut first_normal: Vec<DVec3> = Vec::new();
         for (e, element) in elements.elements.iter().enumerate() {
             if !element.is_leaf() {
                 continue;
@@ -178,26 +190,33 @@ impl Vertices {
             for k in 0..3 {
                 let key = elements.point_key(mesh, e, k);
                 let candidates = at_point.entry(key).or_default();
-                let found = candidates.iter().copied().find(|&c| v.material[c as usize] == material && v.normal[c as usize].dot(g.normal) >= cos_crease);
+                let found = candidates.iter().copied().find(|&c| v.material[c as usize] == material && first_normal[c as usize].dot(g.normal) >= cos_crease);
                 let id = match found {
                     Some(id) => id,
                     None => {
                         let id = v.position.len() as u32;
                         v.position.push(world[k]);
-                        v.normal.push(g.normal);
+                        first_normal.push(g.normal);
                         v.hat_area.push(0.0);
                         v.material.push(material);
                         v.triangle.push(t as u32);
                         v.key.push((key, t as u32));
                         inside_sum.push(DVec3::ZERO);
+                        normal_sum.push(DVec3::ZERO);
                         candidates.push(id);
                         id
                     }
                 };
                 v.hat_area[id as usize] += area / 3.0;
                 inside_sum[id as usize] += area * centroid;
+                normal_sum[id as usize] += area * g.normal;
                 v.of_element[e][k] = id;
             }
+        }
+        for i in 0..v.hat_area.len() {
+            let mean = if v.hat_area[i] > 0.0 { normal_sum[i] / (3.0 * v.hat_area[i]) } else { first_normal[i] };
+            v.mean_normal.push(mean);
+            v.normal.push(mean.try_normalize().unwrap_or(first_normal[i]));
         }
         // A point a ten-thousandth of the way from the vertex towards the
         // area-weighted centroid of its leaves' centroids.

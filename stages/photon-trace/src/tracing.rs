@@ -143,6 +143,13 @@ pub struct Scene<'a> {
     /// Bounces after which a photon is dropped, whatever its weight (only
     /// reached with reflectances near 1).
     pub max_bounces: u32,
+    /// Nearest hit a ray accepts, m. Skipping the triangle a photon leaves
+    /// is not enough: its origin, rounded to f32 for the BVH, may lie a
+    /// hair behind its plane, where a coplanar neighbour triangle (the
+    /// other half of a quad) would take it as a back-face hit and absorb
+    /// it. A millionth of the scene's diagonal is far above that rounding
+    /// and far below any gap between surfaces that matters.
+    pub t_min: f32,
 }
 
 /// What one batch of photons left: `(vertex, power W per channel)` per
@@ -196,7 +203,7 @@ impl Scene<'_> {
         };
         for bounce in 0..=self.max_bounces {
             batch.rays += 1;
-            let Some(hit) = self.rays.closest_hit(origin, direction, 0.0, f32::INFINITY, [from, u32::MAX]) else { return };
+            let Some(hit) = self.rays.closest_hit(origin, direction, self.t_min, f32::INFINITY, [from, u32::MAX]) else { return };
             let t = hit.triangle as usize;
             let g = &self.geometry[t];
             if direction.dot(g.normal) >= 0.0 {
