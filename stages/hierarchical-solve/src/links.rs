@@ -251,8 +251,24 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[
     if r == s {
         return Split::Both;
     }
-    let wanted = match (r, s) {
-        (Node::Element(_), Node::Element(_)) => decide_elements(h, link, radiosity, deviation, allowance),
+    let (can_r, can_s) = (h.can_split(r, min_area), h.can_split(s, min_area));
+    let size = |n: Node| {
+        let (lo, hi) = h.bounds(n);
+        (hi - lo).length_squared()
+    };
+    let larger = if size(s) > size(r) { Split::Sender } else { Split::Receiver };
+    let feasible = |wanted: Split| match (wanted, can_r, can_s) {
+        (Split::Receiver, true, _) | (Split::Sender, _, true) => Some(wanted),
+        (Split::Larger, true, true) => Some(larger),
+        (Split::Larger, true, false) => Some(Split::Receiver),
+        (Split::Larger, false, true) => Some(Split::Sender),
+        _ => None,
+    };
+    match (r, s) {
+        // The largest error over the link's share that a split can reduce.
+        (Node::Element(_), Node::Element(_)) => {
+            decide_elements(h, link, radiosity, deviation, allowance).into_iter().find_map(feasible).unwrap_or(Split::Keep)
+        }
         _ => {
             let threshold = allowance.at(radiosity[h.flat(r)]);
             let rho = h.node_reflectance(r);
@@ -266,27 +282,15 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[
                 .flat_map(|&child| (0..3).map(move |c| (child, c)))
                 .map(|(child, c)| rho[c] * (radiosity[h.flat(child)][c] - b[c]).abs())
                 .fold(0.0, f64::max);
-            if sender_variation * link.form_factor > threshold && sender_variation * link.form_factor >= reflected * bound {
+            let wanted = if sender_variation * link.form_factor > threshold && sender_variation * link.form_factor >= reflected * bound {
                 Split::Sender
             } else if reflected * bound > threshold {
                 Split::Larger
             } else {
                 Split::Keep
-            }
+            };
+            feasible(wanted).unwrap_or(Split::Keep)
         }
-    };
-    let (can_r, can_s) = (h.can_split(r, min_area), h.can_split(s, min_area));
-    let size = |n: Node| {
-        let (lo, hi) = h.bounds(n);
-        (hi - lo).length_squared()
-    };
-    let larger = if size(s) > size(r) { Split::Sender } else { Split::Receiver };
-    match (wanted, can_r, can_s) {
-        (Split::Receiver, true, _) | (Split::Sender, _, true) => wanted,
-        (Split::Larger, true, true) => larger,
-        (Split::Larger, true, false) => Split::Receiver,
-        (Split::Larger, false, true) => Split::Sender,
-        _ => Split::Keep,
     }
 }
 
@@ -307,15 +311,22 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[
 /// Plain BF (`rho_r B_s F_rs`, split the larger) would also split senders
 /// whose every part sends the same light: our form factor is exact over
 /// the sender, so that buys nothing, and it multiplies links whose small
-/// same-signed errors then add up on the receiver. The largest term above
-/// the link's share of the receiver's allowance ([`Allowance::for_link`])
-/// decides which element is split, unless its children would be smaller
-/// than `min_area` (see [`decide`]): then a shadow edge splits the other
-/// element, and the other errors keep the link (splitting the other element
-/// would not reduce them). Links with a cluster at an end keep the whole
+/// same-signed errors then add up on the receiver. Returned: the splits
+/// whose terms exceed the link's share of the receiver's allowance
+/// ([`Allowance::for_link`]), largest term first; [`decide`] takes the
+/// first whose children would not be smaller than `min_area` (a shadow
+/// edge splits the other element when the larger cannot be). So a link
+/// whose receiver is at the floor but whose sender's radiosity varies too
+/// much still splits the sender: keeping it because the larger term (the
+/// kernel's spread over the receiver) could not be reduced left block
+/// faces next to the floor lit by the mean of a sender whose part near the
+/// crease is in the block's contact shadow (Cornell box, full gather
+/// against Mitsuba: tall block -4.1% -> -1.8%, short block +2.9% -> +0.2%,
+/// relative RMSE 2.3% -> 1.2%, for 1.6x the links and the same leaves).
+/// Links with a cluster at an end keep the whole
 /// allowance ([`Allowance::at`]): their bound is conservative, not an
 /// estimate, and shared, it refined a 99k-triangle closed box without end.
-fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], allowance: &Allowance) -> Split {
+fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], allowance: &Allowance) -> Vec<Split> {
     let (Node::Element(receiver), Node::Element(sender)) = (link.receiver, link.sender) else {
         unreachable!("an element link")
     };
@@ -341,12 +352,9 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation
         (sender_variation * link.form_factor, Split::Sender),
         (2.0 * v.min(1.0 - v) * reflected * link.form_factor, Split::Larger),
     ];
-    let (error, wanted) = errors.into_iter().fold((0.0, Split::Keep), |best, e| if e.0 > best.0 { e } else { best });
-    if error <= threshold {
-        Split::Keep
-    } else {
-        wanted
-    }
+    let mut over: Vec<(f64, Split)> = errors.into_iter().filter(|e| e.0 > threshold).collect();
+    over.sort_by(|a, b| b.0.total_cmp(&a.0));
+    over.into_iter().map(|e| e.1).collect()
 }
 
 /// Per element, the largest difference (per channel) between the radiosity
