@@ -43,7 +43,7 @@ sweep_comma := ,
 sweep_space := $(subst ,, )
 
 .PHONY: sweep
-sweep: $(BINS) $(BENCH_BINS)
+sweep: $(BINS) $(BENCH_BINS) $(BIN)/exact
 	$(if $(SWEEP_KNOB),$(if $(SWEEP_VALUES),,$(error SWEEP_KNOB=$(SWEEP_KNOB) needs SWEEP_VALUES=v1,v2,...)))
 	$(BIN)/sweep --scene $(SCENE) --solver $(SWEEP_SOLVER) $(if $(strip $(SWEEP_GATHER)),--gather $(subst $(sweep_space),$(sweep_comma),$(strip $(SWEEP_GATHER)))) \
 	  $(if $(SWEEP_KNOB),--knob $(SWEEP_KNOB)=$(SWEEP_VALUES)) $(foreach k,$(SWEEP_KNOBS),--knob $(k)) \

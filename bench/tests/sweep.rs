@@ -1,5 +1,6 @@
 //! The `sweep` binary end to end: a two-point sweep of an integrating
-//! sphere against its closed form, and one-line errors for bad options.
+//! sphere against its closed form, one of paper 002's simple environment
+//! against the exact stage's image, and one-line errors for bad options.
 //!
 //! The sweep drives the release stage binaries beside it in
 //! `target/release`, which `make test` builds before the tests.
@@ -62,6 +63,22 @@ fn a_sweep_of_the_integrating_sphere_has_both_points_and_its_error_falls_as_eps_
     let png = std::fs::read(out.join("sweep.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"));
     assert!(std::fs::read_to_string(out.join("sweep.svg")).unwrap().contains("<svg"));
+}
+
+/// Paper 002's simple environment has no closed form per element but an
+/// exact image: the sweep measures against it, and the error falls as EPS
+/// tightens (32 x 32 pixels: the exact image takes a second).
+#[test]
+fn a_sweep_of_the_simple_environment_is_measured_against_its_exact_image() {
+    let out = scratch("sweep_exact");
+    let o = out.to_str().unwrap();
+    let run = sweep(&["--scene", "simple-environment", "--knob", "EPS=0.05,0.001", "--reps", "1", "--gather", "preview", "--width", "32", "--height", "32", "-o", o]);
+    assert!(run.status.success(), "sweep failed:\n{}", String::from_utf8_lossy(&run.stderr));
+    let table: Sweep = read_ron(&out.join("sweep.ron")).unwrap().value;
+    assert_eq!(table.reference.kind, ReferenceKind::Exact, "{:?} {:?}", table.reference, table.notes);
+    let at = |eps: f64| table.points.iter().find(|p| p.knob("EPS") == Some(eps)).unwrap_or_else(|| panic!("no point at EPS {eps}")).error.median;
+    eprintln!("simple environment against its exact image: error {:.3e} at EPS 0.05, {:.3e} at EPS 0.001", at(0.05), at(0.001));
+    assert!(at(0.001) < at(0.05) && at(0.001) > 0.0);
 }
 
 #[test]

@@ -29,11 +29,19 @@
 //!    factor by which the other triangles' own relative RMSE can exceed
 //!    the figure (7.6x on sphere-300). A `--reference` given
 //!    too is not used, and the notes say so;
-//! 2. a foreign EXR given with `--reference`: each point's image is
+//! 2. the exact image, where the `exact` stage can render the scene (no
+//!    occluders, planar diffuse surfaces: paper 002's simple environment)
+//!    with [`EXACT_BOUNCES`] bounces, every pixel within its stated bound
+//!    of the truth; images are compared leaving out emitters and the
+//!    pixels within 1 pixel of an edge (`exact` samples each pixel at its
+//!    centre, the gathers average over it). Where `exact` refuses the
+//!    scene, its one-line reason is in the notes. A `--reference` given too
+//!    is not used;
+//! 3. a foreign EXR given with `--reference`: each point's image is
 //!    compared with it leaving out emitters and pixels within 2 pixels of
 //!    an edge (`compare --exclude-emitters --exclude-edges 2`: another
 //!    renderer's pixel filter and light sources differ there);
-//! 3. otherwise a run at settings stricter than every point's (every
+//! 4. otherwise a run at settings stricter than every point's (every
 //!    swept knob beyond its strictest value, see [`knobs::Tighten`], and
 //!    SPP 4x), with the most accurate gather swept (full where swept) and
 //!    seeds no point uses: "reference: strictest run (not converged
@@ -373,17 +381,16 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
         }
         Err(why) => {
             notes.push(format!("no closed form per element: {why}"));
-            match &config.reference {
-                Some(path) => {
-                    record.input(Input::new(path, &read_bytes(path)?, None))?;
-                    let name = path.file_name().map_or_else(|| s(path), |n| n.to_string_lossy().into_owned());
-                    let label = format!("reference: {name} (foreign EXR)");
-                    let flags = vec!["--exclude-emitters", "--exclude-edges", "2"];
-                    (Reference { kind: ReferenceKind::ForeignExr, label, file: s(path), run: None }, Measure::Image(path.clone(), flags))
+            match exact_reference(stages, config, &prepared, &reference_dir) {
+                Ok(found) => {
+                    if let Some(given) = &config.reference {
+                        notes.push(format!("--reference {} not used: the scene has an exact image, which comes first", given.display()));
+                    }
+                    found
                 }
-                None => {
-                    let (reference, image) = strictest_run(stages, config, &plans[0], &prepared, &reference_dir, progress)?;
-                    (reference, Measure::Image(image, vec!["--exclude-emitters", "--exclude-edges", "0"]))
+                Err(refused) => {
+                    notes.push(format!("no exact image: {refused}"));
+                    other_reference(stages, config, &plans[0], &prepared, &reference_dir, &mut record, progress)?
                 }
             }
         }
@@ -431,6 +438,7 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
 
     let error_metric = match reference.kind {
         ReferenceKind::ClosedForm => "relative RMSE of the solution per input triangle, area-weighted (compare's relative_rmse; the closed form is per element, so the gather's own error is not in it)",
+        ReferenceKind::Exact => "relative RMSE of the image (compare's relative_rmse, emitters and pixels within 1 of an edge left out)",
         ReferenceKind::ForeignExr => "relative RMSE of the image (compare's relative_rmse, emitters and pixels within 2 of an edge left out)",
         ReferenceKind::StrictestRun => "relative RMSE of the image (compare's relative_rmse, emitters and pixels that mix surfaces left out)",
     };
@@ -504,6 +512,51 @@ fn point(solver: Solver, gather: Gather, g: usize, setting: &Setting, reps: &[Re
         pareto: false,
         runs: s(dir),
     }
+}
+
+/// Bounces `exact` renders for a sweep's reference: far more than a
+/// closed two-plane system needs for the further bounces to fall under its
+/// tolerance at reflectances up to 0.8 (0.8^20 = 1e-2 of the first).
+pub const EXACT_BOUNCES: u32 = 20;
+
+/// The exact image as the reference, if the `exact` stage renders the
+/// scene; else its refusal, one line.
+fn exact_reference(stages: &Stages, config: &Config, prepared: &Prepared, dir: &Path) -> std::result::Result<(Reference, Measure), String> {
+    let image = dir.join("exact.exr");
+    let mut args = vec!["--mesh".to_string(), s(&prepared.mesh), "--manifest".into(), s(&prepared.manifest), "-o".into(), s(&image)];
+    args.push(format!("--bounces={EXACT_BOUNCES}"));
+    args.extend(config.width.map(|w| format!("--width={w}")));
+    args.extend(config.height.map(|h| format!("--height={h}")));
+    stages.run("exact", &args, &dir.join("exact.report.ron")).map_err(|e| e.to_string())?;
+    let label = format!("reference: exact image (paper 002, {EXACT_BOUNCES} bounces, within its stated bound)");
+    Ok((Reference { kind: ReferenceKind::Exact, label, file: s(&image), run: None }, Measure::Image(image, vec!["--exclude-emitters", "--exclude-edges", "1"])))
+}
+
+/// The reference of a scene with neither a closed form nor an exact image:
+/// the `--reference` EXR, else the strictest run of `plan`.
+#[allow(clippy::too_many_arguments)]
+fn other_reference(
+    stages: &Stages,
+    config: &Config,
+    plan: &Plan,
+    prepared: &Prepared,
+    dir: &Path,
+    record: &mut Run,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Reference, Measure)> {
+    Ok(match &config.reference {
+        Some(path) => {
+            record.input(Input::new(path, &read_bytes(path)?, None))?;
+            let name = path.file_name().map_or_else(|| s(path), |n| n.to_string_lossy().into_owned());
+            let label = format!("reference: {name} (foreign EXR)");
+            let flags = vec!["--exclude-emitters", "--exclude-edges", "2"];
+            (Reference { kind: ReferenceKind::ForeignExr, label, file: s(path), run: None }, Measure::Image(path.clone(), flags))
+        }
+        None => {
+            let (reference, image) = strictest_run(stages, config, plan, prepared, dir, progress)?;
+            (reference, Measure::Image(image, vec!["--exclude-emitters", "--exclude-edges", "0"]))
+        }
+    })
 }
 
 /// The strictest-run reference: the first solver's plan with every swept

@@ -54,6 +54,10 @@ pub enum ReferenceKind {
     /// The scene's radiosity per element in closed form (integrating
     /// sphere); errors are the solutions' per triangle.
     ClosedForm,
+    /// The `exact` stage's image (paper 002: Lambert's formula and
+    /// quadrature, to a stated bound), for the scenes it can solve;
+    /// errors are the images'.
+    Exact,
     /// An EXR image given with `--reference` (another renderer's, say);
     /// errors are the images'.
     ForeignExr,
