@@ -8,8 +8,9 @@
 SHELL := bash
 
 # --- scene -------------------------------------------------------------
-# SCENE=cornell (the default) and the sized procedural scenes (plants-100k,
-# sphere-5k, box-100k, cornell-box-2k, ...) are built into mesh-prep;
+# SCENE=cornell (the default), simple-environment (paper 002's) and the sized
+# procedural scenes (plants-100k, sphere-5k, box-100k, cornell-box-2k, ...)
+# are built into mesh-prep;
 # anything that names an existing file is a scene.ron path. The files a
 # scene reads (OBJ, MTL, textures, photometric files, wherever they lie)
 # are listed by mesh-prep itself in $(OUT)/mesh.d, which the pipelines

@@ -22,7 +22,8 @@ struct Args {
     scene: Option<PathBuf>,
     /// Use a built-in scene instead of a file: cornell-box, or sized
     /// (n like 10k, 100k, 1m): cornell-box-<n> (tessellated), plants-<n>,
-    /// sphere-<n> (integrating sphere), box-<n> (closed box, rho 0.8).
+    /// sphere-<n> (integrating sphere), box-<n> (closed box, rho 0.8);
+    /// simple-environment (paper 002's one-bounce scene).
     #[arg(long, conflicts_with = "scene")]
     builtin: Option<Builtin>,
     /// Output: the mesh (EXR tables of vertices and triangles).
