@@ -96,8 +96,9 @@ pub struct Params {
     pub filter_radius: f64,
     /// Shadow rays per vertex and emitting triangle in the direct pass.
     pub visibility_rays: usize,
-    /// Split a leaf when its corners' Stevens brightness differs by more
-    /// than this (brightness 1 = the adaptation luminance).
+    /// Split a leaf when the Stevens brightness at an edge midpoint departs
+    /// from the mean of its edge's ends by more than this (brightness 1 =
+    /// the adaptation luminance; [`perceptual`]).
     pub brightness_threshold: f64,
     /// Exponent of Stevens' power law.
     pub stevens_exponent: f64,
@@ -128,7 +129,7 @@ impl Default for Params {
             crease_angle_deg: 45.0,
             filter_radius: 0.2,
             visibility_rays: 16,
-            brightness_threshold: 0.05,
+            brightness_threshold: 0.02,
             stevens_exponent: 1.0 / 3.0,
             max_splits: 6,
             min_area: 1e-4,
@@ -431,8 +432,8 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         let candidates: Vec<usize> =
             (0..fine.elements.elements.len()).filter(|&e| fine.elements.elements[e].is_leaf() && f64::from(fine.elements.elements[e].area) / 4.0 >= smallest).collect();
         // The direct light at the edge midpoints, the vertices a split
-        // would make: a leaf is judged on its corners and those, so light
-        // that peaks inside an edge is seen.
+        // would make: a leaf is judged on how far their brightness departs
+        // from its corners' interpolation ([`perceptual`]).
         let mut queries = Vec::new();
         let mut queued = std::collections::HashSet::new();
         for &e in &candidates {
@@ -455,9 +456,9 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
                 let mid = |a: usize, b: usize| [0, 1, 2].map(|c| 0.5 * (ci[a][c] + ci[b][c]));
                 let indirect_mid = [mid(0, 1), mid(1, 2), mid(2, 0)];
                 let keys = midpoints(&setup, &fine.elements, e).map(|(key, _)| key);
-                let mut l: Vec<f64> = corners.iter().map(|&v| luminance_at[v]).collect();
-                l.extend((0..3).map(|k| luminance_of(corners[0], cache[&keys[k]], indirect_mid[k])));
-                perceptual::should_split(&l, adaptation, params.stevens_exponent, params.brightness_threshold)
+                let l = corners.map(|v| luminance_at[v]);
+                let mids = [0, 1, 2].map(|k| luminance_of(corners[0], cache[&keys[k]], indirect_mid[k]));
+                perceptual::should_split(l, mids, adaptation, params.stevens_exponent, params.brightness_threshold)
             })
             .collect();
         if to_split.is_empty() {

@@ -75,7 +75,7 @@ struct Args {
     /// Shadow rays per vertex and emitting triangle in the direct pass.
     #[arg(long)]
     visibility_rays: Option<usize>,
-    /// Split an element when its corners' Stevens brightness differs by more than this.
+    /// Split an element when the Stevens brightness at an edge midpoint departs from its edge's interpolation by more than this.
     #[arg(long)]
     brightness_threshold: Option<f64>,
     /// Exponent of Stevens' power law.

@@ -22,8 +22,15 @@
 //! the adaptation level and grows compressively, so a step that is
 //! conspicuous in a dark corner counts less beside a bright lamp, and the
 //! indirect light, which adds to both sides of a shadow edge, makes that
-//! edge less conspicuous, as the paper wants. A leaf is split when the
-//! brightness of its corners differs by more than a threshold.
+//! edge less conspicuous, as the paper wants.
+//!
+//! "Local differences in brightness" we take as the difference, at each
+//! edge midpoint of a leaf (the vertices a split would make), between the
+//! brightness there and the mean of the brightness at that edge's two
+//! ends: the brightness error the linear interpolation of the preview
+//! (Gouraud over the vertices) makes at that point. A leaf is split when
+//! one exceeds a threshold. So a shadow edge across a leaf is split, and
+//! a smooth gradient that interpolates well is not, however steep.
 
 use radiometry::color::luminance;
 
@@ -42,13 +49,13 @@ pub fn surface_luminance(b: [f64; 3]) -> f64 {
     luminance(b) / std::f64::consts::PI
 }
 
-/// Whether a leaf whose points (corners, and the edge midpoints a split
-/// would make) have luminances `points` should be split: their brightness
-/// differs by more than `threshold`.
-pub fn should_split(points: &[f64], adaptation: f64, exponent: f64, threshold: f64) -> bool {
-    let q = points.iter().map(|&l| brightness(l, adaptation, exponent));
-    let (lo, hi) = q.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), b| (lo.min(b), hi.max(b)));
-    hi - lo > threshold
+/// Whether a leaf whose corners have luminances `corners` and whose edge
+/// midpoints (01, 12, 20) have `midpoints` should be split: at some
+/// midpoint the brightness departs from its edge's interpolated brightness
+/// by more than `threshold` (module documentation).
+pub fn should_split(corners: [f64; 3], midpoints: [f64; 3], adaptation: f64, exponent: f64, threshold: f64) -> bool {
+    let q = |l: f64| brightness(l, adaptation, exponent);
+    [(0, 1), (1, 2), (2, 0)].iter().zip(midpoints).any(|(&(a, b), m)| (q(m) - 0.5 * (q(corners[a]) + q(corners[b]))).abs() > threshold)
 }
 
 #[cfg(test)]
@@ -59,10 +66,14 @@ mod tests {
     fn brightness_follows_the_cube_root_law_and_adds_indirect_light_to_both_sides() {
         // Eight times the adaptation luminance looks twice as bright.
         assert!((brightness(8.0, 1.0, 1.0 / 3.0) - 2.0).abs() < 1e-12);
-        // A 1:2 luminance step at the adaptation level: 2^(1/3) - 1 = 0.26.
-        assert!(should_split(&[1.0, 2.0, 1.0], 1.0, 1.0 / 3.0, 0.2));
-        // The same direct step on top of indirect light 10 at both corners:
-        // 12^(1/3) - 11^(1/3) = 0.066, under the threshold.
-        assert!(!should_split(&[11.0, 12.0, 11.0], 1.0, 1.0 / 3.0, 0.2));
+        // A 1:2 luminance step at the adaptation level inside edge 01 (the
+        // midpoint as bright as corner 1): half of 2^(1/3) - 1 = 0.13.
+        assert!(should_split([1.0, 2.0, 1.0], [2.0, 1.5, 1.0], 1.0, 1.0 / 3.0, 0.1));
+        // The same direct step on top of indirect light 10 everywhere:
+        // (12^(1/3) - 11^(1/3)) / 2 = 0.033, under the threshold.
+        assert!(!should_split([11.0, 12.0, 11.0], [12.0, 11.5, 11.0], 1.0, 1.0 / 3.0, 0.1));
+        // A linear 1:2 luminance gradient along edge 01 has no step: the
+        // cube root bends it by 1.5^(1/3) - (1 + 2^(1/3)) / 2 = 0.015.
+        assert!(!should_split([1.0, 2.0, 1.0], [1.5, 1.5, 1.0], 1.0, 1.0 / 3.0, 0.1));
     }
 }
