@@ -53,7 +53,6 @@ struct Scene {
     rho_a: f64,
     /// B: the plane z = b_z, facing up.
     b_z: f64,
-    b_rect: [f64; 4],
     rho_b: f64,
     object_a: u32,
     object_b: u32,
@@ -74,7 +73,7 @@ impl Scene {
         };
         let (a, b, ls) = (object("A"), object("B"), object("LS"));
         let material = |o: u32| &run.manifest.materials[run.mesh.triangles.iter().find(|t| t.object == o).unwrap().material as usize];
-        let ((a_rect, a_z), (b_rect, b_z)) = (rect(a), rect(b));
+        let ((a_rect, a_z), (_, b_z)) = (rect(a), rect(b));
         Scene {
             light: corners(ls),
             exitance: material(ls).emission[0],
@@ -82,7 +81,6 @@ impl Scene {
             a_rect,
             rho_a: material(a).diffuse[0],
             b_z,
-            b_rect,
             rho_b: material(b).diffuse[0],
             object_a: a,
             object_b: b,
@@ -231,13 +229,12 @@ fn every_samples_direct_luminance_is_lamberts_to_1e_9() {
     assert!(checked > 50, "{checked} samples");
 }
 
-/// Issue 16's figure, not met: the stage's defaults give 2.06 (A's
-/// steepest tenth holds 65 of its 316 samples); see readme-structured.md.
-/// Kept at the issue's 3x rather than loosened; run with `--ignored`.
-#[test]
-#[ignore = "issue 16 asks for 3x; measured 2.06 with the defaults"]
-fn samples_concentrate_where_the_direct_gradient_is_large() {
-    let run = structured("structured_gradient", &[]);
+/// On A: the density of samples in the tenth of A where the exact direct
+/// luminance's gradient is largest, over A's mean density; and the mean of
+/// `|grad|^2` over that tenth over its mean on A (what a density
+/// proportional to the squared gradient would give).
+fn gradient_concentration(test: &str) -> (f64, f64) {
+    let run = structured(test, &[]);
     let scene = Scene::of(&run);
     // |grad l| of A's exact direct luminance on a 50 x 50 grid of cells,
     // by central differences of Lambert's formula.
@@ -254,6 +251,9 @@ fn samples_concentrate_where_the_direct_gradient_is_large() {
         })
         .collect();
     cells.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mean = |c: &[(f64, usize)], p: i32| c.iter().map(|c| c.0.powi(p)).sum::<f64>() / c.len() as f64;
+    let squared = mean(&cells[..n * n / 10], 2) / mean(&cells, 2);
+    eprintln!("A's steepest tenth: |grad| {:.2} x its mean, |grad|^2 {squared:.2} x", mean(&cells[..n * n / 10], 1) / mean(&cells, 1));
     let steep: std::collections::HashSet<usize> = cells[..n * n / 10].iter().map(|c| c.1).collect();
     let on_a: Vec<[f64; 3]> = run.samples.samples.iter().filter(|s| run.samples.surfaces[s.surface as usize].object == scene.object_a).map(|s| s.position).collect();
     let in_steep = on_a
@@ -266,6 +266,26 @@ fn samples_concentrate_where_the_direct_gradient_is_large() {
     // Densities per unit area: the steepest tenth against A as a whole.
     let ratio = (in_steep as f64 / 0.1) / on_a.len() as f64;
     eprintln!("A: {} samples, {in_steep} in the steepest 10%: density ratio {ratio:.2}", on_a.len());
+    (ratio, squared)
+}
+
+/// The samples follow the light's change at least as a density
+/// proportional to the squared gradient would (uniform samples give 1).
+#[test]
+fn samples_concentrate_where_the_direct_gradient_is_large() {
+    let (ratio, squared) = gradient_concentration("structured_gradient");
+    assert!(ratio >= squared && ratio > 1.5, "density in the steepest 10% of A is {ratio:.2} x the mean; |grad|^2 there is {squared:.2} x");
+}
+
+/// Issue 16's example figure, not met: the defaults give 2.14 (A's
+/// steepest tenth holds 66 of its 309 samples). On this surface the
+/// gradient there is only 1.22 x its mean (its square 1.43 x), so 3 x
+/// would take a density growing like the gradient's sixth power. Kept at
+/// the issue's 3 x rather than loosened; run with `--ignored`.
+#[test]
+#[ignore = "issue 16's example asks for 3x; measured 2.14 (the gradient itself is 1.22x its mean there)"]
+fn samples_in_the_steepest_tenth_are_three_times_denser() {
+    let (ratio, _) = gradient_concentration("structured_gradient_3x");
     assert!(ratio >= 3.0, "density in the steepest 10% of A is {ratio:.2} x the mean");
 }
 

@@ -65,12 +65,15 @@ pub fn conical(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> 
 /// reproduces a linear luminance on any set, so the one-sided
 /// neighbourhoods at a surface's edges are not biased towards the
 /// interior. Falls back to [`conical`] where the samples within `r` lie
-/// on a line or fewer than three do.
+/// on a line or fewer than three do. The value is clamped to the range of
+/// the samples within `r` (per channel): a plane fitted across a steep
+/// shadow edge would otherwise overshoot it, even below zero.
 pub fn conical_linear(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> {
     // Normal equations of the weighted fit in (1, du, dv), in units of r.
     let mut m = [[0.0; 3]; 3];
     let mut rhs = [[0.0; 3]; 3];
     let mut count = 0;
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for s in samples {
         let d = (s.uv - at) / r;
         let distance = d.length();
@@ -85,6 +88,10 @@ pub fn conical_linear(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f6
                     rhs[k][a] += w * basis[a] * l;
                 }
             }
+            for k in 0..3 {
+                lo[k] = lo[k].min(s.luminance[k]);
+                hi[k] = hi[k].max(s.luminance[k]);
+            }
             count += 1;
         }
     }
@@ -93,7 +100,8 @@ pub fn conical_linear(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f6
         return conical(samples, at, r);
     }
     // c by Cramer's rule: the first column replaced by the right-hand side.
-    Some(rhs.map(|y| (y[0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (y[1] * m[2][2] - m[1][2] * y[2]) + m[0][2] * (y[1] * m[2][1] - m[1][1] * y[2])) / det))
+    let c = rhs.map(|y| (y[0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (y[1] * m[2][2] - m[1][2] * y[2]) + m[0][2] * (y[1] * m[2][1] - m[1][1] * y[2])) / det);
+    Some([0, 1, 2].map(|k| c[k].clamp(lo[k], hi[k])))
 }
 
 /// Which cone a display grid uses.

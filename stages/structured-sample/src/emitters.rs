@@ -43,30 +43,44 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
 
 /// The isolux polygons of one surface, `surface_index`, from its
 /// light-transfer samples (`indices` into the global sample list, with
-/// their `(u, v)` and direct illuminance) and its isolux cuts `levels`.
-/// Triangles whose centroid lies outside the surface (a concave outline)
-/// are dropped.
-pub fn isolux_polygons(surface_index: u32, surface: &Surface, indices: &[u32], uv: &[DVec2], illuminance: &[f64], levels: &[f64]) -> Vec<Polygon> {
-    let triangles: Vec<[usize; 3]> =
-        triangulate(uv).into_iter().filter(|t| surface.triangle_at((uv[t[0]] + uv[t[1]] + uv[t[2]]) / 3.0).is_some()).collect();
-    let bands: Vec<usize> = triangles.iter().map(|t| band(levels, t.iter().map(|&k| illuminance[k]).sum::<f64>() / 3.0)).collect();
+/// their `(u, v)`), `illuminance(uv)` the direct illuminance and `levels`
+/// the isolux cuts.
+///
+/// A triangle's band is that of the illuminance at its centroid (its
+/// corners lie on contours, so their mean would sit on a cut and flip
+/// between bands). Triangles whose centroid lies outside the surface (a
+/// concave outline) are dropped. Regions smaller than `min_area` (m²; a
+/// penumbra crosses every band in a narrow strip) are merged into the
+/// neighbour they share the longest boundary with, smallest first, so
+/// that no emitter is a sliver: "the emitters need not contain many
+/// samples, especially in the case of the shadowed regions" (002 Section
+/// 3.2).
+pub fn isolux_polygons(surface_index: u32, surface: &Surface, indices: &[u32], uv: &[DVec2], illuminance: impl Fn(DVec2) -> f64, levels: &[f64], min_area: f64) -> Vec<Polygon> {
+    let centroid = |t: &[usize; 3]| (uv[t[0]] + uv[t[1]] + uv[t[2]]) / 3.0;
+    let triangles: Vec<[usize; 3]> = triangulate(uv).into_iter().filter(|t| surface.triangle_at(centroid(t)).is_some()).collect();
+    let bands: Vec<usize> = triangles.iter().map(|t| band(levels, illuminance(centroid(t)))).collect();
+    let areas: Vec<f64> = triangles.iter().map(|t| 0.5 * (uv[t[1]] - uv[t[0]]).perp_dot(uv[t[2]] - uv[t[0]])).collect();
     let mut parent: Vec<usize> = (0..triangles.len()).collect();
+    // Edge-adjacent triangle pairs with the shared edge's length.
+    let mut adjacent: Vec<(usize, usize, f64)> = Vec::new();
     let mut by_edge: HashMap<(usize, usize), usize> = HashMap::new();
     for (i, t) in triangles.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             match by_edge.remove(&(b, a)) {
-                Some(j) if bands[j] == bands[i] => {
-                    let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
-                    parent[ri.max(rj)] = ri.min(rj);
-                }
-                Some(_) => {}
+                Some(j) => adjacent.push((j, i, (uv[a] - uv[b]).length())),
                 None => {
                     by_edge.insert((a, b), i);
                 }
             }
         }
     }
+    for &(i, j, _) in &adjacent {
+        if bands[i] == bands[j] {
+            union(&mut parent, i, j);
+        }
+    }
+    merge_small_regions(&mut parent, &areas, &adjacent, min_area);
     let mut polygons: Vec<Polygon> = Vec::new();
     let mut of_root: HashMap<usize, usize> = HashMap::new();
     for (i, t) in triangles.iter().enumerate() {
@@ -78,11 +92,56 @@ pub fn isolux_polygons(surface_index: u32, surface: &Surface, indices: &[u32], u
         let polygon = &mut polygons[p];
         polygon.triangles.push(t.map(|k| indices[k]));
         polygon.vertices.extend(t.map(|k| indices[k]));
-        polygon.area += 0.5 * (uv[t[1]] - uv[t[0]]).perp_dot(uv[t[2]] - uv[t[0]]);
+        polygon.area += areas[i];
     }
     for p in &mut polygons {
         p.vertices.sort_unstable();
         p.vertices.dedup();
     }
     polygons
+}
+
+fn union(parent: &mut [usize], i: usize, j: usize) {
+    let (ri, rj) = (find(parent, i), find(parent, j));
+    parent[ri.max(rj)] = ri.min(rj);
+}
+
+/// Merges every region (union-find `parent` over triangles of `areas`)
+/// smaller than `min_area` into the neighbour across its longest shared
+/// boundary (ties: the lower root), smallest region first, pass after pass
+/// until none is left that has a neighbour.
+fn merge_small_regions(parent: &mut [usize], areas: &[f64], adjacent: &[(usize, usize, f64)], min_area: f64) {
+    loop {
+        let roots: Vec<usize> = (0..parent.len()).map(|i| find(parent, i)).collect();
+        let mut area: HashMap<usize, f64> = HashMap::new();
+        for (i, &r) in roots.iter().enumerate() {
+            *area.entry(r).or_default() += areas[i];
+        }
+        let mut shared: HashMap<(usize, usize), f64> = HashMap::new();
+        for &(i, j, length) in adjacent {
+            let (a, b) = (roots[i], roots[j]);
+            if a != b {
+                *shared.entry((a, b)).or_default() += length;
+                *shared.entry((b, a)).or_default() += length;
+            }
+        }
+        let mut small: Vec<(f64, usize)> = area.iter().filter(|(_, &a)| a < min_area).map(|(&r, &a)| (a, r)).collect();
+        small.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        let mut changed: Vec<usize> = Vec::new();
+        let mut merged = false;
+        for (_, r) in small {
+            if changed.contains(&r) {
+                continue;
+            }
+            let best = shared.iter().filter(|((a, b), _)| *a == r && !changed.contains(b)).max_by(|x, y| x.1.total_cmp(y.1).then((y.0).1.cmp(&(x.0).1)));
+            if let Some((&(_, b), _)) = best {
+                union(parent, r, b);
+                changed.extend([r, b]);
+                merged = true;
+            }
+        }
+        if !merged {
+            return;
+        }
+    }
 }

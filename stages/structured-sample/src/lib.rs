@@ -85,6 +85,12 @@ pub struct Params {
     pub screen_spacing: u32,
     /// Rays per light-source triangle for the direct light's visibility.
     pub visibility_rays: usize,
+    /// Least area of a secondary emitter, as a fraction of its surface's:
+    /// smaller isolux regions are merged into a neighbour.
+    pub emitter_min_area: f64,
+    /// At most this many of a secondary emitter's vertices cast its
+    /// occlusion rays.
+    pub occlusion_vertices: usize,
     /// Stop shooting when the unshot power (all polygons together) is
     /// under this fraction of the emitted power.
     pub threshold: f64,
@@ -119,10 +125,12 @@ impl Default for Params {
             contour_spacing: 0.12,
             turn_angle_deg: 25.0,
             lattice_spacing: 0.25,
-            shadow_spacing: 0.02,
+            shadow_spacing: 0.04,
             umbra_spacing: 0.3,
             screen_spacing: 24,
             visibility_rays: 16,
+            emitter_min_area: 0.05,
+            occlusion_vertices: 16,
             threshold: 1e-3,
             max_shots: 10_000,
             bounces: 0,
@@ -156,6 +164,7 @@ impl Params {
             ("probe_resolution", self.probe_resolution, 4, 4096),
             ("levels", self.levels, 1, 256),
             ("visibility_rays", self.visibility_rays, 1, 4096),
+            ("occlusion_vertices", self.occlusion_vertices, 1, 4096),
             ("display_resolution", self.display_resolution, 1, 4096),
             ("screen_spacing", self.screen_spacing as usize, 1, 16384),
             ("spp_side", self.spp_side as usize, 1, 16),
@@ -165,6 +174,9 @@ impl Params {
         }
         if !(self.turn_angle_deg > 0.0 && self.turn_angle_deg <= 180.0) {
             return Some(format!("turn_angle_deg must be in (0, 180], not {}", self.turn_angle_deg));
+        }
+        if !(self.emitter_min_area >= 0.0 && self.emitter_min_area <= 1.0) {
+            return Some(format!("emitter_min_area must be in [0, 1], not {}", self.emitter_min_area));
         }
         if !(self.threshold > 0.0 && self.threshold < 1.0) {
             return Some(format!("threshold must be in (0, 1), not {}", self.threshold));
@@ -311,12 +323,13 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         }
         let members: Vec<u32> = (0..placed.len() as u32).filter(|&i| placed[i as usize].0 == s as u32 && placed[i as usize].1.reason != Reason::ScreenDensity).collect();
         let uv: Vec<DVec2> = members.iter().map(|&i| placed[i as usize].1.uv).collect();
-        let illuminance: Vec<f64> = members.iter().map(|&i| evaluated[i as usize].1).collect();
-        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, &illuminance, &isolux_levels(&grids[s], params.levels)));
+        let grid = &grids[s];
+        let min_area = params.emitter_min_area * surface.area;
+        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area));
     }
     // 5. Progressive shooting.
     (progress.phase)("shooting", params.max_shots as u64);
-    let shooting_params = ShootingParams { threshold: params.threshold, max_shots: params.max_shots, bounces: params.bounces };
+    let shooting_params = ShootingParams { threshold: params.threshold, max_shots: params.max_shots, bounces: params.bounces, occlusion_vertices: params.occlusion_vertices };
     work.shooting = shoot(&polygons, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
     work.shooting_seconds = clock.elapsed().as_secs_f64();
 

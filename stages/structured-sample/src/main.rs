@@ -63,6 +63,12 @@ struct Args {
     /// Rays per light-source triangle for the direct light's visibility.
     #[arg(long)]
     visibility_rays: Option<usize>,
+    /// Least area of a secondary emitter, fraction of its surface's.
+    #[arg(long)]
+    emitter_min_area: Option<f64>,
+    /// At most this many of a secondary emitter's vertices cast occlusion rays.
+    #[arg(long)]
+    occlusion_vertices: Option<usize>,
     /// Stop shooting under this fraction of the emitted power.
     #[arg(long)]
     threshold: Option<f64>,
@@ -109,6 +115,8 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.umbra_spacing = args.umbra_spacing.unwrap_or(p.umbra_spacing);
     p.screen_spacing = args.screen_spacing.unwrap_or(p.screen_spacing);
     p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
+    p.emitter_min_area = args.emitter_min_area.unwrap_or(p.emitter_min_area);
+    p.occlusion_vertices = args.occlusion_vertices.unwrap_or(p.occlusion_vertices);
     p.threshold = args.threshold.unwrap_or(p.threshold);
     p.max_shots = args.max_shots.unwrap_or(p.max_shots);
     p.bounces = args.bounces.unwrap_or(p.bounces);

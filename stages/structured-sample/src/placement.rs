@@ -5,7 +5,7 @@
 //!   probe grid's illuminance is cut at `levels` evenly spaced levels
 //!   (its Figure 3 quantises the same way) and samples are placed where a
 //!   contour crosses a grid edge, spaced along the contour by
-//!   `s = s_c / (1 + s_c kappa / theta) * clamp((g_mean / g)², 1/16, 4)`:
+//!   `s = s_c / (1 + s_c kappa / theta) * clamp((g_mean / g)², 1/4, 4)`:
 //!   `s_c` on a straight contour of average steepness, one sample per
 //!   `theta` of turning on a curved one. Evenly spaced levels lie closer
 //!   together where the gradient `g` is large; the last factor (a choice:
@@ -17,8 +17,9 @@
 //!   (`shadow_spacing`) in the penumbra, sparse (`umbra_spacing`) in the
 //!   umbra, which "does not contribute much";
 //! - a coarse lattice (`lattice_spacing`) keeps smooth regions sampled,
-//!   and the surface's corners and edges are sampled at `s_c`, so that
-//!   resampling never extrapolates past the last sample;
+//!   and the surface's corners and edges are sampled at the lattice's
+//!   spacing, so that resampling never extrapolates far past the last
+//!   sample;
 //! - display samples "in a view-dependent manner": one per
 //!   `screen_spacing` x `screen_spacing` pixels of the camera image, so
 //!   denser where the surface is larger on screen ([`screen_candidates`]).
@@ -71,10 +72,11 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
     let theta = params.turn_angle_deg.to_radians();
     let candidate = |uv, reason, spacing| Candidate { uv, reason, level: NO_LEVEL, spacing, priority: 0.0 };
     let mut out = Vec::new();
+    let s_edge = params.lattice_spacing * extent;
     for edge in boundary {
-        let pieces = ((edge[1] - edge[0]).length() / s_c).ceil().max(1.0) as usize;
+        let pieces = ((edge[1] - edge[0]).length() / s_edge).ceil().max(1.0) as usize;
         for k in 0..=pieces {
-            out.push(candidate(edge[0].lerp(edge[1], k as f64 / pieces as f64), Reason::SurfaceEdge, s_c));
+            out.push(candidate(edge[0].lerp(edge[1], k as f64 / pieces as f64), Reason::SurfaceEdge, s_edge));
         }
     }
     for j in 0..grid.nv {
@@ -105,7 +107,7 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
                     let w = fa / (fa - fb);
                     let kappa = (1.0 - w) * grid.curvature(a.0, a.1) + w * grid.curvature(b.0, b.1);
                     let g = (1.0 - w) * grid.gradient(a.0, a.1) + w * grid.gradient(b.0, b.1);
-                    let steepness = if g > 0.0 && g_mean > 0.0 { (g_mean / g).powi(2).clamp(1.0 / 16.0, 4.0) } else { 1.0 };
+                    let steepness = if g > 0.0 && g_mean > 0.0 { (g_mean / g).powi(2).clamp(0.25, 4.0) } else { 1.0 };
                     let uv = grid.uv(a.0, a.1).lerp(grid.uv(b.0, b.1), w);
                     let spacing = s_c / (1.0 + s_c * kappa / theta) * steepness;
                     contour.push(Candidate { uv, reason: Reason::IsoluxContour, level: level as u32, spacing, priority: kappa });

@@ -68,6 +68,17 @@ impl ProbeGrid {
         &self.probes[i + j * self.nu]
     }
 
+    /// The illuminance at `uv`, bilinear between the four nodes around it
+    /// (clamped to the grid).
+    pub fn illuminance_at(&self, uv: DVec2) -> f64 {
+        let g = ((uv - self.lo) / self.h).clamp(DVec2::ZERO, DVec2::new((self.nu - 1) as f64, (self.nv - 1) as f64));
+        let (i, j) = ((g.x.floor() as usize).min(self.nu.saturating_sub(2)), (g.y.floor() as usize).min(self.nv.saturating_sub(2)));
+        let (fx, fy) = (g.x - i as f64, g.y - j as f64);
+        let (i1, j1) = ((i + 1).min(self.nu - 1), (j + 1).min(self.nv - 1));
+        let f = |a: usize, b: usize| self.at(a, b).illuminance;
+        (1.0 - fy) * ((1.0 - fx) * f(i, j) + fx * f(i1, j)) + fy * ((1.0 - fx) * f(i, j1) + fx * f(i1, j1))
+    }
+
     /// `(u, v)` of node `(i, j)`.
     pub fn uv(&self, i: usize, j: usize) -> DVec2 {
         self.lo + DVec2::new(i as f64, j as f64) * self.h

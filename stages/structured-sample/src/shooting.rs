@@ -15,7 +15,10 @@
 //!
 //!   the paper's occlusion: "a ray is cast from each v_i to every display
 //!   sample ... the result at each display sample is weighted based on the
-//!   ray intersection count";
+//!   ray intersection count". The paper's polygons are coarse (a few
+//!   vertices); a merged region here may have a hundred, so at most
+//!   `occlusion_vertices` of them cast rays, evenly spread over the
+//!   vertex list (all of them where there are fewer);
 //! - a sample of reflectance `rho` gains `rho dE` of radiosity, and every
 //!   polygon it is a vertex of gains the vertex average of those gains as
 //!   unshot radiosity;
@@ -79,6 +82,8 @@ pub struct ShootingParams {
     pub max_shots: usize,
     /// Reflections off secondary emitters; 0 for all of them.
     pub bounces: u32,
+    /// At most this many of a polygon's vertices cast occlusion rays.
+    pub occlusion_vertices: usize,
 }
 
 /// Shoots until converged (see the module documentation); adds each
@@ -99,6 +104,11 @@ pub fn shoot(polygons: &[Polygon], samples: &mut [Collector], rays: &SceneRays, 
     }
     let mut work = ShootingWork { shot: vec![[0.0; 3]; polygons.len()], ..Default::default() };
     let power = |p: usize, g: usize, unshot: &[Vec<[f64; 3]>]| polygons[p].area * luminance(unshot[p][g]);
+    // Each polygon's transfer factors, kept from its first shot for the
+    // next ones (its geometry and occlusion do not change).
+    let mut transfer: Vec<Option<Vec<f64>>> = vec![None; polygons.len()];
+    let mut cached = 0usize;
+    let mut gains: Vec<[f64; 3]> = Vec::with_capacity(samples.len());
     loop {
         let best = (0..polygons.len()).flat_map(|p| (0..generations).map(move |g| (p, g))).max_by(|a, b| power(a.0, a.1, &unshot).total_cmp(&power(b.0, b.1, &unshot)));
         let Some((p, g)) = best else {
@@ -118,47 +128,85 @@ pub fn shoot(polygons: &[Polygon], samples: &mut [Collector], rays: &SceneRays, 
         for (s, d) in work.shot[p].iter_mut().zip(db) {
             *s += d;
         }
-        let polygon = &polygons[p];
-        let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect();
-        let sender_normal = samples[polygon.vertices[0] as usize].normal;
-        let vertices: Vec<(DVec3, u32)> = polygon.vertices.iter().map(|&v| (samples[v as usize].position, samples[v as usize].triangle)).collect();
-        let gains: Vec<([f64; 3], u64)> = samples
-            .par_iter()
-            .map(|x| {
-                if x.surface == polygon.surface {
-                    return ([0.0; 3], 0);
-                }
-                let factor: f64 = corners.iter().map(|c| point_to_one_sided_polygon(x.position, x.normal, c, sender_normal)).sum();
-                if factor <= 0.0 {
-                    return ([0.0; 3], 0);
-                }
-                let clear = vertices.iter().filter(|(v, t)| rays.segment_clear(*v, x.position, [*t, x.triangle])).count();
-                let visible = clear as f64 / vertices.len() as f64;
-                ([0, 1, 2].map(|k| x.reflectance[k] * db[k] * factor * visible), vertices.len() as u64)
-            })
-            .collect();
-        work.rays += gains.iter().map(|g| g.1).sum::<u64>();
-        let next = if params.bounces == 0 { Some(0) } else { (g + 1 < generations).then_some(g + 1) };
-        for (s, (gain, _)) in gains.iter().enumerate() {
-            for (i, d) in samples[s].indirect.iter_mut().zip(gain) {
-                *i += d;
+        if transfer[p].is_none() {
+            let (factors, rays_cast) = transfer_factors(&polygons[p], samples, rays, params.occlusion_vertices);
+            work.rays += rays_cast;
+            // Over the cache's bound, the factors serve this shot only.
+            let keep = cached + factors.len() <= CACHE_ENTRIES;
+            cached += if keep { factors.len() } else { 0 };
+            transfer[p] = Some(factors);
+            shoot_with(transfer[p].as_deref().expect("just set"), &db, samples, &mut gains);
+            if !keep {
+                transfer[p] = None;
             }
+        } else {
+            shoot_with(transfer[p].as_deref().expect("cached"), &db, samples, &mut gains);
         }
-        if let Some(next) = next {
-            let mut touched: Vec<usize> = gains.iter().enumerate().filter(|(_, g)| g.0 != [0.0; 3]).flat_map(|(s, _)| member_of[s].iter().copied()).collect();
-            touched.sort_unstable();
-            touched.dedup();
-            for q in touched {
-                let mean = vertex_mean(&polygons[q], |s| gains[s].0);
-                for (u, m) in unshot[q][next].iter_mut().zip(mean) {
-                    *u += m;
-                }
-            }
-        }
+        spread(&gains, g, generations, params.bounces, &member_of, polygons, &mut unshot);
         work.shots += 1;
         shot(work.remaining);
     }
     work
+}
+
+/// Most transfer factors kept between shots (8 bytes each).
+const CACHE_ENTRIES: usize = 1 << 25;
+
+/// Per sample, `F_{dx->P} V_P(x)` of polygon `P` (0 on P's own surface),
+/// and the rays cast: Lambert's formula summed over P's triangles, the
+/// visible fraction by one ray from each of P's vertices (at most
+/// `occlusion_vertices` of them, evenly spread over the list).
+fn transfer_factors(polygon: &Polygon, samples: &[Collector], rays: &SceneRays, occlusion_vertices: usize) -> (Vec<f64>, u64) {
+    let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect();
+    let sender_normal = samples[polygon.vertices[0] as usize].normal;
+    let n = polygon.vertices.len();
+    let casting = n.min(occlusion_vertices.max(1));
+    let vertices: Vec<(DVec3, u32)> = (0..casting).map(|k| polygon.vertices[k * n / casting] as usize).map(|v| (samples[v].position, samples[v].triangle)).collect();
+    let factors: Vec<(f64, u64)> = samples
+        .par_iter()
+        .map(|x| {
+            if x.surface == polygon.surface {
+                return (0.0, 0);
+            }
+            let factor: f64 = corners.iter().map(|c| point_to_one_sided_polygon(x.position, x.normal, c, sender_normal)).sum();
+            if factor <= 0.0 {
+                return (0.0, 0);
+            }
+            let clear = vertices.iter().filter(|(v, t)| rays.segment_clear(*v, x.position, [*t, x.triangle])).count();
+            (factor * clear as f64 / vertices.len() as f64, vertices.len() as u64)
+        })
+        .collect();
+    let rays_cast = factors.iter().map(|f| f.1).sum();
+    (factors.into_iter().map(|f| f.0).collect(), rays_cast)
+}
+
+/// Adds `rho dB F V` to every sample's `indirect` and leaves it in `gains`.
+fn shoot_with(factors: &[f64], db: &[f64; 3], samples: &mut [Collector], gains: &mut Vec<[f64; 3]>) {
+    gains.clear();
+    for (x, f) in samples.iter_mut().zip(factors) {
+        let gain = [0, 1, 2].map(|k| x.reflectance[k] * db[k] * f);
+        for (i, d) in x.indirect.iter_mut().zip(gain) {
+            *i += d;
+        }
+        gains.push(gain);
+    }
+}
+
+/// Passes the samples' `gains` from a shot of generation `g` on to the
+/// unshot radiosity of the polygons they are vertices of: generation
+/// `g + 1`, or none past the last one `bounces` allows.
+fn spread(gains: &[[f64; 3]], g: usize, generations: usize, bounces: u32, member_of: &[Vec<usize>], polygons: &[Polygon], unshot: &mut [Vec<[f64; 3]>]) {
+    let next = if bounces == 0 { Some(0) } else { (g + 1 < generations).then_some(g + 1) };
+    let Some(next) = next else { return };
+    let mut touched: Vec<usize> = gains.iter().enumerate().filter(|(_, g)| **g != [0.0; 3]).flat_map(|(s, _)| member_of[s].iter().copied()).collect();
+    touched.sort_unstable();
+    touched.dedup();
+    for q in touched {
+        let mean = vertex_mean(&polygons[q], |s| gains[s]);
+        for (u, m) in unshot[q][next].iter_mut().zip(mean) {
+            *u += m;
+        }
+    }
 }
 
 /// The mean over `polygon`'s vertices of `value`.
