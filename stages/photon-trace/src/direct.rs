@@ -84,8 +84,8 @@ impl DirectScene<'_> {
                 }
             }
             let v = visible.fraction().unwrap_or(1.0);
-            for c in 0..3 {
-                e[c] += light.exitance[c] * f * v;
+            for (e, m) in e.iter_mut().zip(light.exitance) {
+                *e += m * f * v;
             }
         }
         let (goniometric, cast) = self.luminaires.at_point(x, n, triangle);

@@ -91,8 +91,8 @@ pub fn filter(tree: &VertexTree, e: &Estimates, cos_crease: f64) -> Vec<[f64; 3]
                     continue;
                 }
                 let w = (1.0 - d2 / (r * r)).max(0.0) * e.hat_area[u];
-                for c in 0..3 {
-                    sum[c] += w * e.irradiance[u][c];
+                for (s, x) in sum.iter_mut().zip(e.irradiance[u]) {
+                    *s += w * x;
                 }
                 weight += w;
             }

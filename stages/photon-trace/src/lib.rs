@@ -5,27 +5,33 @@
 //! leaving a displayable solution:
 //!
 //! 1. **Stochastic** ([`tracing`]): photons from every emitter, bucketed
-//!    into the vertices of the leaf mesh ([`mesh`]), every hit deposited,
-//!    the estimates filtered over a kd-tree of the vertices with a radius
-//!    that shrinks as each vertex's variance falls ([`filter`]), until
+//!    into the vertices of the *photon mesh* ([`mesh`]: the input
+//!    triangles split 1:4 to `initial_area`), every hit deposited, the
+//!    estimates filtered over a kd-tree of the vertices with a radius that
+//!    shrinks as each vertex's variance falls ([`filter`]), until
 //!    `preview_photons`.
 //! 2. **Deterministic direct light** ([`direct`]): Lambert's formula with
 //!    ray-cast visibility for area lights, `I cos / r²` for goniometric
-//!    ones, at every vertex, on a mesh split where the perceived brightness
-//!    (Stevens' power law over direct plus the stage-1 indirect estimate,
-//!    [`perceptual`]) differs across a leaf by more than a threshold.
+//!    ones, at every vertex of a *display mesh* that starts as the photon
+//!    mesh and is split where linear interpolation misses the perceived
+//!    brightness (Stevens' power law over direct plus the stage-1 indirect
+//!    estimate, [`perceptual`]).
 //! 3. **Stochastic indirect**: photons again, their first hits no longer
-//!    deposited (the direct light is exact now), into fresh tallies on the
-//!    split mesh ([`tally`]), until every vertex's estimated relative error
-//!    is under `target_error`, or `max_photons`, or `time_budget_s`.
+//!    deposited (the direct light is exact now), added to stage 1's
+//!    indirect tally ([`tally`]: the deposits of photons that had bounced
+//!    at least once), until every photon-mesh vertex's estimated relative
+//!    error is under `target_error`, or `max_photons`, or `time_budget_s`.
 //!
-//! Stage 3 starts its tallies afresh: the stage-1 deposits are hat-weighted
-//! projections onto the leaves as they were then, and splitting a leaf
-//! changes its corners' hat functions, so those sums no longer estimate
-//! anything on the new mesh (the paper, too, "replaces the finished direct
-//! computations with additional stochastic particle tracing"). Stage 1 is
-//! short by default; it serves the first images and the adaptation of
-//! stage 2.
+//! Indirect light stays on the photon mesh; the display mesh's vertices
+//! get it by linear interpolation over the photon-mesh leaf they lie in.
+//! This is the premise of the hybrid: the sharp features (shadow edges)
+//! are in the direct light, which is exact at every display vertex, and
+//! the indirect light is smooth, so the photons need not resolve them, and
+//! each photon-mesh vertex keeps a hat area large enough to converge. It
+//! also keeps every photon: stage 3 continues stage 1's indirect sums
+//! (the paper "replaces the finished direct computations with additional
+//! stochastic particle tracing"); a split would have changed the hat
+//! functions those sums project onto.
 //!
 //! Radiosity at a vertex is `B = M + rho (E_direct + E_indirect)` (stage 1:
 //! `M + rho E`), per channel; an element's radiosity in `solution.exr` is
@@ -79,7 +85,8 @@ pub struct Params {
     /// Stage 3 stops once every vertex's estimated relative standard error
     /// of radiosity is under this (see [`Params::relative_floor`]).
     pub target_error: f64,
-    /// Stage 3 stops after this many photons whatever the error.
+    /// Stage 3 stops once the indirect estimate holds this many photons
+    /// (stage 1's included), whatever the error.
     pub max_photons: u64,
     /// Stage 3 stops after this many seconds of the whole run (makes the
     /// result depend on the machine); none by default.
@@ -204,7 +211,7 @@ impl std::fmt::Display for Stage {
 pub struct Snapshot {
     /// Its stage.
     pub stage: Stage,
-    /// Photons traced in that stage so far.
+    /// Photons in the estimate (as [`Progress::photons`]).
     pub photons: u64,
     /// Seconds since the solve started (volatile).
     pub seconds: f64,
@@ -219,7 +226,8 @@ pub struct Snapshot {
 pub struct Progress {
     /// Stage.
     pub stage: Stage,
-    /// Photons traced in that stage so far.
+    /// Photons in the estimate: of stage 1, or, in stage 3, of the
+    /// indirect estimate (stage 1's included).
     pub photons: u64,
     /// Seconds since the solve started (volatile).
     pub seconds: f64,
@@ -272,9 +280,6 @@ pub struct Work {
 pub struct Solved {
     /// Elements with radiosity.
     pub elements: Vec<Element>,
-    /// Per vertex: unfiltered and filtered indirect (stage 3) irradiance,
-    /// W/m² luminance, for tests of the filter.
-    pub vertex_irradiance: Vec<(f64, f64)>,
     /// Work done.
     pub work: Work,
 }
@@ -515,12 +520,11 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     work.stage3_photons = indirect.photons() - work.stage1_photons;
     work.final_s = clock();
     let smoothed = filtered(&setup, &coarse, &mean, &errors, params);
-    let vertex_irradiance = (0..coarse.vertices.len()).map(|v| (luminance(mean[v]), luminance(smoothed[v]))).collect();
     let elements = element_radiosity(&fine, &fine_radiosity(&smoothed));
     work.elements = elements.len();
     work.leaves = elements.iter().filter(|e| e.is_leaf()).count();
     work.vertices = fine.vertices.len();
-    Ok(Solved { elements, vertex_irradiance, work })
+    Ok(Solved { elements, work })
 }
 
 /// Per leaf of `fine` (whose elements extend `coarse`'s), the values at
@@ -704,7 +708,7 @@ fn snapshot_due(observer: &Observer, params: &Params, round: u64, last: bool) ->
     }
     let per_round = (params.batches_per_round * params.batch_photons) as u64;
     let every = observer.snapshot_every.div_ceil(per_round).max(1);
-    round % every == 0
+    round.is_multiple_of(every)
 }
 
 /// The elements with radiosity: a leaf's is the mean of its corners'

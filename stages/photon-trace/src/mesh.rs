@@ -187,7 +187,7 @@ impl Vertices {
             let world = g.element(&elements.corners[e]);
             let centroid = (world[0] + world[1] + world[2]) / 3.0;
             let area = g.area / 4f64.powi(element.level as i32);
-            for k in 0..3 {
+            for (k, &corner) in world.iter().enumerate() {
                 let key = elements.point_key(mesh, e, k);
                 let candidates = at_point.entry(key).or_default();
                 let found = candidates.iter().copied().find(|&c| v.material[c as usize] == material && first_normal[c as usize].dot(g.normal) >= cos_crease);
@@ -195,7 +195,7 @@ impl Vertices {
                     Some(id) => id,
                     None => {
                         let id = v.position.len() as u32;
-                        v.position.push(world[k]);
+                        v.position.push(corner);
                         first_normal.push(g.normal);
                         v.hat_area.push(0.0);
                         v.material.push(material);

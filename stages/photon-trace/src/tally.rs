@@ -56,8 +56,8 @@ impl Tally {
                 continue; // already added (a vertex hit twice in the batch)
             }
             let x = d.map(|d| d * scale * self.inverse_area[v]);
-            for c in 0..3 {
-                self.sum[v][c] += x[c];
+            for (s, x) in self.sum[v].iter_mut().zip(x) {
+                *s += x;
             }
             self.sum_sq[v] += luminance(x).powi(2);
             self.scratch[v] = [0.0; 3];
