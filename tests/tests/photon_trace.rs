@@ -10,7 +10,7 @@
 //! per-leaf checks are per-vertex checks averaged over three vertices.
 
 use end_to_end::closed_form::{lambert_polygon, point_to_rectangle};
-use end_to_end::scenes::{rectangle, QuadScene};
+use end_to_end::scenes::{closed_box, rectangle, rotational_ldt, QuadScene};
 use end_to_end::{bin, refused, run_ok, s, scratch};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::report::Report;
@@ -427,4 +427,38 @@ fn the_solution_has_the_same_bits_at_any_thread_count() {
     // records; compare the element tables.
     let read = |threads: &str| Solution::read(&dir.join(format!("solution-{threads}.exr"))).unwrap().0.elements;
     assert_eq!(read("1"), read("3"));
+}
+
+#[test]
+fn a_goniometric_lights_photons_carry_its_flux() {
+    // A closed 2 m room (reflectance 1/2) lit only by a luminaire of
+    // I_v = 500 (1 + cos gamma) cd hanging 0.5 m under the ceiling (flux
+    // 2000 pi lm, Phi = 2000 pi / 683 W per channel). Stage 1 deposits every
+    // hit, so the area-mean radiosity of its snapshot, rho E, estimates
+    // rho Phi / ((1 - rho) A) without bias: directions drawn by rejection
+    // with density I / Phi, each photon carrying Phi. A photon's number of
+    // hits is geometric (mean 2, standard deviation 1.41), so at 2^17
+    // photons the mean's standard error is 1.41 / 2 / sqrt(2^17) = 0.2%:
+    // 1% is five of them. The final solution's mean adds the
+    // direct pass's discretisation (point values at vertices, interpolated
+    // linearly), within 2% on this mesh.
+    let dir = scratch("photon_luminaire");
+    std::fs::write(dir.join("lamp.ldt"), rotational_ldt(&|gamma| 500.0 * (1.0 + gamma.to_radians().cos()))).unwrap();
+    let mut room = closed_box(2.0, 0.5, 0.0);
+    room.lights.push("Goniometric(file: \"lamp.ldt\", position: (1.0, 1.0, 1.5), nadir: (0.0, 0.0, -1.0))".into());
+    prepare(&dir, &[s(&room.write(&dir))]);
+    let snapshots = dir.join("snapshots");
+    std::fs::create_dir_all(&snapshots).unwrap();
+    let solution = trace(&dir, "solution", &["--preview-photons", "131072", "--target-error", "0.02", "--snapshot-dir", s(&snapshots)]);
+    let (manifest, _, stochastic) = read_leaves(&dir, &snapshots.join("stochastic.exr"));
+    let phi = manifest.goniometric_lights[0].flux_lm / 683.0;
+    assert!((phi / (2000.0 * std::f64::consts::PI / 683.0) - 1.0).abs() < 1e-3, "flux {phi} W");
+    let expected = 0.5 * phi / (0.5 * manifest.statistics.total_area);
+    let mean = area_mean(&stochastic, |_| true);
+    eprintln!("luminaire room: stage-1 mean radiosity {mean} vs {expected}");
+    assert!((mean / expected - 1.0).abs() < 0.01, "stage 1: mean radiosity {mean} vs closed form {expected}");
+    let (_, _, last) = read_leaves(&dir, &solution);
+    let mean = area_mean(&last, |_| true);
+    eprintln!("luminaire room: final mean radiosity {mean} vs {expected}");
+    assert!((mean / expected - 1.0).abs() < 0.02, "final: mean radiosity {mean} vs closed form {expected}");
 }
