@@ -5,8 +5,8 @@
 //! wall, and the flux of an open scene. The references are the closed
 //! forms of `end_to_end::closed_form`, evaluated on the mesh gpu-shoot
 //! read, averaged over each element by a quadrature of their own; only the
-//! emitter shoots (`--max-shots 1`, every other surface black or its light
-//! leaving the scene), so each receiver's radiosity is `rho B F(point ->
+//! emitter's triangles shoot (`--max-shots`, every other surface black or
+//! its light leaving the scene), so each receiver's radiosity is `rho B F(point ->
 //! emitter)`. gpu-shoot needs a Vulkan adapter (lavapipe is enough):
 //! without one each test skips loudly, but fails when CI is set.
 
@@ -20,12 +20,15 @@ use std::path::{Path, PathBuf};
 
 /// Emitted radiosity of every emitter, W/m².
 const EMISSION: f64 = 10.0;
+/// Emitted radiosity of the `dim` emitters, W/m².
+const DIM: f64 = 4.0;
 /// Reflectance of every receiver.
 const RHO: f64 = 0.5;
 
 /// A scene of planar polygons (triangles or quads, corners in order, front
-/// face by the right-hand rule) on three materials: `emitter` (black,
-/// emitting), `receiver` (grey) and `black`.
+/// face by the right-hand rule) on four materials: `emitter` and `dim`
+/// (black, emitting [`EMISSION`] and [`DIM`]), `receiver` (grey) and
+/// `panel` (grey, two-sided).
 #[derive(Default)]
 struct Polygons(Vec<(&'static str, &'static str, Vec<[f64; 3]>)>);
 
@@ -47,10 +50,11 @@ impl Polygons {
             writeln!(obj, "f {}", face.join(" ")).unwrap();
         }
         std::fs::write(dir.join("scene.obj"), obj).unwrap();
-        std::fs::write(dir.join("scene.mtl"), format!("newmtl emitter\nKd 0 0 0\nnewmtl receiver\nKd {RHO} {RHO} {RHO}\nnewmtl black\nKd 0 0 0\n")).unwrap();
-        let e = EMISSION;
+        let mtl = format!("newmtl emitter\nKd 0 0 0\nnewmtl dim\nKd 0 0 0\nnewmtl receiver\nKd {RHO} {RHO} {RHO}\nnewmtl panel\nKd {RHO} {RHO} {RHO}\n");
+        std::fs::write(dir.join("scene.mtl"), mtl).unwrap();
+        let (e, dim) = (EMISSION, DIM);
         let scene = format!(
-            "Scene(\n  meshes: [Obj(file: \"scene.obj\")],\n  camera: Camera(eye: (0.5, -3.0, 1.0), target: (0.5, 0.5, 0.0), up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 16, height: 16),\n  lights: [],\n  materials: {{ \"emitter\": (emission: Some(({e:?}, {e:?}, {e:?}))) }},\n)\n"
+            "Scene(\n  meshes: [Obj(file: \"scene.obj\")],\n  camera: Camera(eye: (0.5, -3.0, 1.0), target: (0.5, 0.5, 0.0), up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 16, height: 16),\n  lights: [],\n  materials: {{ \"emitter\": (emission: Some(({e:?}, {e:?}, {e:?}))), \"dim\": (emission: Some(({dim:?}, {dim:?}, {dim:?}))), \"panel\": (two_sided: Some(true)) }},\n)\n"
         );
         std::fs::write(dir.join("scene.ron"), scene).unwrap();
         let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
@@ -82,30 +86,31 @@ impl Solved {
         [0, 1, 2].map(|k| p0[k] + uv[0] * (p1[k] - p0[k]) + uv[1] * (p2[k] - p0[k]))
     }
 
-    /// `rho B F(point -> emitter)`, the emitter's part in front of the point
-    /// (Lambert's formula over each emitting triangle).
+    /// `rho sum B_e F(point -> e)` over the emitting triangles `e`, their
+    /// part in front of the point (Lambert's formula), occlusion aside.
     fn exact(&self, t: usize, p: [f64; 3]) -> f64 {
         let normal = self.mesh.triangles[t].normal.map(f64::from);
+        let emission = |e: usize| self.manifest.materials[self.mesh.triangles[e].material as usize].emission[0];
         (0..self.mesh.triangles.len())
-            .filter(|&e| self.object_of(e) == "emitter")
+            .filter(|&e| emission(e) > 0.0)
             .map(|e| {
                 let front = clip_to_front(&self.corners(e), p, normal);
                 if front.len() < 3 {
                     0.0
                 } else {
-                    lambert_polygon(p, normal, &front)
+                    emission(e) * lambert_polygon(p, normal, &front)
                 }
             })
             .sum::<f64>()
             * RHO
-            * EMISSION
     }
 
     /// The mean of [`Solved::exact`] over the element with barycentric
-    /// `corners`: the midpoint rule on its 4^3 = 64 congruent sub-triangles.
+    /// `corners`: the midpoint rule on its 4^5 = 1024 congruent
+    /// sub-triangles (4^3 left 1% at the ends of a shared edge).
     fn exact_mean(&self, t: usize, corners: [[f64; 2]; 3]) -> f64 {
         let mut triangles = vec![corners];
-        for _ in 0..3 {
+        for _ in 0..5 {
             triangles = triangles
                 .iter()
                 .flat_map(|&[a, b, c]| {
@@ -120,28 +125,42 @@ impl Solved {
     }
 
     /// Worst relative error and RMS of the receiver's leaves against their
-    /// exact means, and their number.
-    fn element_errors(&self) -> (f64, f64, usize) {
-        let mut errors = Vec::new();
+    /// exact means, and their number; the leaves with a corner at one of
+    /// `singular` (points where the exact radiosity jumps) apart: their
+    /// worst error.
+    fn element_errors(&self, singular: &[[f64; 3]]) -> (f64, f64, usize, f64) {
+        self.element_errors_on(&|t| self.object_of(t) == "receiver", singular)
+    }
+
+    /// [`Solved::element_errors`] on the triangles `on` picks.
+    fn element_errors_on(&self, on: &dyn Fn(usize) -> bool, singular: &[[f64; 3]]) -> (f64, f64, usize, f64) {
+        let (mut errors, mut at_singular) = (Vec::new(), 0.0f64);
         for e in self.solution.elements.iter().filter(|e| e.is_leaf()) {
             let t = e.triangle as usize;
-            if self.object_of(t) != "receiver" {
+            if !on(t) {
                 continue;
             }
             let exact = self.exact_mean(t, e.corners.map(|c| c.map(f64::from)));
-            errors.push(f64::from(e.radiosity[0]) / exact - 1.0);
+            let error = f64::from(e.radiosity[0]) / exact - 1.0;
+            let corners = e.corners.map(|c| self.point(t, c.map(f64::from)));
+            let distance = |a: [f64; 3], b: [f64; 3]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+            if corners.iter().any(|&c| singular.iter().any(|&q| distance(c, q) < 1e-5)) {
+                at_singular = at_singular.max(error.abs());
+            } else {
+                errors.push(error);
+            }
         }
         let worst = errors.iter().fold(0.0f64, |w, e| w.max(e.abs()));
         let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
-        (worst, rms, errors.len())
+        (worst, rms, errors.len(), at_singular)
     }
 
     /// Worst relative error of the receiver's covered texels against
-    /// [`Solved::exact`] at the point each stands for, and the largest
-    /// texel radiosity over its exact value.
-    fn texel_errors(&self) -> (f64, f64) {
+    /// [`Solved::exact`] at the point each stands for, the largest texel
+    /// radiosity over its exact value, and the largest texel radiosity.
+    fn texel_errors(&self) -> (f64, f64, f64) {
         let lm = &self.lightmap;
-        let (mut worst, mut highest) = (0.0f64, 0.0f64);
+        let (mut worst, mut highest, mut brightest) = (0.0f64, 0.0f64, 0.0f64);
         for (t, r) in lm.regions.iter().enumerate() {
             if self.object_of(t) != "receiver" {
                 continue;
@@ -151,14 +170,19 @@ impl Solved {
                     let (x, y) = r.texel(i, j);
                     let k = y as usize * lm.width + x as usize;
                     assert_eq!(lm.coverage[k], COVERED);
-                    let exact = self.exact(t, lm.position[k].map(f64::from));
+                    // A texel on the hypotenuse stands for the centroid of its
+                    // half square inside the triangle, the others for their centre.
+                    let n = f64::from(r.size);
+                    let uv = if i + j + 1 == r.size { [(f64::from(i) + 1.0 / 3.0) / n, (f64::from(j) + 1.0 / 3.0) / n] } else { r.uv(i, j) };
+                    let exact = self.exact(t, self.point(t, uv));
                     let ratio = f64::from(lm.radiosity[k][0]) / exact;
                     worst = worst.max((ratio - 1.0).abs());
                     highest = highest.max(ratio);
+                    brightest = brightest.max(f64::from(lm.radiosity[k][0]));
                 }
             }
         }
-        (worst, highest)
+        (worst, highest, brightest)
     }
 
     /// Power (W, channel 0) leaving the receiver: leaves' area x radiosity.
@@ -172,13 +196,19 @@ impl Solved {
     }
 }
 
-/// Runs gpu-shoot on `scene` with the emitter's one shot and `extra`
-/// arguments; `None` when there is no adapter.
+/// Runs gpu-shoot on `scene` with `extra` arguments and, unless they set a
+/// convergence target, as many shots as the emitters have triangles (each
+/// shoots once, before any receiver, which gets less power); `None` when
+/// there is no adapter.
 fn shoot(test: &str, scene: &Polygons, extra: &[&str]) -> Option<Solved> {
     let dir = scratch(test);
     let (mesh, manifest) = scene.prepare(&dir);
     let (solution, lightmap) = (dir.join("solution.exr"), dir.join("lightmap.exr"));
-    let mut args = vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--lightmap", s(&lightmap), "--max-shots", "1"];
+    let shots = scene.0.iter().filter(|p| ["emitter", "dim"].contains(&p.1)).map(|p| p.2.len() - 2).sum::<usize>().to_string();
+    let mut args = vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--lightmap", s(&lightmap)];
+    if !extra.contains(&"--convergence-target") {
+        args.extend(["--max-shots", &shots]);
+    }
     args.extend(extra);
     if skipped_without_gpu(&run("gpu-shoot", &args), test) {
         return None;
@@ -202,10 +232,141 @@ fn floor_elements_under_a_tilted_triangle_match_lambert() {
         .add("receiver", "receiver", &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]])
         .add("emitter", "emitter", &[[0.2, 0.2, 0.45], [0.4, 0.85, 0.35], [0.85, 0.3, 0.65]]);
     let Some(solved) = shoot("gpu_elements_tilted", &scene, &["--texels", "8000"]) else { return };
-    let (worst, rms, count) = solved.element_errors();
-    let (texels, _) = solved.texel_errors();
+    let (worst, rms, count, _) = solved.element_errors(&[]);
+    let (texels, _, _) = solved.texel_errors();
     eprintln!("tilted triangle: {count} floor elements, worst {worst:.4}, rms {rms:.4}; texels worst {texels:.4}");
     assert!(count > 500, "{count} elements");
     assert!(texels < 0.02, "worst texel {texels}");
     assert!(worst < 0.02, "worst element {worst} (rms {rms})");
+}
+
+/// Checks the receiver of a one-shot scene: every element within 2% of its
+/// exact mean, and its power within 0.5% of `rho B A_e F` (`A_e` the
+/// emitter's area, `F` the catalogue's factor from emitter to receiver).
+/// The elements touching a corner the receiver shares with the emitter
+/// (the ends of a shared edge) are held to 4%: there the exact radiosity
+/// jumps from `rho B / 2` along the edge to `rho B / 4` at the corner, a
+/// variation at every scale that no fixed texel grid resolves (2.2% at
+/// 8000 texels, the rest of such a receiver within 1.8%). Texels are not
+/// checked here: next to the crease a texel holds its patch's mean (the
+/// rule of the receiver pass), up to 7% off the value at its centre.
+fn check_receiver(name: &str, solved: &Solved, emitter_area: f64, factor: f64) {
+    let vertices_of = |object: &str| -> Vec<[f64; 3]> {
+        let triangles = (0..solved.mesh.triangles.len()).filter(|&t| solved.object_of(t) == object);
+        triangles.flat_map(|t| solved.corners(t)).collect()
+    };
+    let emitter = vertices_of("emitter");
+    let shared: Vec<[f64; 3]> = vertices_of("receiver").into_iter().filter(|v| emitter.contains(v)).collect();
+    let (worst, rms, count, at_corners) = solved.element_errors(&shared);
+    let (texels, highest, _) = solved.texel_errors();
+    let flux = solved.receiver_flux() / (RHO * EMISSION * emitter_area * factor) - 1.0;
+    eprintln!(
+        "{name}: {count} elements, worst {worst:.4}, rms {rms:.4}, at shared corners {at_corners:.4}; texels worst {texels:.4}, highest ratio {highest:.4}; receiver power {:+.3}%",
+        100.0 * flux
+    );
+    assert!(count > 200, "{name}: {count} elements");
+    assert!(worst < 0.02, "{name}: worst element {worst} (rms {rms})");
+    assert!(at_corners < 0.04, "{name}: worst element at a shared corner {at_corners}");
+    assert!(flux.abs() < 0.005, "{name}: receiver power {:+.3}% off the catalogue", 100.0 * flux);
+}
+
+/// Howell C-11: an `a x b` emitter at `z = c` facing down over the
+/// receiver `[0, a] x [0, b]` facing up, for a square (1 x 1, 1 apart) and
+/// a strip (1 x 0.2, 0.3 apart).
+#[test]
+fn parallel_rectangles_match_howell_c11_per_element() {
+    for (a, b, c) in [(1.0, 1.0, 1.0), (1.0, 0.2, 0.3)] {
+        let scene = Polygons::default()
+            .add("receiver", "receiver", &[[0.0, 0.0, 0.0], [a, 0.0, 0.0], [a, b, 0.0], [0.0, b, 0.0]])
+            .add("emitter", "emitter", &[[0.0, 0.0, c], [0.0, b, c], [a, b, c], [a, 0.0, c]]);
+        let Some(solved) = shoot("gpu_elements_c11", &scene, &["--texels", "8000"]) else { return };
+        check_receiver(&format!("C-11 {a} x {b}, {c} apart"), &solved, a * b, parallel_rectangles(a, b, c));
+    }
+}
+
+/// Howell C-14: an emitter `w x l` in the plane `z = 0` facing up and a
+/// receiver `h x l` in the plane `x = 0` facing `+x`, sharing the edge of
+/// length `l` along `y`, for `(l, w, h) = (1, 0.2, 3)` and `(0.1, 1, 1)`.
+/// Near the shared edge the texels were off by up to +-90% in the period
+/// of the shooting groups (8 texels), which the totals (1-3.5%) hid.
+#[test]
+fn perpendicular_rectangles_sharing_an_edge_match_howell_c14_per_element() {
+    for (l, w, h) in [(1.0, 0.2, 3.0), (0.1, 1.0, 1.0)] {
+        let scene = Polygons::default()
+            .add("receiver", "receiver", &[[0.0, 0.0, 0.0], [0.0, l, 0.0], [0.0, l, h], [0.0, 0.0, h]])
+            .add("emitter", "emitter", &[[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, l, 0.0], [0.0, l, 0.0]]);
+        let Some(solved) = shoot("gpu_elements_c14", &scene, &["--texels", "8000"]) else { return };
+        check_receiver(&format!("C-14 l {l} w {w} h {h}"), &solved, w * l, perpendicular_rectangles(w, h, l));
+    }
+}
+
+/// A sliver (1 m x 1e-6 m) before a 10 m square emitter: facing it 1 m
+/// away, and at right angles to it with one long edge touching it. No
+/// texel may exceed what the emitter can give (`rho B`, a form factor of
+/// 1), and every texel is within 2% of Lambert's formula. (The texel's
+/// own patch, 1e-6 m wide, was the one integrated: f32 lost its solid
+/// angle and the facing sliver read 21.6 times the maximum.)
+#[test]
+fn a_sliver_before_a_large_emitter_gets_at_most_what_the_emitter_gives() {
+    let (d, z) = (1e-6, 1.0);
+    let wall = [[-5.0, -5.0, z], [-5.0, 5.0, z], [5.0, 5.0, z], [5.0, -5.0, z]];
+    let facing = [[-0.5, 0.0, 0.0], [0.5, 0.0, 0.0], [0.5, d, 0.0], [-0.5, d, 0.0]];
+    let touching = [[-0.5, 0.0, z - d], [-0.5, 0.0, z], [0.5, 0.0, z], [0.5, 0.0, z - d]];
+    for (name, sliver) in [("facing, 1 m away", facing), ("at right angles, touching", touching)] {
+        let scene = Polygons::default().add("receiver", "receiver", &sliver).add("emitter", "emitter", &wall);
+        let Some(solved) = shoot("gpu_elements_sliver", &scene, &["--texels", "4000"]) else { return };
+        let (texels, highest, brightest) = solved.texel_errors();
+        eprintln!("sliver {name}: texels worst {texels:.4}, highest ratio {highest:.4}, brightest texel {brightest:.4} of at most {}", RHO * EMISSION);
+        assert!(brightest <= RHO * EMISSION, "{name}: a texel at {brightest}, over rho B = {}", RHO * EMISSION);
+        assert!(texels < 0.02, "{name}: worst texel {texels} (highest ratio {highest})");
+    }
+}
+
+/// Two-sided surfaces: a 1.2 m square of the two-sided `panel` (mesh-prep
+/// gives each triangle a twin facing down, over the same corners) with an
+/// emitter 0.2 m above it and a receiver 1 m below it that only the
+/// square's bottom face can light. The top face's elements match Lambert's
+/// formula within 2%; the bottom face, which no light reaches, and the
+/// receiver stay dark (under 1e-4 of the top's brightest) through the
+/// whole solve, so neither the twins' shared corners in the visibility
+/// maps nor a shot from one face leaks light to the other side. Lit from
+/// both sides (a dimmer emitter 0.2 m below instead of the receiver), each
+/// face matches Lambert's formula for its own emitter within 2%.
+#[test]
+fn the_faces_of_a_two_sided_square_keep_their_own_radiosity() {
+    let square = [[-0.6, -0.6, 1.0], [0.6, -0.6, 1.0], [0.6, 0.6, 1.0], [-0.6, 0.6, 1.0]];
+    let lamp = |z: f64, down: bool| {
+        let q = [[-0.25, -0.25, z], [0.25, -0.25, z], [0.25, 0.25, z], [-0.25, 0.25, z]];
+        if down { [q[0], q[3], q[2], q[1]] } else { q }
+    };
+    let floor = [[-0.25, -0.25, 0.0], [0.25, -0.25, 0.0], [0.25, 0.25, 0.0], [-0.25, 0.25, 0.0]];
+    let faces = |solved: &Solved| {
+        let side = |t: usize| solved.mesh.triangles[t].normal[2];
+        let top = solved.element_errors_on(&|t| solved.object_of(t) == "panel" && side(t) > 0.0, &[]);
+        let bottom = solved.element_errors_on(&|t| solved.object_of(t) == "panel" && side(t) < 0.0, &[]);
+        (top, bottom)
+    };
+    let brightest = |solved: &Solved, on: &dyn Fn(usize) -> bool| {
+        let leaves = solved.solution.elements.iter().filter(|e| e.is_leaf() && on(e.triangle as usize));
+        leaves.map(|e| f64::from(e.radiosity[0])).fold(0.0f64, f64::max)
+    };
+
+    let scene = Polygons::default().add("panel", "panel", &square).add("emitter", "emitter", &lamp(1.2, true)).add("receiver", "receiver", &floor);
+    let Some(solved) = shoot("gpu_elements_two_sided", &scene, &["--texels", "8000", "--convergence-target", "0.999"]) else { return };
+    assert_eq!(solved.manifest.statistics.two_sided_twins, 2, "mesh-prep made no twins");
+    let ((worst, rms, count, _), _) = faces(&solved);
+    let panel = |t: usize| solved.object_of(t) == "panel";
+    let top = brightest(&solved, &|t| panel(t) && solved.mesh.triangles[t].normal[2] > 0.0);
+    let bottom = brightest(&solved, &|t| panel(t) && solved.mesh.triangles[t].normal[2] < 0.0);
+    let receiver = brightest(&solved, &|t| solved.object_of(t) == "receiver");
+    eprintln!("two-sided, lit from above: top {count} elements worst {worst:.4} rms {rms:.4}; brightest bottom {bottom:.3e}, receiver {receiver:.3e} of top {top:.4}");
+    assert!(count > 200 && worst < 0.02, "top face: worst element {worst} over {count}");
+    assert!(bottom < 1e-4 * top && receiver < 1e-4 * top, "light through the square: bottom {bottom}, receiver {receiver}, top {top}");
+
+    let scene = Polygons::default().add("panel", "panel", &square).add("emitter", "emitter", &lamp(1.2, true)).add("dim", "dim", &lamp(0.8, false));
+    let Some(solved) = shoot("gpu_elements_two_sided", &scene, &["--texels", "8000", "--convergence-target", "0.999"]) else { return };
+    let ((top, top_rms, top_count, _), (bottom, bottom_rms, bottom_count, _)) = faces(&solved);
+    eprintln!("two-sided, lit from both sides: top worst {top:.4} rms {top_rms:.4} ({top_count}), bottom worst {bottom:.4} rms {bottom_rms:.4} ({bottom_count})");
+    assert!(top_count > 200 && bottom_count > 200, "{top_count} and {bottom_count} elements");
+    assert!(top < 0.02 && bottom < 0.02, "worst element: top {top}, bottom {bottom}");
 }

@@ -47,6 +47,33 @@ pub struct Group {
     pub centroid: [f32; 3],
     /// Total area of the group, m².
     pub area: f32,
+    /// The part of the triangle the group covers, mesh frame, m: its block
+    /// of texels, `[gi g, (gi + 1) g] x [gj g, (gj + 1) g] / n` in
+    /// barycentrics, cut by the region's edge and the hypotenuse `u + v =
+    /// 1`; `corners` of the 5 are used.
+    pub polygon: [[f32; 3]; 5],
+    /// Corners of `polygon` (3 to 5).
+    pub corners: u32,
+}
+
+/// The barycentric square `[u0, u1] x [v0, v1]` cut by the hypotenuse
+/// `u + v <= 1` (Sutherland-Hodgman against one line), counter-clockwise.
+pub fn block_polygon(u0: f64, u1: f64, v0: f64, v1: f64) -> Vec<[f64; 2]> {
+    let square = [[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
+    let inside = |p: [f64; 2]| 1.0 - p[0] - p[1];
+    let mut out = Vec::with_capacity(5);
+    for k in 0..4 {
+        let (a, b) = (square[k], square[(k + 1) % 4]);
+        let (da, db) = (inside(a), inside(b));
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
+            let t = da / (da - db);
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        }
+    }
+    out
 }
 
 /// Per-triangle ranges into the texel and group lists.
@@ -195,7 +222,13 @@ pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_si
                 let count = all_texels.len() as u32 - start;
                 if count > 0 {
                     let centroid = (sum / area).as_vec3().to_array();
-                    groups.push(Group { first: start, count, centroid, area: (region.texel_area as f64 * area) as f32 });
+                    let nf = n as f64;
+                    let corners = block_polygon((gi * g) as f64 / nf, (((gi + 1) * g).min(n)) as f64 / nf, (gj * g) as f64 / nf, (((gj + 1) * g).min(n)) as f64 / nf);
+                    let mut polygon = [[0.0f32; 3]; 5];
+                    for (slot, uv) in polygon.iter_mut().zip(&corners) {
+                        *slot = geometry.point(*uv).as_vec3().to_array();
+                    }
+                    groups.push(Group { first: start, count, centroid, area: (region.texel_area as f64 * area) as f32, polygon, corners: corners.len() as u32 });
                 }
             }
         }

@@ -163,6 +163,10 @@ pub struct GpuSample {
     pub n: [f32; 4],
     /// rgb: unshot radiosity (area sample) or I_max in W/sr (light); w: 0 area, 1 light.
     pub power: [f32; 4],
+    /// xyz: the corners of the part of the shooter the group covers
+    /// ([`crate::atlas::Group::polygon`]), m; w of the first: their number
+    /// (0 for a light).
+    pub polygon: [[f32; 4]; 5],
 }
 
 /// Host mirror of `Selection` in solver.wgsl.

@@ -45,7 +45,7 @@ use radiometry::geometry::frame_with_normal;
 pub use radiometry::photometry::Luminaire;
 use gpu::{Gpu, GpuGroup, GpuParams, GpuSample, GpuTexel, GpuTri, Setup};
 use schemas::lightmap::Shot;
-use schemas::mesh::{Manifest, Mesh};
+use schemas::mesh::{cyclic, reversed, Manifest, Mesh};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -206,6 +206,14 @@ fn sum3(v: [f64; 3]) -> f64 {
     v[0] + v[1] + v[2]
 }
 
+/// Per triangle, whether it has a twin: a triangle over the same vertices
+/// wound the other way ([`schemas::mesh::reversed`]), the other face of a
+/// two-sided surface (mesh-prep makes them; [`Manifest::check_mesh`]).
+pub fn has_twin(mesh: &Mesh) -> Vec<bool> {
+    let wound: std::collections::HashSet<[u32; 3]> = mesh.triangles.iter().map(|t| cyclic(t.vertices)).collect();
+    mesh.triangles.iter().map(|t| wound.contains(&cyclic(reversed(t.vertices)))).collect()
+}
+
 /// Runs the progressive solver on `device` / `queue`. `on_shot` sees every
 /// shot as it completes (for a progress bar).
 pub fn solve(
@@ -265,12 +273,16 @@ pub fn solve(
         })
         .collect();
     let groups: Vec<GpuGroup> = atlas.groups.iter().map(|g| GpuGroup { first: g.first, count: g.count, _pad: [0; 2] }).collect();
+    // w: 2 for the corners of a triangle with a twin, whose back face the
+    // visibility maps leave out (visibility.wgsl), else 1.
+    let twinned = has_twin(mesh);
     let vertices: Vec<[f32; 4]> = mesh
         .triangles
         .iter()
-        .flat_map(|t| t.vertices.map(|v| {
+        .zip(&twinned)
+        .flat_map(|(t, &twin)| t.vertices.map(|v| {
             let p = mesh.positions[v as usize];
-            [p[0], p[1], p[2], 1.0]
+            [p[0], p[1], p[2], if twin { 2.0 } else { 1.0 }]
         }))
         .collect();
     // Scene size: near plane, far distance, and the sample offset.
@@ -372,6 +384,7 @@ pub fn solve(
             b: f4(u0.to_array()),
             n: f4(n0.to_array()),
             power: [i, i, i, 1.0],
+            polygon: [[0.0; 4]; 5],
         };
         gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
         let p = GpuParams { shooter: u32::MAX, sample_first: 0, sample_count: 1, layers_per_sample: 6, mode: 0, ..base };
@@ -397,12 +410,15 @@ pub fn solve(
             .iter()
             .map(|g| {
                 let c = DVec3::from(g.centroid.map(f64::from)) + n * offset;
+                let mut polygon = g.polygon.map(|p| [p[0], p[1], p[2], 0.0]);
+                polygon[0][3] = g.corners as f32;
                 GpuSample {
                     position_area: [c.x as f32, c.y as f32, c.z as f32, g.area],
                     t: f4(t.to_array()),
                     b: f4(b.to_array()),
                     n: f4(n.to_array()),
                     power: [0.0; 4],
+                    polygon,
                 }
             })
             .collect();

@@ -71,7 +71,8 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert_and_the_cpu_kernel() 
             for g in &solved.atlas.groups[r.group_first as usize..(r.group_first + r.group_count) as usize] {
                 let c = DVec3::from(g.centroid.map(f64::from));
                 let (count, patch) = reference::patch_of(&solved.atlas, &mesh, k);
-                h_cpu += e * reference::area_transfer(p, DVec3::Y, t.area as f64, &patch[..count], c, -DVec3::Y, g.area as f64);
+                let polygon: Vec<DVec3> = g.polygon[..g.corners as usize].iter().map(|q| DVec3::from(q.map(f64::from))).collect();
+                h_cpu += e * reference::area_transfer(p, DVec3::Y, t.area as f64, &patch[..count], &reference::AreaSample { point: c, normal: -DVec3::Y, area: g.area as f64, polygon: &polygon });
             }
         }
         worst_cpu = worst_cpu.max((b - rho * h_cpu).abs() / (rho * h_cpu));

@@ -348,12 +348,12 @@ fn ldt_lookup(c_deg: f32, gamma: f32) -> f32 {
 // energy loss A_s / (pi d^2 + A_s) is then below 1 / (pi NEAR_FIELD).
 const NEAR_FIELD: f32 = 100.0;
 
-// Form factor from a differential sender at the origin with normal n to
-// the polygon corners[0..count] (relative to the sender), clipped to the
-// sender's hemisphere: Lambert's contour formula, mirrors
+// Form factor from a differential area at the origin with normal n to the
+// polygon corners[0..count] (relative to that area), clipped to its
+// hemisphere: Lambert's contour formula, mirrors
 // reference::polygon_form_factor.
-fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 4>, count: u32) -> f32 {
-    var clipped: array<vec3<f32>, 5>;
+fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 5>, count: u32) -> f32 {
+    var clipped: array<vec3<f32>, 6>;
     var m = 0u;
     for (var k = 0u; k < count; k += 1u) {
         let a = corners[k];
@@ -374,37 +374,76 @@ fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 4>, count: u32) -
     return abs(sum) / (2.0 * PI);
 }
 
-// Irradiance per unit radiosity of an area sample at `s` (normal n, area
-// a_s) on the receiving texel k at p (its patch: half edges of its
-// triangle, half a square on the hypotenuse), with the cosines at p.
-fn area_transfer(k: u32, p: vec3<f32>, s: vec3<f32>, n: vec3<f32>, a_s: f32, d2: f32, cos_s: f32, cos_r: f32) -> f32 {
+// Irradiance per unit radiosity of the area sample s on the receiving
+// texel k at p (normal nr), with the cosines at the sample's point;
+// mirrors reference::area_transfer. Far: the disc approximation. Near, the
+// larger of the two patches is integrated exactly (Lambert's formula) and
+// the smaller one by a rule of its own:
+//   sample over RECIPROCAL texels:  H = mean over the texel's rule points q
+//                   of F(q -> sample's polygon)             (reciprocity)
+//   otherwise:      H = A_s F(s -> texel's patch) / A_r
+// A group of 8 x 8 texels taken as its centroid misplaced the power of its
+// near part by half a group, +-90% on the texels next to a shared edge
+// (issue 10, item 7), and a texel patch much smaller than its distance
+// (a sliver's) lost its solid angle to f32 cancellation. The rule on the
+// texel (2 x 2 Gauss points on a parallelogram, the three points (2/3,
+// 1/6, 1/6) on a hypotenuse half square) makes its value its patch's mean,
+// as the other branch's is. At equal sizes the sample's point conserves
+// power exactly, hence the threshold RECIPROCAL (see reference.rs).
+// A sample this many times larger than a texel in its near field is
+// taken by reciprocity (area_transfer); mirrors reference::RECIPROCAL.
+const RECIPROCAL: f32 = 16.0;
+
+// Whether texel k takes area sample s, at squared distance d2, by
+// reciprocity.
+fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
     let a_r = texels[k].position.w;
+    let a_s = s.position.w;
+    return d2 < NEAR_FIELD * (a_r + a_s) && a_s > RECIPROCAL * a_r;
+}
+
+fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, s: Sample, d2: f32, cos_s: f32, cos_r: f32) -> f32 {
+    let a_r = texels[k].position.w;
+    let a_s = s.position.w;
     if (d2 >= NEAR_FIELD * (a_r + a_s)) {
         // 004 Eq. 2.2 / 4.1 with one disc per sample.
         return a_s * cos_s * cos_r / (PI * d2 + a_s);
     }
+    // The corners of the texel's patch relative to p.
     let tri = tris[bitcast<u32>(texels[k].normal.w)];
     let a = tri.half_u.xyz;
     let b = tri.half_v.xyz;
-    var corners: array<vec3<f32>, 4>;
+    var corner_of: array<vec3<f32>, 5>;
     var count = 4u;
     if (texels[k].rho.w != 0.0) {
         // The hypotenuse texel stands for the half square whose centroid is p.
-        let c = p - s + (a + b) / 3.0;
-        corners[0] = c - a - b;
-        corners[1] = c + a - b;
-        corners[2] = c - a + b;
+        let c = (a + b) / 3.0;
+        corner_of[0] = c - a - b;
+        corner_of[1] = c + a - b;
+        corner_of[2] = c - a + b;
         count = 3u;
     } else {
-        let c = p - s;
-        corners[0] = c - a - b;
-        corners[1] = c + a - b;
-        corners[2] = c + a + b;
-        corners[3] = c - a + b;
+        corner_of[0] = -a - b;
+        corner_of[1] = a - b;
+        corner_of[2] = a + b;
+        corner_of[3] = -a + b;
     }
+    var corners: array<vec3<f32>, 5>;
+    if (reciprocal(k, s, d2)) {
+        let m = u32(s.polygon[0].w);
+        var f = 0.0;
+        for (var j = 0u; j < count; j += 1u) {
+            var q = 0.57735027 * corner_of[j];
+            if (count == 3u) { q = (4.0 * corner_of[j] + corner_of[(j + 1u) % 3u] + corner_of[(j + 2u) % 3u]) / 6.0; }
+            for (var c = 0u; c < m; c += 1u) { corners[c] = (s.polygon[c].xyz - p) - q; }
+            f += polygon_form_factor(nr, corners, m);
+        }
+        return f / f32(count);
+    }
+    for (var j = 0u; j < count; j += 1u) { corners[j] = (p - s.position.xyz) + corner_of[j]; }
     // H_r = B_s A_s F_(s -> patch) / A_r: the power the patch receives
     // spread over its area, so the shares of a closed room sum to 1.
-    return a_s * polygon_form_factor(n, corners, count) / a_r;
+    return a_s * polygon_form_factor(s.n.xyz, corners, count) / a_r;
 }
 
 // The receiver pass (004 Sec. 2.3, Eq. 2.2 / 4.1-4.3): every covered texel
@@ -429,14 +468,36 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
         let d = sqrt(d2);
         if (d <= 0.0) { continue; }
         let cos_r = -dot(nr, v) / d;
-        if (cos_r <= 0.0) { continue; }
-        let local = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
         let light = s.power.w != 0.0;
-        let cos_s = local.z / d;
-        if (!light && cos_s <= 0.0) { continue; }
+        // A sample that the receiver's plane cuts, near enough to be
+        // integrated exactly from the receiver (area_transfer), gives the
+        // part in front of that plane even when its centroid lies behind;
+        // its visibility from the centroid says nothing about that part, so
+        // it is taken as seen (the part of a wall that a sliver touching it
+        // faces got nothing).
+        var straddles = false;
+        if (cos_r <= 0.0) {
+            if (light || !reciprocal(k, s, d2)) { continue; }
+            for (var c = 0u; c < u32(s.polygon[0].w); c += 1u) {
+                if (dot(nr, s.polygon[c].xyz - p) > 0.0) { straddles = true; }
+            }
+            if (!straddles) { continue; }
+        }
+        let local = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
+        // An area sample's point lies a hair (1e-6 of the scene) in front
+        // of its shooter so its maps do not see the shooter; which side of
+        // the shooter a receiver is on is decided by the shooter's own
+        // plane, or a receiver nearer to it than that hair (a sliver
+        // touching it) got nothing.
+        var cos_s = local.z / d;
+        if (!light) {
+            if (dot(p - s.polygon[0].xyz, s.n.xyz) <= 0.0) { continue; }
+            cos_s = max(cos_s, 0.0);
+        }
         let base = i * params.layers_per_sample;
-        var seen = false;
-        if (params.mode == 1u && !light) {
+        var seen = straddles;
+        if (straddles) {
+        } else if (params.mode == 1u && !light) {
             seen = visible_stereographic(base, tri, p, s);
         } else {
             let face = face_of(local);
@@ -449,7 +510,7 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
             let c = degrees(atan2(local.y, local.x));
             h += s.power.xyz * ldt_lookup(c, gamma) * cos_r / d2;
         } else {
-            h += s.power.xyz * area_transfer(k, p, s.position.xyz, s.n.xyz, s.position.w, d2, cos_s, cos_r);
+            h += s.power.xyz * area_transfer(k, p, nr, s, d2, cos_s, cos_r);
         }
     }
     let db = texel.rho.xyz * h;
