@@ -64,6 +64,12 @@ BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep)
 $(BENCH_BINS) &: FORCE
 	@cargo build --release --quiet -p bench --bins
 
+# sweep_bins(text): the stages a sweep whose solvers are named in `text`
+# runs besides the hierarchical pipeline's, and exact, which renders the
+# reference where it can (the pipelines' fragments build each).
+sweep_bins = $(BIN)/exact $(if $(findstring gpu,$(1)),$(BIN)/gpu-shoot) \
+  $(if $(findstring photon,$(1)),$(BIN)/photon-trace) $(if $(findstring structured,$(1)),$(BIN)/structured-sample)
+
 # params_file(stage, flags): the stage's effective parameters as RON,
 # rewritten only when they change, so a knob reruns only what it affects.
 define params_file

@@ -47,7 +47,7 @@ $(PEER_VENV)/.installed:
 	$(PEER_VENV)/bin/pip install --quiet $(PEER_MITSUBA) numpy
 	@touch $@
 
-bench-peer: $(BINS) $(BENCH_BINS) $(OUT)/preview.exr $(MITSUBA_XML) | $(PEER_VENV)/.installed
+bench-peer: $(BINS) $(BENCH_BINS) $(call sweep_bins,$(PEER_SWEEP_FLAGS)) $(OUT)/preview.exr $(MITSUBA_XML) | $(PEER_VENV)/.installed
 	@mkdir -p $(PEER_OUT)
 	@if [ "$(PEER_VARIANT)" != scalar_rgb ] && ! ls /usr/lib/x86_64-linux-gnu/libLLVM.so.19* /usr/lib/x86_64-linux-gnu/libLLVM-19.so* >/dev/null 2>&1; then \
 	  if [ "$$(id -u)" = 0 ] && apt-cache show libllvm19 >/dev/null 2>&1; then \

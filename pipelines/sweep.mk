@@ -17,8 +17,12 @@
 #   make sweep SWEEP_KNOBS="EPS=1e-3,3e-4 SPP=4,16"   # a 2 x 2 grid
 #   make sweep SCENE=sphere-1k SWEEP_REPS=1      # closed-form reference
 #   make sweep SWEEP_SOLVER=gpu                  # GPU_CONVERGENCE 0.8 .. 0.999
+#   make sweep SWEEP_SOLVER=hierarchical,gpu,photon   # three curves
+#   make sweep SCENE=simple-environment SWEEP_SOLVER=hierarchical,structured
 
-# hierarchical, gpu, or both (comma-separated: each sweeps its own grid).
+# hierarchical, gpu, photon (photon-trace, PHOTON_TARGET_ERROR 0.2 .. 0.025),
+# structured (structured-sample, STRUCTURED_LEVELS 2 .. 16; its own display
+# instead of a gather), comma-separated: each sweeps its own grid.
 SWEEP_SOLVER ?= hierarchical
 # Gather modes (preview, full; space- or comma-separated); empty: every
 # mode the solver allows (full needs the hierarchical solver's links).
@@ -43,7 +47,7 @@ sweep_comma := ,
 sweep_space := $(subst ,, )
 
 .PHONY: sweep
-sweep: $(BINS) $(BENCH_BINS) $(BIN)/exact
+sweep: $(BINS) $(BENCH_BINS) $(call sweep_bins,$(SWEEP_SOLVER))
 	$(if $(SWEEP_KNOB),$(if $(SWEEP_VALUES),,$(error SWEEP_KNOB=$(SWEEP_KNOB) needs SWEEP_VALUES=v1,v2,...)))
 	$(BIN)/sweep --scene $(SCENE) --solver $(SWEEP_SOLVER) $(if $(strip $(SWEEP_GATHER)),--gather $(subst $(sweep_space),$(sweep_comma),$(strip $(SWEEP_GATHER)))) \
 	  $(if $(SWEEP_KNOB),--knob $(SWEEP_KNOB)=$(SWEEP_VALUES)) $(foreach k,$(SWEEP_KNOBS),--knob $(k)) \

@@ -5,6 +5,7 @@
 //! The sweep drives the release stage binaries beside it in
 //! `target/release`, which `make test` builds before the tests.
 
+use bench::sweep::knobs::Solver;
 use bench::sweep::table::{ReferenceKind, Sweep};
 use schemas::ron_io::read_ron;
 use std::path::{Path, PathBuf};
@@ -66,19 +67,30 @@ fn a_sweep_of_the_integrating_sphere_has_both_points_and_its_error_falls_as_eps_
 }
 
 /// Paper 002's simple environment has no closed form per element but an
-/// exact image: the sweep measures against it, and the error falls as EPS
-/// tightens (32 x 32 pixels: the exact image takes a second).
+/// exact image: the sweep measures every solver against it (32 x 32
+/// pixels: the exact image takes a second), the hierarchical error falls
+/// as EPS tightens, and photon-trace (gathered) and structured-sample (its
+/// own display) give points of their own.
 #[test]
 fn a_sweep_of_the_simple_environment_is_measured_against_its_exact_image() {
     let out = scratch("sweep_exact");
     let o = out.to_str().unwrap();
-    let run = sweep(&["--scene", "simple-environment", "--knob", "EPS=0.05,0.001", "--reps", "1", "--gather", "preview", "--width", "32", "--height", "32", "-o", o]);
+    let knobs = ["--knob", "EPS=0.05,0.001", "--knob", "PHOTON_TARGET_ERROR=0.2", "--knob", "STRUCTURED_LEVELS=4"];
+    let mut args = vec!["--scene", "simple-environment", "--solver", "hierarchical,photon,structured", "--reps", "1", "--width", "32", "--height", "32", "-o", o];
+    args.extend(knobs);
+    let run = sweep(&args);
     assert!(run.status.success(), "sweep failed:\n{}", String::from_utf8_lossy(&run.stderr));
     let table: Sweep = read_ron(&out.join("sweep.ron")).unwrap().value;
     assert_eq!(table.reference.kind, ReferenceKind::Exact, "{:?} {:?}", table.reference, table.notes);
     let at = |eps: f64| table.points.iter().find(|p| p.knob("EPS") == Some(eps)).unwrap_or_else(|| panic!("no point at EPS {eps}")).error.median;
     eprintln!("simple environment against its exact image: error {:.3e} at EPS 0.05, {:.3e} at EPS 0.001", at(0.05), at(0.001));
     assert!(at(0.001) < at(0.05) && at(0.001) > 0.0);
+    for (solver, stages) in [(Solver::Photon, ["photon-trace", "grid-gather"].as_slice()), (Solver::Structured, ["structured-sample"].as_slice())] {
+        let p = table.points.iter().find(|p| p.solver == solver).unwrap_or_else(|| panic!("no {solver} point"));
+        assert_eq!(p.stages.iter().map(|s| s.stage.as_str()).collect::<Vec<_>>(), stages);
+        eprintln!("{solver}: error {:.3e} in {:.3} s", p.error.median, p.total_s.median);
+        assert!(p.error.median > 0.0 && p.error.median < 0.5, "{solver}: {p:?}");
+    }
 }
 
 #[test]

@@ -28,7 +28,7 @@ struct Args {
     /// Scene: `cornell`, a built-in scene (sphere-300, box-10k, ...) or a scene.ron path.
     #[arg(long, default_value = "cornell")]
     scene: String,
-    /// Solvers, comma-separated: hierarchical, gpu.
+    /// Solvers, comma-separated: hierarchical, gpu, photon, structured.
     #[arg(long, value_delimiter = ',', default_value = "hierarchical")]
     solver: Vec<String>,
     /// Gather modes, comma-separated: preview, full [default: every mode the solver's solution allows].
@@ -77,7 +77,7 @@ fn config(args: &Args) -> Result<Config> {
     let solvers = args
         .solver
         .iter()
-        .map(|n| Solver::parse(n.trim()).ok_or_else(|| bad_parameter(format!("--solver {n}: expected hierarchical or gpu"))))
+        .map(|n| Solver::parse(n.trim()).ok_or_else(|| bad_parameter(format!("--solver {n}: expected hierarchical, gpu, photon or structured"))))
         .collect::<Result<Vec<_>>>()?;
     let gathers = match &args.gather {
         None => None,

@@ -16,17 +16,25 @@ pub enum Solver {
     Hierarchical,
     /// `gpu-shoot` (progressive radiosity, wgpu).
     Gpu,
+    /// `photon-trace` (paper 001: photons, kd-tree filter, exact direct
+    /// light on a perceptually split mesh).
+    Photon,
+    /// `structured-sample` (paper 002: samples along isolux contours,
+    /// shot and displayed by its own conical filter, no grid-gather).
+    Structured,
 }
 
 impl Solver {
     /// Every solver, in the order the table lists them.
-    pub const ALL: [Solver; 2] = [Solver::Hierarchical, Solver::Gpu];
+    pub const ALL: [Solver; 4] = [Solver::Hierarchical, Solver::Gpu, Solver::Photon, Solver::Structured];
 
     /// The name on the command line and in the table.
     pub fn name(self) -> &'static str {
         match self {
             Solver::Hierarchical => "hierarchical",
             Solver::Gpu => "gpu",
+            Solver::Photon => "photon",
+            Solver::Structured => "structured",
         }
     }
 
@@ -40,16 +48,26 @@ impl Solver {
         match self {
             Solver::Hierarchical => "hierarchical-solve",
             Solver::Gpu => "gpu-shoot",
+            Solver::Photon => "photon-trace",
+            Solver::Structured => "structured-sample",
         }
     }
 
     /// Gather modes that apply to this solver's solutions: the full gather
-    /// resamples links, and gpu-shoot's solution has none.
+    /// resamples links, which gpu-shoot's and photon-trace's solutions do
+    /// not have; structured-sample displays its samples itself.
     pub fn gathers(self) -> &'static [Gather] {
         match self {
             Solver::Hierarchical => &[Gather::Preview, Gather::Full],
-            Solver::Gpu => &[Gather::Preview],
+            Solver::Gpu | Solver::Photon => &[Gather::Preview],
+            Solver::Structured => &[Gather::Own],
         }
+    }
+
+    /// Whether the solver writes a per-element solution (which a closed
+    /// form per element can measure).
+    pub fn has_solution(self) -> bool {
+        self != Solver::Structured
     }
 
     /// The grid a sweep of this solver runs when no knob of it is given:
@@ -59,10 +77,16 @@ impl Solver {
     /// half-decades; MIN_AREA stays at its default (1e-4), which is what
     /// stops refinement below EPS 1e-4 on the Cornell box. GPU_CONVERGENCE
     /// spans 80% to 99.9% of the power shot at the Makefile's 32768 texels.
+    /// PHOTON_TARGET_ERROR halves the photon estimate's relative error per
+    /// step (four times the photons); STRUCTURED_LEVELS doubles the isolux
+    /// bands (and so the samples along them) per step.
     pub fn default_knobs(self) -> Vec<(&'static Knob, Vec<f64>)> {
+        let named = |name: &str| knob(name).unwrap_or_else(|| panic!("{name} is a knob"));
         match self {
-            Solver::Hierarchical => vec![(knob("EPS").expect("EPS is a knob"), vec![1e-2, 3e-3, 1e-3, 3e-4, 1e-4])],
-            Solver::Gpu => vec![(knob("GPU_CONVERGENCE").expect("GPU_CONVERGENCE is a knob"), vec![0.8, 0.9, 0.99, 0.999])],
+            Solver::Hierarchical => vec![(named("EPS"), vec![1e-2, 3e-3, 1e-3, 3e-4, 1e-4])],
+            Solver::Gpu => vec![(named("GPU_CONVERGENCE"), vec![0.8, 0.9, 0.99, 0.999])],
+            Solver::Photon => vec![(named("PHOTON_TARGET_ERROR"), vec![0.2, 0.1, 0.05, 0.025])],
+            Solver::Structured => vec![(named("STRUCTURED_LEVELS"), vec![2.0, 4.0, 8.0, 16.0])],
         }
     }
 }
@@ -80,17 +104,21 @@ pub enum Gather {
     Preview,
     /// `--mode full`: paper 000's final gather over the solution's links.
     Full,
+    /// No grid-gather: the solver's own display (structured-sample's
+    /// conical filter), timed with the solve.
+    Own,
 }
 
 impl Gather {
-    /// Both modes.
-    pub const ALL: [Gather; 2] = [Gather::Preview, Gather::Full];
+    /// Every mode.
+    pub const ALL: [Gather; 3] = [Gather::Preview, Gather::Full, Gather::Own];
 
     /// The name on the command line, in the table, and grid-gather's `--mode`.
     pub fn name(self) -> &'static str {
         match self {
             Gather::Preview => "preview",
             Gather::Full => "full",
+            Gather::Own => "own",
         }
     }
 
@@ -158,7 +186,9 @@ pub const KNOBS: &[Knob] = &[
     Knob { name: "GPU_CONVERGENCE", target: Target::Solve, flag: "--convergence-target", solvers: &[Solver::Gpu], integer: false, tighten: Tighten::Remaining(10.0), meaning: "fraction of the power shot" },
     Knob { name: "GPU_RESOLUTION", target: Target::Solve, flag: "--resolution", solvers: &[Solver::Gpu], integer: true, tighten: Tighten::Multiply(2.0), meaning: "visibility map side, pixels" },
     Knob { name: "GPU_SHOOT_LEVEL", target: Target::Solve, flag: "--shoot-level", solvers: &[Solver::Gpu], integer: true, tighten: Tighten::Decrement, meaning: "shoot from 2^level x 2^level texels" },
-    Knob { name: "SPP", target: Target::Gather, flag: "--spp", solvers: &[Solver::Hierarchical, Solver::Gpu], integer: true, tighten: Tighten::Multiply(4.0), meaning: "camera rays per pixel" },
+    Knob { name: "PHOTON_TARGET_ERROR", target: Target::Solve, flag: "--target-error", solvers: &[Solver::Photon], integer: false, tighten: Tighten::Divide(2.0), meaning: "photons until every vertex's relative error is under this" },
+    Knob { name: "STRUCTURED_LEVELS", target: Target::Solve, flag: "--levels", solvers: &[Solver::Structured], integer: true, tighten: Tighten::Multiply(2.0), meaning: "isolux bands per surface" },
+    Knob { name: "SPP", target: Target::Gather, flag: "--spp", solvers: &[Solver::Hierarchical, Solver::Gpu, Solver::Photon], integer: true, tighten: Tighten::Multiply(4.0), meaning: "camera rays per pixel" },
 ];
 
 /// grid-gather's camera rays per pixel where SPP is not swept: the

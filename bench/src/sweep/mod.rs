@@ -184,6 +184,8 @@ pub fn plan(config: &Config) -> Result<Vec<Plan>> {
     let mut plans = Vec::new();
     for &solver in &config.solvers {
         let gathers = match &config.gathers {
+            // structured-sample displays its own samples: no grid-gather mode applies.
+            None | Some(_) if solver == Solver::Structured => solver.gathers().to_vec(),
             None => solver.gathers().to_vec(),
             Some(gathers) => {
                 if let Some(g) = gathers.iter().find(|g| !solver.gathers().contains(g)) {
@@ -204,10 +206,11 @@ pub fn plan(config: &Config) -> Result<Vec<Plan>> {
 }
 
 /// The arguments a setting gives the solver's stage (the knob flags and,
-/// for hierarchical-solve, the visibility seed).
+/// for every solver that draws random rays, their seed; gpu-shoot draws
+/// none).
 fn solve_flags(solver: Solver, setting: &Setting, seed: u64) -> Vec<String> {
     let mut args: Vec<String> = setting.iter().filter(|(k, _)| k.target == Target::Solve).map(|(k, v)| k.arg(*v)).collect();
-    if solver == Solver::Hierarchical {
+    if solver != Solver::Gpu {
         args.push(format!("--seed={seed}"));
     }
     args
@@ -259,17 +262,29 @@ fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solver: S
         let report = stages.run("cluster", &args, &dir.join("cluster.report.ron"))?;
         solve_stages.push(("cluster".to_string(), report.wall_time_s));
     }
-    let solution = dir.join("solution.exr");
+    // structured-sample writes samples and its own image, not a solution.
+    let solution = dir.join(if solver.has_solution() { "solution.exr" } else { "samples.exr" });
     let mut args = scene.to_vec();
     args.extend(["-o".into(), s(&solution)]);
     if let Some(clusters) = &clusters {
         args.extend(["--clusters".into(), s(clusters)]);
+    }
+    let own = dir.join(format!("{}.exr", Gather::Own.name()));
+    if gathers.contains(&Gather::Own) {
+        args.extend(["--image".into(), s(&own)]);
+        args.extend(config.width.map(|w| format!("--width={w}")));
+        args.extend(config.height.map(|h| format!("--height={h}")));
     }
     args.extend(solve_flags(solver, setting, seeds.0));
     let report = stages.run(solver.stage(), &args, &dir.join("solve.report.ron"))?;
     solve_stages.push((solver.stage().to_string(), report.wall_time_s));
     let mut images = Vec::new();
     for &gather in gathers {
+        if gather == Gather::Own {
+            // Displayed within the solve, whose time includes it.
+            images.push((gather, 0.0, own.clone()));
+            continue;
+        }
         let image = dir.join(format!("{}.exr", gather.name()));
         let mut args = scene.to_vec();
         args.extend(["--solution".into(), s(&solution), "-o".into(), s(&image)]);
@@ -336,7 +351,7 @@ fn check_flags(stages: &Stages, config: &Config, plans: &[Plan]) -> Result<()> {
         for setting in &plan.settings {
             let named = |e: Error| bad_parameter(format!("--knob {}: {e}", knobs::label(setting)));
             stages.check(plan.solver.stage(), &solve_flags(plan.solver, setting, 1)).map_err(named)?;
-            for &gather in &plan.gathers {
+            for &gather in plan.gathers.iter().filter(|g| **g != Gather::Own) {
                 stages.check("grid-gather", &gather_flags(config, gather, setting, 0)).map_err(named)?;
             }
         }
@@ -395,6 +410,9 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
             }
         }
     };
+    if let (Measure::Solution(_), Some(plan)) = (&measure, plans.iter().find(|p| !p.solver.has_solution())) {
+        return Err(bad_parameter(format!("--solver {}: the scene's closed form is per element, and {} writes images, not a solution", plan.solver, plan.solver.stage())));
+    }
     match &reference.run {
         Some(run) => progress(&format!("{} in {:.2} s", reference.label, run.stages.iter().map(|s| s.seconds.median).sum::<f64>())),
         None => progress(&reference.label),
@@ -498,7 +516,9 @@ fn point(solver: Solver, gather: Gather, g: usize, setting: &Setting, reps: &[Re
         .enumerate()
         .map(|(i, (name, _))| StageTime { stage: name.clone(), seconds: spread(&|r| r.solve_stages[i].1) })
         .collect();
-    stages.push(StageTime { stage: "grid-gather".into(), seconds: spread(&|r| r.gathers[g].0) });
+    if gather != Gather::Own {
+        stages.push(StageTime { stage: "grid-gather".into(), seconds: spread(&|r| r.gathers[g].0) });
+    }
     // Rounded to the nanosecond the reports resolve, so sums print
     // without float noise.
     let total = |r: &RepFigures| ((r.solve_stages.iter().map(|(_, t)| t).sum::<f64>() + r.gathers[g].0) * 1e9).round() / 1e9;
@@ -569,7 +589,7 @@ fn strictest_run(stages: &Stages, config: &Config, plan: &Plan, prepared: &Prepa
         let spp = knobs::knob("SPP").expect("SPP is a knob");
         setting.push((spp, spp.beyond(&[knobs::DEFAULT_SPP])));
     }
-    let gather = if plan.gathers.contains(&Gather::Full) { Gather::Full } else { Gather::Preview };
+    let gather = if plan.gathers.contains(&Gather::Full) { Gather::Full } else { plan.gathers[0] };
     progress(&format!("reference: strictest run, {} {} {gather} ...", plan.solver, knobs::label(&setting)));
     let run = run_pipeline(stages, config, prepared, plan.solver, &setting, &[gather], (1 + REFERENCE_SEED, REFERENCE_SEED), dir)?;
     let mut times: Vec<StageTime> = run.solve_stages.iter().map(|(st, t)| StageTime { stage: st.clone(), seconds: Spread::of(&[*t]) }).collect();
