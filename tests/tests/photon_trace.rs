@@ -449,7 +449,12 @@ fn a_goniometric_lights_photons_carry_its_flux() {
     prepare(&dir, &[s(&room.write(&dir))]);
     let snapshots = dir.join("snapshots");
     std::fs::create_dir_all(&snapshots).unwrap();
-    let solution = trace(&dir, "solution", &["--preview-photons", "131072", "--target-error", "0.02", "--snapshot-dir", s(&snapshots)]);
+    let solution = trace(&dir, "solution", &["--preview-photons", "131072", "--target-error", "0.02", "--snapshot-dir", s(&snapshots), "--snapshot-every", "65536"]);
+    // Rounds of 65536 photons: one numbered snapshot inside stage 1, its
+    // end, the direct pass, and one per round of stage 3 but the last.
+    for name in ["stochastic-000000065536.exr", "stochastic.exr", "direct.exr", "indirect-000000196608.exr"] {
+        assert!(snapshots.join(name).exists(), "snapshot {name} missing");
+    }
     let (manifest, _, stochastic) = read_leaves(&dir, &snapshots.join("stochastic.exr"));
     let phi = manifest.goniometric_lights[0].flux_lm / 683.0;
     assert!((phi / (2000.0 * std::f64::consts::PI / 683.0) - 1.0).abs() < 1e-3, "flux {phi} W");

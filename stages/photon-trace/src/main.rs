@@ -163,9 +163,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         let Some(dir) = &args.snapshot_dir else { return Ok(()) };
         let name = match s.stage {
             Stage::Direct => "direct.exr".to_string(),
-            _ if snapshots.iter().all(|(_, stage, _, _)| *stage != s.stage) && s.stage == Stage::Stochastic && s.photons >= params.preview_photons => {
-                "stochastic.exr".to_string()
-            }
+            Stage::Stochastic if s.photons >= params.preview_photons => "stochastic.exr".to_string(),
             stage => format!("{stage}-{:012}.exr", s.photons),
         };
         let path = dir.join(&name);
