@@ -193,8 +193,8 @@ fn every_leaf_of_an_integrating_sphere_has_the_closed_form_radiosity_and_filteri
         let twice_area = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         for corner in &l.corners {
             let entry = normals.entry(key(corner)).or_insert(([0.0; 3], 0.0));
-            for k in 0..3 {
-                entry.0[k] += 0.5 * n[k]; // area x unit normal = n / 2
+            for (sum, x) in entry.0.iter_mut().zip(n) {
+                *sum += 0.5 * x; // area x unit normal = n / 2
             }
             entry.1 += 0.5 * twice_area;
         }
