@@ -19,7 +19,11 @@
 //!    one per isolux region (Delaunay triangles merged by band,
 //!    [`delaunay`]);
 //! 5. [`shooting`]: progressive shooting from the polygon of highest unshot
-//!    power, vertex-averaged, with the paper's vertex-ray occlusion;
+//!    power, vertex-averaged, with the paper's vertex-ray occlusion; then,
+//!    on surfaces the direct light leaves without contours (lit only by
+//!    interreflection, like the paper's B), display samples along the
+//!    contours of the indirect light, each gathering what the emitters
+//!    shot;
 //! 6. [`display`]: grid resampling with the conical filter, tag-aware at
 //!    shadow boundaries, and [`render`]: the image through the camera.
 //!
@@ -207,6 +211,11 @@ pub struct Work {
     pub direct_seconds: f64,
     /// Seconds shooting.
     pub shooting_seconds: f64,
+    /// Rays cast placing and gathering the display samples of surfaces
+    /// lit only indirectly.
+    pub indirect_rays: u64,
+    /// Seconds placing and gathering them.
+    pub indirect_placement_seconds: f64,
     /// Seconds resampling and rendering.
     pub display_seconds: f64,
 }
@@ -332,6 +341,59 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let shooting_params = ShootingParams { threshold: params.threshold, max_shots: params.max_shots, bounces: params.bounces, occlusion_vertices: params.occlusion_vertices };
     work.shooting = shoot(&polygons, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
     work.shooting_seconds = clock.elapsed().as_secs_f64();
+
+    // 5b. Surfaces the direct light leaves without isolux structure (lit
+    // only by interreflection, like paper 002's B, whose contours its
+    // Figure 3(b) shows): their indirect light is probed from the shot
+    // emitters, display samples go along its contours, and each gathers
+    // what the emitters shot.
+    let clock = std::time::Instant::now();
+    let mut placed = placed;
+    let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_vertices)).collect();
+    let gather = |point: DVec3, normal: DVec3, surface: u32, triangle: u32| -> ([f64; 3], u64) {
+        let (mut e, mut rays_cast) = ([0.0; 3], 0);
+        for (sender, shot) in senders.iter().zip(&work.shooting.shot) {
+            let (f, r) = sender.factor(&rays, point, normal, surface, triangle);
+            rays_cast += r;
+            for (e, b) in e.iter_mut().zip(shot) {
+                *e += b * f;
+            }
+        }
+        (e, rays_cast)
+    };
+    for (s, surface) in surfaces.iter().enumerate() {
+        if !isolux_levels(&grids[s], params.levels).is_empty() || luminance(surface.reflectance) <= 0.0 || senders.is_empty() {
+            continue;
+        }
+        let grid = ProbeGrid::of(surface, (params.probe_resolution / 2).max(4), |point, triangle, _| {
+            let (e, rays_cast) = gather(point, surface.normal, s as u32, triangle);
+            (luminance(e), 1.0, rays_cast)
+        });
+        work.indirect_rays += grid.rays;
+        let before = thinnings[s].kept().len();
+        for c in light_candidates(surface, &[], &grid, params).into_iter().filter(|c| c.reason == Reason::IsoluxContour) {
+            thinnings[s].offer(c);
+        }
+        for c in &thinnings[s].kept()[before..] {
+            let triangle = surface.triangle_at(c.uv).unwrap_or_else(|| nearest_triangle(surface, c.uv));
+            let position = surface.point(c.uv);
+            let e = direct.at(position, surface.normal, triangle, (1u64 << 61) + placed.len() as u64);
+            let (indirect, rays_cast) = gather(position, surface.normal, s as u32, triangle);
+            work.direct_rays += e.rays;
+            work.indirect_rays += rays_cast;
+            collectors.push(Collector {
+                position,
+                normal: surface.normal,
+                surface: s as u32,
+                triangle,
+                reflectance: surface.reflectance,
+                direct: [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]),
+                indirect: [0, 1, 2].map(|k| surface.reflectance[k] * indirect[k]),
+            });
+            placed.push((s as u32, *c));
+        }
+    }
+    work.indirect_placement_seconds = clock.elapsed().as_secs_f64();
 
     let mut emitter_of = vec![NO_EMITTER; placed.len()];
     for (p, polygon) in polygons.iter().enumerate() {

@@ -212,6 +212,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("placement_seconds".to_string(), w.placement_seconds),
             ("direct_seconds".to_string(), w.direct_seconds),
             ("shooting_seconds".to_string(), w.shooting_seconds),
+            ("indirect_rays".to_string(), w.indirect_rays as f64),
+            ("indirect_placement_seconds".to_string(), w.indirect_placement_seconds),
             ("display_seconds".to_string(), w.display_seconds),
         ]);
         for r in Reason::ALL {

@@ -7,7 +7,7 @@
 
 use crate::direct::DirectLight;
 use crate::surfaces::Surface;
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 /// One probe.
@@ -42,9 +42,20 @@ pub struct ProbeGrid {
 }
 
 impl ProbeGrid {
-    /// Probes `surface` with `resolution` cells along its longer side;
-    /// `key` offsets the probes' random streams (one range per surface).
+    /// Probes `surface`'s direct light with `resolution` cells along its
+    /// longer side; `key` offsets the probes' random streams (one range
+    /// per surface).
     pub fn new(surface: &Surface, direct: &DirectLight, resolution: usize, key: u64) -> Self {
+        Self::of(surface, resolution, |point, triangle, k| {
+            let e = direct.at(point, surface.normal, triangle, key + k);
+            (radiometry::color::luminance(e.rgb), e.visibility, e.rays)
+        })
+    }
+
+    /// Probes `surface` with `resolution` cells along its longer side by
+    /// `light(point, triangle, probe index) -> (illuminance, visibility,
+    /// rays cast)`.
+    pub fn of(surface: &Surface, resolution: usize, light: impl Fn(DVec3, u32, u64) -> (f64, f64, u64) + Sync) -> Self {
         let h = surface.extent() / resolution as f64;
         let size = surface.hi - surface.lo;
         let (nu, nv) = ((size.x / h).round() as usize + 1, (size.y / h).round() as usize + 1);
@@ -55,8 +66,8 @@ impl ProbeGrid {
                 let Some(triangle) = surface.triangle_at(uv) else {
                     return (Probe { triangle: None, illuminance: 0.0, visibility: 1.0 }, 0);
                 };
-                let e = direct.at(surface.point(uv), surface.normal, triangle, key + k as u64);
-                (Probe { triangle: Some(triangle), illuminance: radiometry::color::luminance(e.rgb), visibility: e.visibility }, e.rays)
+                let (illuminance, visibility, rays) = light(surface.point(uv), triangle, k as u64);
+                (Probe { triangle: Some(triangle), illuminance, visibility }, rays)
             })
             .collect();
         let rays = evaluated.iter().map(|p| p.1).sum();

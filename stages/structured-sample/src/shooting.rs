@@ -152,30 +152,50 @@ pub fn shoot(polygons: &[Polygon], samples: &mut [Collector], rays: &SceneRays, 
 /// Most transfer factors kept between shots (8 bytes each).
 const CACHE_ENTRIES: usize = 1 << 25;
 
-/// Per sample, `F_{dx->P} V_P(x)` of polygon `P` (0 on P's own surface),
-/// and the rays cast: Lambert's formula summed over P's triangles, the
-/// visible fraction by one ray from each of P's vertices (at most
-/// `occlusion_vertices` of them, evenly spread over the list).
+/// A polygon as a sender: its triangles' corners, its normal, and the
+/// vertices that cast its occlusion rays (at most `occlusion_vertices`,
+/// evenly spread over its vertex list).
+pub struct Sender {
+    surface: u32,
+    corners: Vec<[DVec3; 3]>,
+    normal: DVec3,
+    vertices: Vec<(DVec3, u32)>,
+}
+
+impl Sender {
+    /// The sender of `polygon`, whose vertices are `samples`.
+    pub fn new(polygon: &Polygon, samples: &[Collector], occlusion_vertices: usize) -> Self {
+        let n = polygon.vertices.len();
+        let casting = n.min(occlusion_vertices.max(1));
+        Sender {
+            surface: polygon.surface,
+            corners: polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect(),
+            normal: samples[polygon.vertices[0] as usize].normal,
+            vertices: (0..casting).map(|k| polygon.vertices[k * n / casting] as usize).map(|v| (samples[v].position, samples[v].triangle)).collect(),
+        }
+    }
+
+    /// `F_{dx->P} V_P(x)` at `position` (unit `normal`, on `surface` and
+    /// mesh `triangle`; 0 on the sender's own surface), and the rays cast:
+    /// Lambert's formula summed over the triangles, the visible fraction
+    /// by one ray from each casting vertex.
+    pub fn factor(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32) -> (f64, u64) {
+        if surface == self.surface {
+            return (0.0, 0);
+        }
+        let factor: f64 = self.corners.iter().map(|c| point_to_one_sided_polygon(position, normal, c, self.normal)).sum();
+        if factor <= 0.0 {
+            return (0.0, 0);
+        }
+        let clear = self.vertices.iter().filter(|(v, t)| rays.segment_clear(*v, position, [*t, triangle])).count();
+        (factor * clear as f64 / self.vertices.len() as f64, self.vertices.len() as u64)
+    }
+}
+
+/// Per sample, [`Sender::factor`] of `polygon`, and the rays cast.
 fn transfer_factors(polygon: &Polygon, samples: &[Collector], rays: &SceneRays, occlusion_vertices: usize) -> (Vec<f64>, u64) {
-    let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect();
-    let sender_normal = samples[polygon.vertices[0] as usize].normal;
-    let n = polygon.vertices.len();
-    let casting = n.min(occlusion_vertices.max(1));
-    let vertices: Vec<(DVec3, u32)> = (0..casting).map(|k| polygon.vertices[k * n / casting] as usize).map(|v| (samples[v].position, samples[v].triangle)).collect();
-    let factors: Vec<(f64, u64)> = samples
-        .par_iter()
-        .map(|x| {
-            if x.surface == polygon.surface {
-                return (0.0, 0);
-            }
-            let factor: f64 = corners.iter().map(|c| point_to_one_sided_polygon(x.position, x.normal, c, sender_normal)).sum();
-            if factor <= 0.0 {
-                return (0.0, 0);
-            }
-            let clear = vertices.iter().filter(|(v, t)| rays.segment_clear(*v, x.position, [*t, x.triangle])).count();
-            (factor * clear as f64 / vertices.len() as f64, vertices.len() as u64)
-        })
-        .collect();
+    let sender = Sender::new(polygon, samples, occlusion_vertices);
+    let factors: Vec<(f64, u64)> = samples.par_iter().map(|x| sender.factor(rays, x.position, x.normal, x.surface, x.triangle)).collect();
     let rays_cast = factors.iter().map(|f| f.1).sum();
     (factors.into_iter().map(|f| f.0).collect(), rays_cast)
 }
