@@ -158,7 +158,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         bar.set_position(if p.stage == Stage::Indirect { p.photons } else { 0 });
         bar.set_message(format!("{}: {} photons, error {:.2e}", p.stage, p.photons, p.max_error));
     };
-    let mut snapshots: Vec<(String, Stage, u64, f64)> = Vec::new();
+    let mut snapshots: Vec<(String, Stage, u64, f64, f64)> = Vec::new();
     let mut on_snapshot = |s: &Snapshot| -> Result<(), String> {
         let Some(dir) = &args.snapshot_dir else { return Ok(()) };
         let name = match s.stage {
@@ -170,7 +170,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         let solution = Solution { header: header.clone(), elements: s.elements.clone(), clusters: Vec::new(), links: Vec::new() };
         let mut outputs = Outputs::new();
         outputs.write(&path, |p| solution.write(p)).and_then(|()| outputs.keep()).map_err(|e| e.to_string())?;
-        snapshots.push((name, s.stage, s.photons, s.seconds));
+        snapshots.push((name, s.stage, s.photons, s.seconds, s.max_error));
         Ok(())
     };
     let mut observer = Observer { progress: &mut on_progress, snapshot_every: args.snapshot_every, snapshot: &mut on_snapshot };
@@ -191,8 +191,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     if w.capped_photons > 0 {
         notes.push(format!("{} photons reached max_bounces = {} and were dropped (their remaining power is lost)", w.capped_photons, params.max_bounces));
     }
-    for (name, stage, photons, seconds) in &snapshots {
-        notes.push(format!("snapshot {name}: {stage} stage, {photons} photons, {seconds:.3} s"));
+    for (name, stage, photons, seconds, error) in &snapshots {
+        let error = if error.is_finite() { format!(", largest vertex error {error:.3e}") } else { String::new() };
+        notes.push(format!("snapshot {name}: {stage} stage, {photons} photons, {seconds:.3} s{error}"));
     }
     let solution = Solution { header, elements: solved.elements, clusters: Vec::new(), links: Vec::new() };
     let mut outputs = Outputs::new();
