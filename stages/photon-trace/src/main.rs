@@ -123,8 +123,8 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
 /// What this stage does not simulate, for the effects the scene has.
 fn skipped(effects: &Effects) -> Vec<String> {
     Effects::skipped(&[
-        (effects.specular_reflection, "specular reflection: not simulated by photon-trace; photons see mirrors' diffuse part only"),
-        (effects.specular_transmission, "specular transmission: not simulated by photon-trace; glass is opaque"),
+        (effects.specular_reflection, "specular reflection: photons reflect off mirrors, but solution.exr holds diffuse radiosity only, so the preview shows a mirror's diffuse part"),
+        (effects.specular_transmission, "specular transmission: photons pass through as through a thin sheet (no refraction: materials carry no index); the preview shows the glass's diffuse part"),
         (effects.diffuse_transmission, "diffuse transmission: not simulated by photon-trace"),
         (effects.textures, "textures: photons use each material's mean diffuse reflectance"),
         (effects.alpha_masks, "alpha masks: surfaces are treated as opaque"),

@@ -20,15 +20,26 @@
 //! # Bounces
 //!
 //! At a hit on a front face the photon's power is deposited (the incident
-//! flux; `E = deposited / area`, radiosity `B = M + rho E`); it then
-//! survives with probability `q = max_c rho_c` and continues with power
-//! `rho_c / q` per channel, in a cosine-distributed direction. A hit on a
-//! back face is absorbed: surfaces are one-sided (mesh-prep gives two-sided
-//! materials a twin face), as the radiosity solvers treat them. A photon
-//! that leaves the scene is lost.
+//! flux; `E = deposited / area`, radiosity `B = M + rho_d E`, the diffuse
+//! part being all a radiosity solution shows). Then one event is drawn
+//! with probabilities `q_d = max_c rho_d`, `q_s = max_c rho_s`, `q_t =
+//! max_c tau_s` (diffuse, ideal specular reflection, ideal specular
+//! transmission; their sum is at most 1 for a physical material), the
+//! rest absorption; the photon continues with power `rho_c / q` per
+//! channel of the event drawn: in a cosine-distributed direction, in the
+//! mirror direction `d - 2 (d . n) n`, or straight on. Transmission keeps
+//! the direction because materials carry no index of refraction: a thin
+//! sheet (a window pane's two refractions cancel). A hit on a back face is
+//! absorbed, except that a transmitting material lets the photon through
+//! with probability `q_t` there too: surfaces are one-sided (mesh-prep
+//! gives two-sided materials a twin face), as the radiosity solvers treat
+//! them. Photons reflected or transmitted specularly are indirect light
+//! for stage 3 (the direct pass sees emitters only along straight lines).
+//! A photon that leaves the scene is lost.
 
 use crate::mesh::{Elements, Vertices};
 use glam::DVec3;
+use radiometry::color::max_channel;
 use radiometry::geometry::{frame_with_normal, TriangleGeometry};
 use radiometry::photometry::Luminaire;
 use radiometry::rays::SceneRays;
@@ -206,10 +217,17 @@ impl Scene<'_> {
             let Some(hit) = self.rays.closest_hit(origin, direction, self.t_min, f32::INFINITY, [from, u32::MAX]) else { return };
             let t = hit.triangle as usize;
             let g = &self.geometry[t];
+            let material = &self.manifest.materials[self.mesh.triangles[t].material as usize];
+            let p = origin + direction * f64::from(hit.t);
+            let q_t = max_channel(material.specular_transmittance);
             if direction.dot(g.normal) >= 0.0 {
+                if q_t > 0.0 && s.next_f64() < q_t {
+                    power = [0, 1, 2].map(|c| power[c] * material.specular_transmittance[c] / q_t);
+                    (origin, from) = (p, t as u32);
+                    continue;
+                }
                 return;
             }
-            let p = origin + direction * f64::from(hit.t);
             if bounce > 0 || deposit == Deposit::All {
                 let [u, v] = g.uv_of(p);
                 let (u, v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
@@ -224,14 +242,21 @@ impl Scene<'_> {
                     }
                 }
             }
-            let rho = self.manifest.materials[self.mesh.triangles[t].material as usize].diffuse;
-            let q = rho[0].max(rho[1]).max(rho[2]);
-            if q <= 0.0 || s.next_f64() >= q {
+            let (q_d, q_s) = (max_channel(material.diffuse), max_channel(material.specular_reflectance));
+            let x = s.next_f64();
+            let (weight, q) = if x < q_d {
+                direction = cosine_direction(g.normal, s);
+                (material.diffuse, q_d)
+            } else if x < q_d + q_s {
+                direction = (direction - 2.0 * direction.dot(g.normal) * g.normal).normalize();
+                (material.specular_reflectance, q_s)
+            } else if x < q_d + q_s + q_t {
+                (material.specular_transmittance, q_t)
+            } else {
                 return;
-            }
-            power = [0, 1, 2].map(|c| power[c] * rho[c] / q);
+            };
+            power = [0, 1, 2].map(|c| power[c] * weight[c] / q);
             origin = p;
-            direction = cosine_direction(g.normal, s);
             from = t as u32;
         }
         batch.capped += 1;
