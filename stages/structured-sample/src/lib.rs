@@ -133,7 +133,7 @@ impl Default for Params {
             umbra_spacing: 0.3,
             screen_spacing: 24,
             visibility_rays: 16,
-            emitter_min_area: 0.05,
+            emitter_min_area: 0.02,
             occlusion_vertices: 16,
             threshold: 1e-3,
             max_shots: 10_000,
@@ -345,7 +345,9 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     // 5b. Surfaces the direct light leaves without isolux structure (lit
     // only by interreflection, like paper 002's B, whose contours its
     // Figure 3(b) shows): their indirect light is probed from the shot
-    // emitters, display samples go along its contours, and each gathers
+    // emitters (on a grid a quarter as fine as the direct light's: the
+    // indirect light is smooth, and each probe gathers from every
+    // emitter), display samples go along its contours, and each gathers
     // what the emitters shot.
     let clock = std::time::Instant::now();
     let mut placed = placed;
@@ -365,7 +367,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         if !isolux_levels(&grids[s], params.levels).is_empty() || luminance(surface.reflectance) <= 0.0 || senders.is_empty() {
             continue;
         }
-        let grid = ProbeGrid::of(surface, (params.probe_resolution / 2).max(4), |point, triangle, _| {
+        let grid = ProbeGrid::of(surface, (params.probe_resolution / 4).max(8), |point, triangle, _| {
             let (e, rays_cast) = gather(point, surface.normal, s as u32, triangle);
             (luminance(e), 1.0, rays_cast)
         });
