@@ -286,7 +286,8 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         thinnings.push(thinning);
         (progress.step)();
     }
-    for (s, uv, spacing) in render::screen_candidates(&pinhole, &rays, &surfaces, &surface_of, size, camera.vertical_fov_deg, params.screen_spacing) {
+    let view = render::View { camera: &pinhole, rays: &rays, surfaces: &surfaces, surface_of: &surface_of };
+    for (s, uv, spacing) in render::screen_candidates(&view, size, camera.vertical_fov_deg, params.screen_spacing) {
         thinnings[s as usize].offer(Candidate { uv, reason: Reason::ScreenDensity, level: schemas::samples::NO_LEVEL, spacing, priority: 0.0 });
     }
     work.placement_seconds = clock.elapsed().as_secs_f64();
@@ -443,7 +444,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
             DisplayGrid::new(params.filter, surface.lo, surface.hi, extent / params.display_resolution as f64, &filter, params.filter_radius * extent, params.shadow_filter_radius * extent)
         })
         .collect();
-    let film = render::render(&pinhole, &rays, &surfaces, &surface_of, &display, size, params.spp_side, progress.step);
+    let film = render::render(&view, &display, size, params.spp_side, progress.step);
     work.display_seconds = clock.elapsed().as_secs_f64();
 
     let sampled_surfaces = surfaces.iter().map(|s| SampledSurface { object: s.object, material: s.material, normal: s.normal.to_array() }).collect();

@@ -58,7 +58,7 @@ pub struct Candidate {
 /// lit surface).
 pub fn isolux_levels(grid: &ProbeGrid, levels: usize) -> Vec<f64> {
     let (lo, hi) = grid.range();
-    if !(hi > lo) || hi - lo <= 1e-12 * hi.abs() {
+    if hi <= lo || hi - lo <= 1e-12 * hi.abs() {
         return Vec::new();
     }
     (1..levels).map(|k| lo + (hi - lo) * k as f64 / levels as f64).collect()

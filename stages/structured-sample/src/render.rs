@@ -10,33 +10,47 @@ use rayon::prelude::*;
 use schemas::image::{PixelSurfaces, EMITTER, NO_SURFACE, SINGLE_SURFACE};
 use std::f64::consts::PI;
 
-/// What a camera ray through image point `(x, y)` sees: the surface, the
-/// hit's `(u, v)` on it, its triangle and distance; `None` for a miss or
-/// the back of a surface.
-pub fn look(camera: &Pinhole, rays: &SceneRays, surfaces: &[Surface], surface_of: &[u32], x: f64, y: f64) -> Option<(u32, DVec2, u32, f64)> {
-    let direction = camera.direction(x, y);
-    let hit = rays.closest_hit(camera.eye, direction, 0.0, f32::INFINITY, [u32::MAX; 2])?;
-    let s = surface_of[hit.triangle as usize];
-    let surface = &surfaces[s as usize];
-    if direction.dot(surface.normal) >= 0.0 {
-        return None;
+/// What the camera looks at.
+pub struct View<'a> {
+    /// The camera.
+    pub camera: &'a Pinhole,
+    /// The scene's BVH.
+    pub rays: &'a SceneRays,
+    /// The planar surfaces.
+    pub surfaces: &'a [Surface],
+    /// Each mesh triangle's surface.
+    pub surface_of: &'a [u32],
+}
+
+impl View<'_> {
+    /// What a camera ray through image point `(x, y)` sees: the surface,
+    /// the hit's `(u, v)` on it, its triangle and distance; `None` for a
+    /// miss or the back of a surface.
+    pub fn look(&self, x: f64, y: f64) -> Option<(u32, DVec2, u32, f64)> {
+        let direction = self.camera.direction(x, y);
+        let hit = self.rays.closest_hit(self.camera.eye, direction, 0.0, f32::INFINITY, [u32::MAX; 2])?;
+        let s = self.surface_of[hit.triangle as usize];
+        let surface = &self.surfaces[s as usize];
+        if direction.dot(surface.normal) >= 0.0 {
+            return None;
+        }
+        let point: DVec3 = self.camera.eye + direction * f64::from(hit.t);
+        Some((s, surface.uv(point), hit.triangle, f64::from(hit.t)))
     }
-    let point: DVec3 = camera.eye + direction * f64::from(hit.t);
-    Some((s, surface.uv(point), hit.triangle, f64::from(hit.t)))
 }
 
 /// One view-dependent display sample candidate per `stride` x `stride`
 /// pixels (at the block's centre) of a `width` x `height` image: the
 /// surface, `(u, v)`, and the width of the block on the surface (m), its
 /// wanted spacing. Row by row: deterministic.
-pub fn screen_candidates(camera: &Pinhole, rays: &SceneRays, surfaces: &[Surface], surface_of: &[u32], size: (u32, u32), vertical_fov_deg: f64, stride: u32) -> Vec<(u32, DVec2, f64)> {
+pub fn screen_candidates(view: &View, size: (u32, u32), vertical_fov_deg: f64, stride: u32) -> Vec<(u32, DVec2, f64)> {
     let (width, height) = size;
     let pixel_angle = 2.0 * (0.5 * vertical_fov_deg.to_radians()).tan() / f64::from(height);
     let (nx, ny) = (width.div_ceil(stride), height.div_ceil(stride));
     (0..nx * ny)
         .filter_map(|k| {
             let (x, y) = (f64::from(k % nx * stride) + 0.5 * f64::from(stride), f64::from(k / nx * stride) + 0.5 * f64::from(stride));
-            let (s, uv, _, t) = look(camera, rays, surfaces, surface_of, x, y)?;
+            let (s, uv, _, t) = view.look(x, y)?;
             Some((s, uv, t * pixel_angle * f64::from(stride)))
         })
         .collect()
@@ -59,7 +73,8 @@ pub struct Film {
 /// surface's emitted luminance `B_e / pi`. A pixel's surface is the one
 /// most of its rays hit (ties: the lower surface index), single when all
 /// of them did.
-pub fn render(camera: &Pinhole, rays: &SceneRays, surfaces: &[Surface], surface_of: &[u32], grids: &[DisplayGrid], size: (u32, u32), spp_side: u32, row_done: &(dyn Fn() + Sync)) -> Film {
+pub fn render(view: &View, grids: &[DisplayGrid], size: (u32, u32), spp_side: u32, row_done: &(dyn Fn() + Sync)) -> Film {
+    let surfaces = view.surfaces;
     let (width, height) = size;
     let n = f64::from(spp_side * spp_side);
     let pixels: Vec<([f32; 3], f32, [u32; 3])> = (0..height)
@@ -71,7 +86,7 @@ pub fn render(camera: &Pinhole, rays: &SceneRays, surfaces: &[Surface], surface_
                     let mut hits: Vec<(u32, u32)> = Vec::new();
                     for k in 0..spp_side * spp_side {
                         let (sx, sy) = ((f64::from(k % spp_side) + 0.5) / f64::from(spp_side), (f64::from(k / spp_side) + 0.5) / f64::from(spp_side));
-                        let Some((s, uv, _, _)) = look(camera, rays, surfaces, surface_of, f64::from(x) + sx, f64::from(y) + sy) else { continue };
+                        let Some((s, uv, _, _)) = view.look(f64::from(x) + sx, f64::from(y) + sy) else { continue };
                         let surface = &surfaces[s as usize];
                         let l = grids[s as usize].at(uv);
                         for c in 0..3 {
