@@ -145,3 +145,65 @@ fn merge_small_regions(parent: &mut [usize], areas: &[f64], adjacent: &[(usize, 
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// A 4 x 2 m rectangle in the plane z = 0, facing +z, as one surface.
+    fn rectangle() -> Surface {
+        let corners = [DVec2::new(0.0, 0.0), DVec2::new(4.0, 0.0), DVec2::new(4.0, 2.0), DVec2::new(0.0, 2.0)];
+        Surface {
+            object: 0,
+            material: 0,
+            normal: DVec3::Z,
+            origin: DVec3::ZERO,
+            axes: [DVec3::X, DVec3::Y],
+            triangles: vec![0, 1],
+            corners_uv: vec![[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]],
+            lo: corners[0],
+            hi: corners[2],
+            area: 8.0,
+            reflectance: [0.5; 3],
+            emission: [0.0; 3],
+        }
+    }
+
+    fn lattice() -> Vec<DVec2> {
+        (0..=16).flat_map(|i| (0..=8).map(move |j| DVec2::new(0.25 * i as f64, 0.25 * j as f64))).collect()
+    }
+
+    #[test]
+    fn regions_follow_the_bands_and_partition_the_surface() {
+        let (surface, uv) = (rectangle(), lattice());
+        let indices: Vec<u32> = (100..100 + uv.len() as u32).collect();
+        // Illuminance growing with u: cuts at u = 1.1, 2.1, 3.1 make four bands.
+        let polygons = isolux_polygons(7, &surface, &indices, &uv, |p| p.x, &[1.1, 2.1, 3.1], 0.0);
+        assert_eq!(polygons.len(), 4);
+        let area: f64 = polygons.iter().map(|p| p.area).sum();
+        assert!((area - 8.0).abs() < 1e-12, "{area}");
+        for p in &polygons {
+            assert_eq!(p.surface, 7);
+            assert!(p.vertices.iter().all(|v| (100..100 + uv.len() as u32).contains(v)));
+            // One band per polygon: every triangle's centroid on one side of each cut.
+            let band_of = |t: &[u32; 3]| band(&[1.1, 2.1, 3.1], t.iter().map(|&v| uv[(v - 100) as usize].x).sum::<f64>() / 3.0);
+            assert!(p.triangles.iter().all(|t| band_of(t) == band_of(&p.triangles[0])));
+        }
+    }
+
+    #[test]
+    fn regions_under_the_least_area_join_a_neighbour() {
+        let (surface, uv) = (rectangle(), lattice());
+        let indices: Vec<u32> = (0..uv.len() as u32).collect();
+        // A thin band u in (1.0, 1.3) between two wide ones.
+        let cuts = [1.05, 1.3];
+        let thin = isolux_polygons(0, &surface, &indices, &uv, |p| p.x, &cuts, 0.0);
+        assert_eq!(thin.len(), 3);
+        let merged = isolux_polygons(0, &surface, &indices, &uv, |p| p.x, &cuts, 1.0);
+        assert_eq!(merged.len(), 2, "the 0.5 m² band joins a neighbour");
+        assert!(merged.iter().all(|p| p.area >= 1.0));
+        let area: f64 = merged.iter().map(|p| p.area).sum();
+        assert!((area - 8.0).abs() < 1e-12);
+    }
+}
