@@ -54,14 +54,14 @@ pub fn fill_seams(lightmap: &mut Lightmap) {
                             }
                             let near = at(x - dx, y - dy);
                             let value = |k: usize, c: usize| if c < 3 { lightmap.radiosity[k][c] } else { lightmap.residual[k][c - 3] } as f64;
-                            for c in 0..6 {
-                                mean[c] += value(near, c);
+                            for (c, m) in mean.iter_mut().enumerate() {
+                                *m += value(near, c);
                             }
                             count += 1;
                             if known(lightmap, x - 2 * dx, y - 2 * dy) {
                                 let far = at(x - 2 * dx, y - 2 * dy);
-                                for c in 0..6 {
-                                    line[c] += 2.0 * value(near, c) - value(far, c);
+                                for (c, l) in line.iter_mut().enumerate() {
+                                    *l += 2.0 * value(near, c) - value(far, c);
                                 }
                                 lines += 1;
                             }
@@ -234,9 +234,8 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, ambient: Option
         for c in &pieces {
             let point = |l: [f64; 3]| [l[0] * c[0][0] + l[1] * c[1][0] + l[2] * c[2][0], l[0] * c[0][1] + l[1] * c[1][1] + l[2] * c[2][1]];
             for l in points {
-                let v = bilinear(lm, t, point(l));
-                for k in 0..3 {
-                    sum[k] += v[k] * weight;
+                for (s, v) in sum.iter_mut().zip(bilinear(lm, t, point(l))) {
+                    *s += v * weight;
                 }
             }
         }
