@@ -131,7 +131,7 @@ impl Default for Params {
             lattice_spacing: 0.25,
             shadow_spacing: 0.04,
             umbra_spacing: 0.3,
-            screen_spacing: 24,
+            screen_spacing: 12,
             visibility_rays: 16,
             emitter_min_area: 0.02,
             occlusion_vertices: 16,
