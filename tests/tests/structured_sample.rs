@@ -340,3 +340,85 @@ fn a_bad_parameter_is_refused_naming_it() {
     assert!(!samples.exists() && !image.exists());
 }
 
+
+/// A shadow scene, axis-aligned: a 1 m square lamp facing down at z = 2
+/// over `[1.5, 2.5]²`, a black 0.8 m square plate over `[1.6, 2.4]²` at
+/// z = 0.3, a 4 m square floor at z = 0 (reflectance 0.5). From a floor
+/// point `p` the plate hides the part of the lamp inside the plate's
+/// projection from `p` onto the lamp's plane, `q = p + (o - p) h_lamp /
+/// h_plate`: a rectangle, so the seen fraction of the lamp's area is
+/// exact, and with it the umbra (none seen) and the penumbra (some).
+/// Fully lit samples carry Lambert's value to 1e-9, umbra samples none,
+/// and the samples crowd into the penumbra (at least 3 x the floor's mean
+/// density; 18.5 x measured).
+#[test]
+fn shadow_samples_lie_across_the_exact_penumbra_and_umbra() {
+    let dir = scratch("structured_shadow");
+    let mut scene = end_to_end::scenes::QuadScene { camera: ([2.0, -2.5, 3.0], [2.0, 2.0, 0.0]), ..Default::default() };
+    scene.material("floor", 0.5, 0.0).material("black", 0.0, 0.0).material("lamp", 0.0, 10.0);
+    scene.quad("floor", "floor", end_to_end::scenes::rectangle(2, 0.0, [0.0, 0.0], [4.0, 4.0]), [0.0, 0.0, 1.0]);
+    scene.quad("plate", "black", end_to_end::scenes::rectangle(2, 0.3, [1.6, 1.6], [2.4, 2.4]), [0.0, 0.0, 1.0]);
+    scene.quad("lamp", "lamp", end_to_end::scenes::rectangle(2, 2.0, [1.5, 1.5], [2.5, 2.5]), [0.0, 0.0, -1.0]);
+    let scene_path = scene.write(&dir);
+    let (mesh_path, manifest_path, samples_path, image) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("samples.exr"), dir.join("image.exr"));
+    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh_path), "--manifest", s(&manifest_path)]);
+    run_ok("structured-sample", &["--mesh", s(&mesh_path), "--manifest", s(&manifest_path), "-o", s(&samples_path), "--image", s(&image)]);
+    let mesh = Mesh::read(&mesh_path).unwrap().0;
+    let manifest = read_ron::<Manifest>(&manifest_path).unwrap().value;
+    let samples = Samples::read(&samples_path).unwrap().0;
+    // Mesh-frame rectangles [x0, x1, y0, y1] and heights of each object.
+    let object = |name: &str| manifest.objects.iter().position(|o| o == name).unwrap() as u32;
+    let rect = |o: u32| {
+        let p: Vec<[f64; 3]> = mesh.triangles.iter().filter(|t| t.object == o).flat_map(|t| t.vertices.map(|v| mesh.positions[v as usize].map(f64::from))).collect();
+        let f = |k: usize, max: bool| p.iter().map(|q| q[k]).fold(if max { f64::NEG_INFINITY } else { f64::INFINITY }, |a, b| if max { a.max(b) } else { a.min(b) });
+        ([f(0, false), f(0, true), f(1, false), f(1, true)], p[0][2])
+    };
+    let ((lamp, z_lamp), (plate, z_plate), (_, z_floor)) = (rect(object("lamp")), rect(object("plate")), rect(object("floor")));
+    let lamp_triangles: Vec<[[f64; 3]; 3]> =
+        mesh.triangles.iter().filter(|t| t.object == object("lamp")).map(|t| t.vertices.map(|v| mesh.positions[v as usize].map(f64::from))).collect();
+    // The seen fraction of the lamp's area from floor point (x, y).
+    let seen = |x: f64, y: f64| {
+        let k = (z_lamp - z_floor) / (z_plate - z_floor);
+        let hidden = |p: f64, o0: f64, o1: f64, l0: f64, l1: f64| ((p + (o1 - p) * k).min(l1) - (p + (o0 - p) * k).max(l0)).max(0.0);
+        1.0 - hidden(x, plate[0], plate[1], lamp[0], lamp[1]) * hidden(y, plate[2], plate[3], lamp[2], lamp[3]) / ((lamp[1] - lamp[0]) * (lamp[3] - lamp[2]))
+    };
+    let floor = object("floor");
+    let on_floor: Vec<&schemas::samples::Sample> = samples.samples.iter().filter(|s| samples.surfaces[s.surface as usize].object == floor).collect();
+    let (mut lit, mut in_penumbra, mut penumbra_area) = (0, 0, 0.0);
+    for s in &on_floor {
+        let v = seen(s.position[0], s.position[1]);
+        if v >= 1.0 {
+            // Fully lit: the visibility rays are all clear, so Lambert's value.
+            let exact = 0.5 * 10.0 * lamp_triangles.iter().map(|t| lambert_polygon(s.position, [0.0, 0.0, 1.0], t)).sum::<f64>() / PI;
+            assert!((s.direct[1] - exact).abs() <= 1e-9 * exact, "lit sample at {:?}: {} vs {exact}", s.position, s.direct[1]);
+            lit += 1;
+        }
+        if v <= 0.0 {
+            assert_eq!(s.direct, [0.0; 3], "an umbra sample sees no light: {s:?}");
+        }
+        if v > 0.0 && v < 1.0 {
+            in_penumbra += 1;
+        }
+        if s.reason == schemas::samples::Reason::Umbra {
+            assert!(v <= 0.0 || s.direct[1] < 0.05 * 0.5 * 10.0 / PI, "an umbra-tagged sample in the light: {s:?} sees {v}");
+        }
+    }
+    // The penumbra's area on a 200 x 200 grid over the floor.
+    let [fx0, fx1, fy0, fy1] = rect(floor).0;
+    let n = 200;
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = (fx0 + (fx1 - fx0) * (i as f64 + 0.5) / n as f64, fy0 + (fy1 - fy0) * (j as f64 + 0.5) / n as f64);
+            let v = seen(x, y);
+            if v > 0.0 && v < 1.0 {
+                penumbra_area += (fx1 - fx0) * (fy1 - fy0) / (n * n) as f64;
+            }
+        }
+    }
+    let floor_area = (fx1 - fx0) * (fy1 - fy0);
+    let ratio = (in_penumbra as f64 / penumbra_area) / (on_floor.len() as f64 / floor_area);
+    let shadow_tagged = on_floor.iter().filter(|s| s.reason.tag() == Tag::ShadowBoundary).count();
+    eprintln!("floor: {} samples, {lit} fully lit, {in_penumbra} in the penumbra ({penumbra_area:.3} of {floor_area:.1} m²): density {ratio:.2} x the mean; {shadow_tagged} tagged shadow boundary", on_floor.len());
+    assert!(lit > 20 && shadow_tagged > 20);
+    assert!(ratio >= 3.0, "penumbra density {ratio:.2} x the floor's mean");
+}
