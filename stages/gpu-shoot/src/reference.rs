@@ -115,15 +115,14 @@ pub const RECIPROCAL: f64 = 16.0;
 /// aside. Far (beyond [`NEAR_FIELD`]) the disc approximation (004 Eq. 2.2
 /// / 4.1 with one disc per sample), [`disc_form_factor`]. Near, the
 /// larger patch is integrated exactly with [`polygon_form_factor`] and the
-/// smaller one by a point or a rule:
+/// smaller one taken as a point:
 ///
-/// - sample over [`RECIPROCAL`] times the texel (a group of texels): the
-///   mean over the patch's [`rule_points`] `q` of `F(q -> sender.polygon)`, the irradiance a
-///   uniform polygon gives a point (reciprocity). The group's centroid as
-///   a point put the power of the group's near part half a group away: the
+/// - sample over [`RECIPROCAL`] times the texel (a group of texels):
+///   `F(receiver -> sender.polygon)`, the irradiance a uniform polygon
+///   gives the texel's point (reciprocity). The group's centroid as a
+///   point put the power of the group's near part half a group away: the
 ///   texels next to a shared edge were off by up to +-90% in the period of
-///   the groups (issue 10, item 7). The rule makes the texel's value its
-///   patch's mean, as the other branch's is.
+///   the groups (issue 10, item 7).
 /// - otherwise: `A_s F(sender -> patch) / A_r`, the patch's
 ///   exact share of the sender's power spread over the patch, so that the
 ///   shares of a closed room sum to 1 (004 Eq. 2.3).
@@ -153,22 +152,9 @@ pub fn area_transfer(receiver: DVec3, receiver_normal: DVec3, a_r: f64, patch: &
         return disc_form_factor(receiver, receiver_normal, sender.point, sender.normal, sender.area);
     }
     if reciprocal {
-        let points = rule_points(patch);
-        return points.iter().map(|&q| polygon_form_factor(q, receiver_normal, sender.polygon)).sum::<f64>() / points.len() as f64;
+        return polygon_form_factor(receiver, receiver_normal, sender.polygon);
     }
     sender.area * polygon_form_factor(sender.point, sender.normal, patch) / a_r
-}
-
-/// The points of the rule that integrates over a texel's patch: 2 x 2
-/// Gauss points `centre + (corner - centre) / sqrt(3)` on a parallelogram,
-/// `(4 V_k + V_k+1 + V_k+2) / 6` on a triangle (equal weights).
-pub fn rule_points(patch: &[DVec3]) -> Vec<DVec3> {
-    let n = patch.len();
-    if n == 3 {
-        return (0..3).map(|k| (4.0 * patch[k] + patch[(k + 1) % 3] + patch[(k + 2) % 3]) / 6.0).collect();
-    }
-    let centre = patch.iter().copied().sum::<DVec3>() / n as f64;
-    patch.iter().map(|&c| centre + (c - centre) / 3f64.sqrt()).collect()
 }
 
 /// An area sample as the receiver pass sees it: a group of the shooter's

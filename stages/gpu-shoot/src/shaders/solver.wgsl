@@ -378,18 +378,15 @@ fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 5>, count: u32) -
 // texel k at p (normal nr), with the cosines at the sample's point;
 // mirrors reference::area_transfer. Far: the disc approximation. Near, the
 // larger of the two patches is integrated exactly (Lambert's formula) and
-// the smaller one by a rule of its own:
-//   sample over RECIPROCAL texels:  H = mean over the texel's rule points q
-//                   of F(q -> sample's polygon)             (reciprocity)
+// the smaller one taken as a point:
+//   sample over RECIPROCAL texels:  H = F(p -> sample's polygon)  (reciprocity)
 //   otherwise:      H = A_s F(s -> texel's patch) / A_r
 // A group of 8 x 8 texels taken as its centroid misplaced the power of its
 // near part by half a group, +-90% on the texels next to a shared edge
 // (issue 10, item 7), and a texel patch much smaller than its distance
-// (a sliver's) lost its solid angle to f32 cancellation. The rule on the
-// texel (2 x 2 Gauss points on a parallelogram, the three points (2/3,
-// 1/6, 1/6) on a hypotenuse half square) makes its value its patch's mean,
-// as the other branch's is. At equal sizes the sample's point conserves
-// power exactly, hence the threshold RECIPROCAL (see reference.rs).
+// (a sliver's) lost its solid angle to f32 cancellation. At equal sizes
+// the sample's point conserves power exactly, hence the threshold
+// RECIPROCAL (see reference.rs).
 // A sample this many times larger than a texel in its near field is
 // taken by reciprocity (area_transfer); mirrors reference::RECIPROCAL.
 const RECIPROCAL: f32 = 16.0;
@@ -431,14 +428,8 @@ fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, s: Sample, d2: f32, cos_s:
     var corners: array<vec3<f32>, 5>;
     if (reciprocal(k, s, d2)) {
         let m = u32(s.polygon[0].w);
-        var f = 0.0;
-        for (var j = 0u; j < count; j += 1u) {
-            var q = 0.57735027 * corner_of[j];
-            if (count == 3u) { q = (4.0 * corner_of[j] + corner_of[(j + 1u) % 3u] + corner_of[(j + 2u) % 3u]) / 6.0; }
-            for (var c = 0u; c < m; c += 1u) { corners[c] = (s.polygon[c].xyz - p) - q; }
-            f += polygon_form_factor(nr, corners, m);
-        }
-        return f / f32(count);
+        for (var c = 0u; c < m; c += 1u) { corners[c] = s.polygon[c].xyz - p; }
+        return polygon_form_factor(nr, corners, m);
     }
     for (var j = 0u; j < count; j += 1u) { corners[j] = (p - s.position.xyz) + corner_of[j]; }
     // H_r = B_s A_s F_(s -> patch) / A_r: the power the patch receives
