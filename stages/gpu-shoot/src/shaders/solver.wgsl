@@ -374,6 +374,18 @@ fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 5>, count: u32) -
     return abs(sum) / (2.0 * PI);
 }
 
+// A sample this many times larger than a texel in its near field is
+// taken by reciprocity (area_transfer); mirrors reference::RECIPROCAL.
+const RECIPROCAL: f32 = 16.0;
+
+// Whether texel k takes area sample s, at squared distance d2, by
+// reciprocity.
+fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
+    let a_r = texels[k].position.w;
+    let a_s = s.position.w;
+    return d2 < NEAR_FIELD * (a_r + a_s) && a_s > RECIPROCAL * a_r;
+}
+
 // Irradiance per unit radiosity of the area sample s on the receiving
 // texel k at p (normal nr), with the cosines at the sample's point;
 // mirrors reference::area_transfer. Far: the disc approximation. Near, the
@@ -387,18 +399,6 @@ fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 5>, count: u32) -
 // (a sliver's) lost its solid angle to f32 cancellation. At equal sizes
 // the sample's point conserves power exactly, hence the threshold
 // RECIPROCAL (see reference.rs).
-// A sample this many times larger than a texel in its near field is
-// taken by reciprocity (area_transfer); mirrors reference::RECIPROCAL.
-const RECIPROCAL: f32 = 16.0;
-
-// Whether texel k takes area sample s, at squared distance d2, by
-// reciprocity.
-fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
-    let a_r = texels[k].position.w;
-    let a_s = s.position.w;
-    return d2 < NEAR_FIELD * (a_r + a_s) && a_s > RECIPROCAL * a_r;
-}
-
 fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, s: Sample, d2: f32, cos_s: f32, cos_r: f32) -> f32 {
     let a_r = texels[k].position.w;
     let a_s = s.position.w;
@@ -406,32 +406,30 @@ fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, s: Sample, d2: f32, cos_s:
         // 004 Eq. 2.2 / 4.1 with one disc per sample.
         return a_s * cos_s * cos_r / (PI * d2 + a_s);
     }
-    // The corners of the texel's patch relative to p.
-    let tri = tris[bitcast<u32>(texels[k].normal.w)];
-    let a = tri.half_u.xyz;
-    let b = tri.half_v.xyz;
-    var corner_of: array<vec3<f32>, 5>;
-    var count = 4u;
-    if (texels[k].rho.w != 0.0) {
-        // The hypotenuse texel stands for the half square whose centroid is p.
-        let c = (a + b) / 3.0;
-        corner_of[0] = c - a - b;
-        corner_of[1] = c + a - b;
-        corner_of[2] = c - a + b;
-        count = 3u;
-    } else {
-        corner_of[0] = -a - b;
-        corner_of[1] = a - b;
-        corner_of[2] = a + b;
-        corner_of[3] = -a + b;
-    }
     var corners: array<vec3<f32>, 5>;
     if (reciprocal(k, s, d2)) {
         let m = u32(s.polygon[0].w);
         for (var c = 0u; c < m; c += 1u) { corners[c] = s.polygon[c].xyz - p; }
         return polygon_form_factor(nr, corners, m);
     }
-    for (var j = 0u; j < count; j += 1u) { corners[j] = (p - s.position.xyz) + corner_of[j]; }
+    let tri = tris[bitcast<u32>(texels[k].normal.w)];
+    let a = tri.half_u.xyz;
+    let b = tri.half_v.xyz;
+    var count = 4u;
+    let c = p - s.position.xyz;
+    if (texels[k].rho.w != 0.0) {
+        // The hypotenuse texel stands for the half square whose centroid is p.
+        let h = c + (a + b) / 3.0;
+        corners[0] = h - a - b;
+        corners[1] = h + a - b;
+        corners[2] = h - a + b;
+        count = 3u;
+    } else {
+        corners[0] = c - a - b;
+        corners[1] = c + a - b;
+        corners[2] = c + a + b;
+        corners[3] = c - a + b;
+    }
     // H_r = B_s A_s F_(s -> patch) / A_r: the power the patch receives
     // spread over its area, so the shares of a closed room sum to 1.
     return a_s * polygon_form_factor(s.n.xyz, corners, count) / a_r;
