@@ -6,7 +6,10 @@ CLUSTERS_EXR := $(if $(filter 1,$(CLUSTERS)),$(OUT)/clusters.exr)
 
 $(eval $(call params_file,mesh-prep,))
 $(eval $(call params_file,cluster,))
-$(eval $(call params_file,hierarchical-solve,--eps $(EPS) --min-area $(MIN_AREA) --visibility-rays $(VISIBILITY_RAYS) --tolerance $(TOLERANCE) --seed $(SEED)))
+# SHADOW_LEVELS: how many 1:4 levels below MIN_AREA a shadow edge may split
+# (hierarchical-solve's --shadow-levels).
+SHADOW_LEVELS ?= 2
+$(eval $(call params_file,hierarchical-solve,--eps $(EPS) --min-area $(MIN_AREA) --shadow-levels $(SHADOW_LEVELS) --visibility-rays $(VISIBILITY_RAYS) --tolerance $(TOLERANCE) --seed $(SEED)))
 $(eval $(call params_file,grid-gather,--spp $(SPP) $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT))))
 $(eval $(call params_file,tonemap,--operator $(OPERATOR)))
 

@@ -21,6 +21,7 @@
 //! | `relative_floor` | least receiver radiosity the relative criterion assumes, as a fraction of the scene's area-mean reflected radiosity (black receivers terminate) | 1e-2 |
 //! | `share_floor` | relative criterion: a link may err by `eps_relative` times what it brings its receiver, or times this share of the receiver's radiosity if more, so that the errors of an element's links add up to about `eps_relative` of its radiosity ([`links::Allowance::for_link`]) | 1/16 |
 //! | `min_area` | smallest element area, as a fraction of the scene's total area | 1e-4 |
+//! | `shadow_levels` | how many 1:4 levels below `min_area` a shadow edge across a link between elements may split ([`links::Floors`]) | 2 |
 //! | `visibility_rays` | rays per link between two elements | 16 |
 //! | `cluster_samples` | point pairs (and rays) per link with a cluster end | 16 |
 //! | `quadrature_depth` | deepest split of the adaptive receiver quadrature near touching elements, and of the near-field quadrature of a luminaire's direct light over an element ([`luminaires`]) | 3 |
@@ -70,7 +71,7 @@ pub mod transfer;
 pub mod visibility;
 
 use elements::Hierarchy;
-use links::{children_links, decide, link, self_link, Allowance, Link, Linking, Split};
+use links::{children_links, decide, link, self_link, Allowance, Floors, Link, Linking, Split};
 pub use links::Criterion;
 use schemas::cluster::Clusters;
 use schemas::solution::Node;
@@ -102,6 +103,8 @@ pub struct Params {
     pub share_floor: f64,
     /// Smallest element area relative to the total area.
     pub min_area: f64,
+    /// Levels below `min_area` a shadow edge may split ([`links::Floors`]).
+    pub shadow_levels: u32,
     /// Rays per element-element link.
     pub visibility_rays: usize,
     /// Point pairs per link with a cluster end.
@@ -128,6 +131,7 @@ impl Default for Params {
             relative_floor: 1e-2,
             share_floor: 1.0 / 16.0,
             min_area: 1e-4,
+            shadow_levels: 2,
             visibility_rays: 16,
             cluster_samples: 16,
             quadrature_depth: 3,
@@ -166,6 +170,9 @@ impl Params {
         }
         if !positive(self.min_area) || self.min_area > 1.0 {
             return Some(format!("min_area must be in (0, 1], not {}", self.min_area));
+        }
+        if self.shadow_levels > 8 {
+            return Some(format!("shadow_levels must be at most 8, not {}", self.shadow_levels));
         }
         if self.visibility_rays == 0 || self.visibility_rays > 4096 {
             return Some(format!("visibility_rays must be in 1..=4096, not {}", self.visibility_rays));
@@ -300,6 +307,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
     let mut h = Hierarchy::new(mesh, manifest, clusters);
     let total_area: f64 = (0..n).map(|t| h.elements[t].area).sum();
     let min_area = params.min_area * total_area;
+    let floors = Floors { area: min_area, shadow: min_area * 0.25f64.powi(params.shadow_levels as i32) };
     let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed, quadrature_depth: params.quadrature_depth };
     let scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
     let mut work = Work::default();
@@ -357,7 +365,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
         };
         let mut active = std::mem::take(&mut all_links);
         while !active.is_empty() {
-            let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, &deviation, &allowance, min_area)).collect();
+            let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, &deviation, &allowance, floors)).collect();
             for (l, d) in active.iter().zip(&decisions) {
                 let node = match d {
                     Split::Sender => l.sender,

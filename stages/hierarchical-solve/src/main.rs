@@ -59,6 +59,9 @@ struct Args {
     /// Smallest element area, as a fraction of the scene's total area.
     #[arg(long)]
     min_area: Option<f64>,
+    /// How many 1:4 levels below min_area a shadow edge across a link between elements may split [default: 2].
+    #[arg(long)]
+    shadow_levels: Option<u32>,
     /// Visibility rays per link between two elements.
     #[arg(long)]
     visibility_rays: Option<usize>,
@@ -90,6 +93,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.relative_floor = args.relative_floor.unwrap_or(p.relative_floor);
     p.share_floor = args.share_floor.unwrap_or(p.share_floor);
     p.min_area = args.min_area.unwrap_or(p.min_area);
+    p.shadow_levels = args.shadow_levels.unwrap_or(p.shadow_levels);
     p.visibility_rays = args.visibility_rays.unwrap_or(p.visibility_rays);
     p.cluster_samples = args.cluster_samples.unwrap_or(p.cluster_samples);
     p.quadrature_depth = args.quadrature_depth.unwrap_or(p.quadrature_depth);
