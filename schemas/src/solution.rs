@@ -35,6 +35,13 @@ pub struct Element {
 }
 
 impl Element {
+    /// The root element of input triangle `triangle` (area `area`, m²):
+    /// the whole triangle, no parent, no children yet, radiosity
+    /// `radiosity`.
+    pub fn root(triangle: u32, area: f32, radiosity: [f32; 3]) -> Self {
+        Element { triangle, parent: NONE, first_child: NONE, level: 0, corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], area, radiosity }
+    }
+
     /// Whether the element has no children.
     pub fn is_leaf(&self) -> bool {
         self.first_child == NONE

@@ -28,7 +28,7 @@
 
 use schemas::header::{Provenance, Schema};
 use schemas::mesh::{Manifest, Mesh};
-use schemas::solution::{Element, Solution, NONE};
+use schemas::solution::{Element, Solution};
 use std::collections::HashMap;
 
 /// Relative tolerance on the vertices' distance to the fitted centre.
@@ -87,15 +87,7 @@ pub fn solution(mesh: &Mesh, radiosity: &[[f64; 3]], provenance: Provenance) -> 
         .iter()
         .zip(radiosity)
         .enumerate()
-        .map(|(i, (t, b))| Element {
-            triangle: i as u32,
-            parent: NONE,
-            first_child: NONE,
-            level: 0,
-            corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-            area: t.area,
-            radiosity: b.map(|x| x as f32),
-        })
+        .map(|(i, (t, b))| Element::root(i as u32, t.area, b.map(|x| x as f32)))
         .collect();
     Solution { header: Solution::header(provenance), elements, clusters: Vec::new(), links: Vec::new() }
 }

@@ -4,7 +4,7 @@
 use schemas::header::{Provenance, Schema};
 use schemas::image::HdrImage;
 use schemas::report::Report;
-use schemas::solution::{Element, Solution, NONE};
+use schemas::solution::{Element, Solution};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -26,15 +26,7 @@ fn write_image(path: &Path, width: usize, rgb: Vec<[f32; 3]>) {
 }
 
 fn write_solution(path: &Path, radiosity: [f32; 3]) {
-    let e = Element {
-        triangle: 0,
-        parent: NONE,
-        first_child: NONE,
-        level: 0,
-        corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-        area: 0.5,
-        radiosity,
-    };
+    let e = Element::root(0, 0.5, radiosity);
     Solution { header: Solution::header(provenance()), elements: vec![e], clusters: vec![], links: vec![] }.write(path).unwrap();
 }
 

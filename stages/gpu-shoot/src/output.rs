@@ -167,20 +167,7 @@ pub fn bilinear(lm: &Lightmap, t: usize, uv: [f64; 2]) -> [f64; 3] {
 /// `rho x ambient` when asked (004 Eq. 2.4, for display). Inner elements
 /// hold the area-weighted mean of their children. No links, no clusters.
 pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, ambient: Option<[f64; 3]>, texels_per_leaf: f64, header: Header) -> Solution {
-    let mut elements: Vec<Element> = mesh
-        .triangles
-        .iter()
-        .enumerate()
-        .map(|(t, tri)| Element {
-            triangle: t as u32,
-            parent: NONE,
-            first_child: NONE,
-            level: 0,
-            corners: ROOT.map(|c| c.map(|x| x as f32)),
-            area: tri.area,
-            radiosity: [0.0; 3],
-        })
-        .collect();
+    let mut elements: Vec<Element> = mesh.triangles.iter().enumerate().map(|(t, tri)| Element::root(t as u32, tri.area, [0.0; 3])).collect();
     let mut corners_of: Vec<Corners> = vec![ROOT; elements.len()];
     for t in 0..mesh.triangles.len() {
         let covered = lm.regions[t].covered as f64;

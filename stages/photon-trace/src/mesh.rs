@@ -48,20 +48,7 @@ pub struct Elements {
 impl Elements {
     /// One element per input triangle.
     pub fn new(mesh: &Mesh) -> Self {
-        let elements = mesh
-            .triangles
-            .iter()
-            .enumerate()
-            .map(|(t, tri)| Element {
-                triangle: t as u32,
-                parent: NONE,
-                first_child: NONE,
-                level: 0,
-                corners: ROOT.map(|c| c.map(|x| x as f32)),
-                area: tri.area,
-                radiosity: [0.0; 3],
-            })
-            .collect();
+        let elements = mesh.triangles.iter().enumerate().map(|(t, tri)| Element::root(t as u32, tri.area, [0.0; 3])).collect();
         Elements { elements, corners: vec![ROOT; mesh.triangles.len()] }
     }
 
