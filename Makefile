@@ -83,14 +83,21 @@ $(OUT) $(OUT)/params:
 # Every pipeline fragment; each is self-contained.
 include $(sort $(wildcard pipelines/*.mk))
 
-test: $(BINS)
+# The end-to-end tests and the sweep's run every stage's binary (photon-trace,
+# structured-sample, exact, ... too), which cargo test alone builds only for
+# crates with tests of their own: build them all first.
+.PHONY: all-bins
+all-bins:
+	cargo build --release --workspace --bins
+
+test: all-bins
 	cargo test --release --workspace
 
 # The mutation fuzz targets (tests named fuzz_*: OBJ, MTL, scene.ron, ...)
 # for many more cases than `make test` runs (300 each); FUZZ_SEED picks
 # another master seed, FUZZ_REPLAY=<case> reruns one reported case.
 FUZZ_CASES ?= 20000
-fuzz: $(BINS)
+fuzz: all-bins
 	FUZZ_CASES=$(FUZZ_CASES) cargo test --release --workspace -- fuzz_
 
 # Medians of 5 solves of the Cornell box at about 10k leaf elements, and
