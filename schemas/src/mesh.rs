@@ -45,6 +45,18 @@ impl Schema for Mesh {
 }
 
 impl Mesh {
+    /// Each triangle's twin, if it has one: the first triangle over the
+    /// same vertices wound the other way ([`reversed`]), the other face of
+    /// a two-sided surface (mesh-prep makes them; [`Manifest::check_mesh`]
+    /// checks that every two-sided triangle has one of its material).
+    pub fn twins(&self) -> Vec<Option<u32>> {
+        let mut first = std::collections::HashMap::with_capacity(self.triangles.len());
+        for (i, t) in self.triangles.iter().enumerate() {
+            first.entry(cyclic(t.vertices)).or_insert(i as u32);
+        }
+        self.triangles.iter().map(|t| first.get(&cyclic(reversed(t.vertices))).copied()).collect()
+    }
+
     /// Writes `mesh.exr`: layers `vertex` and `triangle`.
     pub fn write(&self, path: &Path) -> Result<()> {
         let p = &self.positions;
@@ -390,8 +402,10 @@ mod tests {
         // The same winding started at another corner is the same face, not its twin.
         mesh.triangles.push(Triangle { vertices: [1, 2, 0], ..front });
         assert!(manifest.check_mesh(path, &mesh).is_err());
+        assert_eq!(mesh.twins(), [None, None]);
         mesh.triangles[1] = Triangle { vertices: [2, 1, 0], normal: [0.0, 0.0, -1.0], ..front };
         manifest.check_mesh(path, &mesh).unwrap();
+        assert_eq!(mesh.twins(), [Some(1), Some(0)]);
         manifest.materials[0].two_sided = false;
         manifest.check_mesh(path, &mesh).unwrap();
     }

@@ -54,8 +54,7 @@ pub mod ply;
 pub mod xml;
 
 use radiometry::color::max_channel;
-use schemas::mesh::{cyclic, reversed, Manifest, Material, Mesh, MeshStatistics};
-use std::collections::HashSet;
+use schemas::mesh::{Manifest, Material, Mesh, MeshStatistics};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use xml::{attribute, comment};
@@ -274,6 +273,7 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
     for (i, t) in mesh.triangles.iter().enumerate() {
         by_material[t.material as usize].push(i);
     }
+    let twins = mesh.twins();
     let mut meshes = Vec::new();
     let mut shapes = String::new();
     let mut emitters = 0;
@@ -286,16 +286,14 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
         let mut local = vec![u32::MAX; mesh.positions.len()];
         let mut positions: Vec<[f32; 3]> = Vec::new();
         let mut faces: Vec<[u32; 3]> = Vec::with_capacity(triangles.len());
-        let mut faced = HashSet::new();
         for &t in triangles {
-            let vertices = mesh.triangles[t].vertices;
             // A two-sided triangle's twin is the same surface for Mitsuba's
-            // `twosided` BSDF; exported twice, the two would z-fight.
-            if material.two_sided && faced.contains(&cyclic(reversed(vertices))) {
+            // `twosided` BSDF; exported twice, the two would z-fight: the
+            // earlier of the pair is written.
+            if material.two_sided && twins[t].is_some_and(|j| (j as usize) < t && mesh.triangles[j as usize].material == m as u32) {
                 continue;
             }
-            faced.insert(cyclic(vertices));
-            let face = vertices.map(|v| {
+            let face = mesh.triangles[t].vertices.map(|v| {
                 let slot = &mut local[v as usize];
                 if *slot == u32::MAX {
                     *slot = positions.len() as u32;

@@ -45,7 +45,7 @@ use radiometry::geometry::frame_with_normal;
 pub use radiometry::photometry::Luminaire;
 use gpu::{Gpu, GpuGroup, GpuParams, GpuSample, GpuTexel, GpuTri, Setup};
 use schemas::lightmap::Shot;
-use schemas::mesh::{cyclic, reversed, Manifest, Mesh};
+use schemas::mesh::{Manifest, Mesh};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -206,14 +206,6 @@ fn sum3(v: [f64; 3]) -> f64 {
     v[0] + v[1] + v[2]
 }
 
-/// Per triangle, whether it has a twin: a triangle over the same vertices
-/// wound the other way ([`schemas::mesh::reversed`]), the other face of a
-/// two-sided surface (mesh-prep makes them; [`Manifest::check_mesh`]).
-pub fn has_twin(mesh: &Mesh) -> Vec<bool> {
-    let wound: std::collections::HashSet<[u32; 3]> = mesh.triangles.iter().map(|t| cyclic(t.vertices)).collect();
-    mesh.triangles.iter().map(|t| wound.contains(&cyclic(reversed(t.vertices)))).collect()
-}
-
 /// Runs the progressive solver on `device` / `queue`. `on_shot` sees every
 /// shot as it completes (for a progress bar).
 pub fn solve(
@@ -275,7 +267,7 @@ pub fn solve(
     let groups: Vec<GpuGroup> = atlas.groups.iter().map(|g| GpuGroup { first: g.first, count: g.count, _pad: [0; 2] }).collect();
     // w: 2 for the corners of a triangle with a twin, whose back face the
     // visibility maps leave out (visibility.wgsl), else 1.
-    let twinned = has_twin(mesh);
+    let twinned: Vec<bool> = mesh.twins().iter().map(Option::is_some).collect();
     let vertices: Vec<[f32; 4]> = mesh
         .triangles
         .iter()
