@@ -6,7 +6,7 @@ use schemas::image::HdrImage;
 use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
 use schemas::report::Report;
 use schemas::ron_io::{read_ron, write_ron};
-use schemas::solution::{Element, Solution, NONE};
+use schemas::solution::{Element, Solution};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -42,15 +42,7 @@ fn write_scene(dir: &Path, roots: u32) {
         statistics: MeshStatistics::default(),
     };
     write_ron(&dir.join("manifest.ron"), &manifest).unwrap();
-    let root = |t: u32| Element {
-        triangle: t,
-        parent: NONE,
-        first_child: NONE,
-        level: 0,
-        corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-        area: 0.5,
-        radiosity: [1.0 + 2.0 * t as f32; 3],
-    };
+    let root = |t: u32| Element::root(t, 0.5, [1.0 + 2.0 * t as f32; 3]);
     let solution = Solution { header: Solution::header(provenance()), elements: (0..roots).map(root).collect(), clusters: vec![], links: vec![] };
     solution.write(&dir.join("solution.exr")).unwrap();
 }

@@ -9,7 +9,7 @@ use radiometry::geometry::TriangleGeometry;
 use radiometry::sampling::Stream;
 use schemas::header::{Provenance, Schema};
 use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
-use schemas::solution::{Element, Link, Node, Solution, NONE};
+use schemas::solution::{Element, Link, Node, Solution};
 use std::path::Path;
 
 fn material(name: &str, diffuse: f64, emission: f64) -> Material {
@@ -54,15 +54,7 @@ fn room() -> Room {
         effects: Effects::default(),
         statistics: MeshStatistics::default(),
     };
-    let element = |t: u32, b: f32| Element {
-        triangle: t,
-        parent: NONE,
-        first_child: NONE,
-        level: 0,
-        corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-        area: 1.0,
-        radiosity: [b; 3],
-    };
+    let element = |t: u32, b: f32| Element::root(t, 1.0, [b; 3]);
     // F of a 0.4 m square 1.5 m away, roughly A cos^2 / (pi r^2) = 0.023
     // per floor point: the links' values steer sample counts only.
     let link = |r: u32, s: u32| Link {
