@@ -347,13 +347,14 @@ impl Manifest {
 }
 
 /// The same triangle wound the other way: its twin, facing the other side.
-pub fn reversed(v: [u32; 3]) -> [u32; 3] {
+pub fn reversed<T: Copy>(v: [T; 3]) -> [T; 3] {
     [v[0], v[2], v[1]]
 }
 
-/// The vertices rotated to start at the smallest index: equal for the same
-/// triangle whichever corner it starts at, different for its twin.
-pub fn cyclic(v: [u32; 3]) -> [u32; 3] {
+/// The corners (vertex indices, or positions) rotated to start at the
+/// smallest: equal for the same triangle whichever corner it starts at,
+/// different for its twin.
+pub fn cyclic<T: Ord + Copy>(v: [T; 3]) -> [T; 3] {
     let first = (0..3).min_by_key(|&i| v[i]).unwrap_or(0);
     [v[first], v[(first + 1) % 3], v[(first + 2) % 3]]
 }

@@ -22,6 +22,7 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+use schemas::mesh::{cyclic, reversed};
 use std::collections::HashMap;
 use std::time::Duration;
 
@@ -52,18 +53,12 @@ pub struct SceneRays {
 /// the same corners, bit for bit in f32, wound the other way.
 pub fn twins(triangles: &[Triangle]) -> Vec<Option<u32>> {
     let bits = |p: Vec3A| p.to_array().map(f32::to_bits);
-    // A corner cycle, rotated to start at its smallest corner: the same
-    // for one winding whichever corner it starts at.
-    let cycle = |c: [[u32; 3]; 3]| {
-        let first = (0..3).min_by_key(|&i| c[i]).unwrap_or(0);
-        [c[first], c[(first + 1) % 3], c[(first + 2) % 3]]
-    };
     let corners: Vec<[[u32; 3]; 3]> = triangles.iter().map(|t| [bits(t.v0), bits(t.v1), bits(t.v2)]).collect();
     let mut first_of: HashMap<[[u32; 3]; 3], u32> = HashMap::with_capacity(triangles.len());
     for (i, c) in corners.iter().enumerate() {
-        first_of.entry(cycle(*c)).or_insert(i as u32);
+        first_of.entry(cyclic(*c)).or_insert(i as u32);
     }
-    let twin_of = |(i, c): (usize, &[[u32; 3]; 3])| first_of.get(&cycle([c[0], c[2], c[1]])).copied().filter(|&j| j as usize != i);
+    let twin_of = |(i, c): (usize, &[[u32; 3]; 3])| first_of.get(&cyclic(reversed(*c))).copied().filter(|&j| j as usize != i);
     corners.iter().enumerate().map(twin_of).collect()
 }
 
