@@ -22,12 +22,20 @@ pub fn default_material() -> Material {
 ///   is a Phong highlight, which a diffuse radiosity solution ignores.
 /// - `Tf` is a specular transmittance for the refracting models (`illum`
 ///   4, 6, 7, 9); without `Tf` those models transmit `1 - d`.
+/// - Under the diffuse models without ray tracing (`illum` 0, 1, 2, and
+///   `illum` absent), a partly dissolved material is *translucent*: the
+///   light that passes (`1 - d`), filtered by `Tf` (1 when absent), loses
+///   its direction in a surface that does not refract (a lamp shade, paper,
+///   frosted glass), so its diffuse transmittance is `tau_d = (1 - d) Tf`
+///   (paper 004 Sec. 4.3.1). An opaque material (`d 1`, the default, which
+///   exporters write beside `Tf 1 1 1`) transmits nothing.
 /// - `map_Kd`, `map_d` and `norm`/`bump` name the diffuse texture, alpha mask
 ///   and normal map.
 pub fn from_mtl(m: &MtlMaterial) -> Material {
     let illum = m.illumination_model.unwrap_or(2);
     let rgb = |v: Option<[f64; 3]>| v.unwrap_or([0.0; 3]);
-    let transmitted = m.transmission_filter.unwrap_or([1.0 - m.dissolve.unwrap_or(1.0); 3]);
+    let passed = 1.0 - m.dissolve.unwrap_or(1.0);
+    let transmitted = m.transmission_filter.unwrap_or([passed; 3]);
     let name = |t: &Option<crate::mtl::TextureRef>| t.as_ref().map(|t| t.name.clone());
     Material {
         name: m.name.clone(),
@@ -35,7 +43,7 @@ pub fn from_mtl(m: &MtlMaterial) -> Material {
         emission: rgb(m.emissive).map(|l| PI * l),
         specular_reflectance: if (3..=7).contains(&illum) { rgb(m.specular) } else { [0.0; 3] },
         specular_transmittance: if matches!(illum, 4 | 6 | 7 | 9) { transmitted } else { [0.0; 3] },
-        diffuse_transmittance: [0.0; 3],
+        diffuse_transmittance: if illum <= 2 { m.transmission_filter.unwrap_or([1.0; 3]).map(|f| passed * f) } else { [0.0; 3] },
         diffuse_map: name(&m.diffuse_texture),
         alpha_map: name(&m.dissolve_texture),
         normal_map: name(&m.normal_texture),
@@ -70,10 +78,13 @@ pub fn apply(material: &mut Material, o: &MaterialOverride) {
 }
 
 /// Why a material is not physical, if it is not: every coefficient finite
-/// and in [0, 1], the scattered total (diffuse + specular, reflected and
-/// transmitted) at most 1 per channel, emission finite and non-negative.
-/// A diffuse reflectance of exactly 1 is allowed here; the solver's
-/// convergence in closed scenes is its own concern.
+/// and in [0, 1], energy conserved, `rho_d + tau_d + rho_s + tau_s <= 1`
+/// per channel (the scattered total, reflected and transmitted, diffuse and
+/// specular; paper 004 Eq. 4.4 splits a translucent surface's light by
+/// these fractions), emission finite and non-negative. The message names
+/// the material and the fields that add up to more than 1. A diffuse
+/// reflectance of exactly 1 is allowed here; the solver's convergence in
+/// closed scenes is its own concern.
 pub fn check(m: &Material) -> Option<String> {
     let coefficients = [
         ("diffuse", m.diffuse),
@@ -89,7 +100,12 @@ pub fn check(m: &Material) -> Option<String> {
     for channel in 0..3 {
         let total: f64 = coefficients.iter().map(|(_, v)| v[channel]).sum();
         if total > 1.0 + 1e-9 {
-            return Some(format!("material '{}': scatters {total} of the light in channel {channel}, more than it receives", m.name));
+            let fields: Vec<&str> = coefficients.iter().filter(|(_, v)| v[channel] > 0.0).map(|(name, _)| *name).collect();
+            return Some(format!(
+                "material '{}': {} is {total} in channel {channel}, more than 1 (it would scatter more light than it receives)",
+                m.name,
+                fields.join(" + ")
+            ));
         }
     }
     if let Some(x) = m.emission.iter().find(|x| !x.is_finite() || **x < 0.0) {
@@ -117,12 +133,29 @@ mod tests {
     }
 
     #[test]
+    fn a_dissolved_diffuse_material_is_translucent_and_a_refracting_one_specular() {
+        let sheet = |illum: Option<u32>, tf: Option<[f64; 3]>, d: Option<f64>| {
+            from_mtl(&MtlMaterial { name: "shade".into(), diffuse: Some([0.3; 3]), transmission_filter: tf, dissolve: d, illumination_model: illum, ..Default::default() })
+        };
+        let shade = sheet(Some(2), Some([1.0, 0.5, 0.0]), Some(0.4));
+        assert_eq!((shade.diffuse_transmittance, shade.specular_transmittance), ([0.6, 0.3, 0.0], [0.0; 3]));
+        assert_eq!(sheet(None, None, Some(0.75)).diffuse_transmittance, [0.25; 3], "Tf absent filters nothing");
+        assert_eq!(sheet(Some(0), Some([1.0; 3]), None).diffuse_transmittance, [0.0; 3], "opaque (d 1) with an exporter's Tf 1 1 1");
+        let glass = sheet(Some(4), Some([0.5; 3]), Some(0.4));
+        assert_eq!((glass.diffuse_transmittance, glass.specular_transmittance), ([0.0; 3], [0.5; 3]));
+        assert_eq!(sheet(Some(3), Some([0.5; 3]), Some(0.4)).diffuse_transmittance, [0.0; 3], "a mirror model does not transmit");
+    }
+
+    #[test]
     fn implausible_materials_are_refused() {
         let mut m = default_material();
         assert_eq!(check(&m), None);
         m.diffuse = [0.7, 0.7, 0.7];
         m.specular_reflectance = [0.5, 0.0, 0.0];
-        assert!(check(&m).unwrap().contains("channel 0"));
+        assert_eq!(
+            check(&m).unwrap(),
+            "material 'default': diffuse + specular_reflectance is 1.2 in channel 0, more than 1 (it would scatter more light than it receives)"
+        );
         m.specular_reflectance = [0.0; 3];
         m.diffuse[1] = f64::NAN;
         assert!(check(&m).unwrap().contains("outside [0, 1]"));
