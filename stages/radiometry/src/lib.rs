@@ -11,6 +11,8 @@
 //!   its Catmull-Rom lookup and flux, irradiance from a luminaire.
 //! - [`camera`]: pinhole camera rays.
 //! - [`color`]: luminance.
+//! - [`texture`]: texture lookups (bilinear reflectance, alpha coverage)
+//!   and their exact averages over triangles and elements.
 //!
 //! Everything here takes data, not paths, and never prints.
 
@@ -22,3 +24,4 @@ pub mod photometry;
 pub mod rays;
 pub mod sampling;
 pub mod subdivision;
+pub mod texture;
