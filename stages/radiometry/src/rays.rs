@@ -15,6 +15,15 @@
 //! face must not be stopped by the other face at `t = 0`). Triangles
 //! without a twin are hit from both sides, as before: their back faces
 //! occlude.
+//!
+//! # Alpha masks
+//!
+//! Triangles given an alpha mask ([`SceneRays::with_alpha_masks`]) stop a
+//! ray only where the hit lies on an opaque texel
+//! ([`crate::texture::opaque`]); elsewhere the ray passes on (an any-hit
+//! test inside the traversal, paper 004 Sec. 4.3.4: texels with alpha 0
+//! do not exist). The hit's texture coordinates are interpolated from the
+//! triangle's corners with barycentrics computed in f64 from the hit point.
 
 use glam::{DVec3, Vec3A};
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
@@ -23,6 +32,7 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 use schemas::mesh::{cyclic, reversed};
+use schemas::surface::Texture;
 use std::collections::HashMap;
 use std::time::Duration;
 
@@ -47,6 +57,17 @@ pub struct SceneRays {
     culled_normal: Vec<Option<Vec3A>>,
     /// Per mesh triangle: its twin's mesh index, if it has one.
     twin: Vec<Option<u32>>,
+    /// Alpha masks, when some triangle has one.
+    alpha: Option<AlphaMasks>,
+}
+
+/// Which triangles a mask cuts, and the masks.
+pub struct AlphaMasks {
+    /// Per mesh triangle: its corners' texture coordinates and its mask's
+    /// index in `textures`, if it has one.
+    pub masked: Vec<Option<([[f64; 2]; 3], u32)>>,
+    /// The alpha textures.
+    pub textures: Vec<Texture>,
 }
 
 /// Each triangle's twin (see the module documentation): the triangle with
@@ -78,7 +99,32 @@ impl SceneRays {
         let mesh_index = bvh.primitive_indices.clone();
         let culled_normal =
             mesh_index.iter().zip(&ordered).map(|(&i, t)| twin[i as usize].map(|_| (t.v1 - t.v0).cross(t.v2 - t.v0))).collect();
-        SceneRays { bvh, ordered, mesh_index, culled_normal, twin }
+        SceneRays { bvh, ordered, mesh_index, culled_normal, twin, alpha: None }
+    }
+
+    /// The same BVH whose rays pass through the transparent texels of
+    /// `masks` (module docs).
+    pub fn with_alpha_masks(self, masks: AlphaMasks) -> Self {
+        SceneRays { alpha: Some(masks), ..self }
+    }
+
+    /// Whether the hit at `t` on BVH primitive `id` lies where its alpha
+    /// mask, if any, is transparent.
+    fn cut_out(&self, ray: &Ray, id: usize, t: f32) -> bool {
+        let Some(alpha) = &self.alpha else { return false };
+        let Some((uv, texture)) = alpha.masked[self.mesh_index[id] as usize] else { return false };
+        let tri = &self.ordered[id];
+        let d = |v: Vec3A| DVec3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z));
+        let (p0, e1, e2) = (d(tri.v0), d(tri.v1 - tri.v0), d(tri.v2 - tri.v0));
+        let hit = d(ray.origin) + d(ray.direction) * f64::from(t) - p0;
+        let (d11, d12, d22, d1, d2) = (e1.dot(e1), e1.dot(e2), e2.dot(e2), hit.dot(e1), hit.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        if det <= 0.0 {
+            return false;
+        }
+        let (b1, b2) = ((d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det);
+        let at = std::array::from_fn(|k| (1.0 - b1 - b2) * uv[0][k] + b1 * uv[1][k] + b2 * uv[2][k]);
+        !crate::texture::opaque(&alpha.textures[texture as usize], at)
     }
 
     /// The mesh triangle `i`'s twin, if it has one.
@@ -94,9 +140,13 @@ impl SceneRays {
         let skipped = skip.contains(&mesh) || self.twin[mesh as usize].is_some_and(|t| skip.contains(&t));
         let back_of_twin = self.culled_normal[id].is_some_and(|n| ray.direction.dot(n) > 0.0);
         if skipped || back_of_twin {
+            return f32::INFINITY;
+        }
+        let t = self.ordered[id].intersect(ray);
+        if t.is_finite() && self.cut_out(ray, id, t) {
             f32::INFINITY
         } else {
-            self.ordered[id].intersect(ray)
+            t
         }
     }
 
@@ -159,6 +209,33 @@ mod tests {
         assert!(!rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 3.0), [u32::MAX; 2]));
         assert!(rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 0.9), [u32::MAX; 2]));
         assert!(rays.closest_hit(dvec3(5.0, 5.0, 0.0), DVec3::Z, 0.0, f32::INFINITY, [u32::MAX; 2]).is_none());
+    }
+
+    #[test]
+    fn rays_pass_through_the_transparent_texels_of_an_alpha_mask() {
+        // A unit quad at z = 1 whose mask's left half (u < 1/2) is cut out,
+        // above an unmasked one at z = 2.
+        let mut tris = quad(1.0, 0.5).to_vec();
+        tris.extend(quad(2.0, 0.5));
+        let texture = Texture {
+            kind: schemas::surface::TextureKind::Alpha,
+            width: 2,
+            height: 1,
+            texels: vec![[0.0; 4], [1.0; 4]],
+            scale: [1.0, 1.0],
+            offset: [0.0, 0.0],
+            clamp: true,
+            strength: 1.0,
+        };
+        // uv = xy + 1/2 on the quad's corners.
+        let uv = |t: &[DVec3; 3]| t.map(|p| [p.x + 0.5, p.y + 0.5]);
+        let masked = vec![Some((uv(&tris[0]), 0)), Some((uv(&tris[1]), 0)), None, None];
+        let rays = SceneRays::new(&tris).with_alpha_masks(AlphaMasks { masked, textures: vec![texture] });
+        let up = |x: f64| rays.closest_hit(dvec3(x, 0.1, 0.0), DVec3::Z, 0.0, f32::INFINITY, [u32::MAX; 2]).map(|h| h.t);
+        assert_eq!(up(-0.25), Some(2.0), "through the cut-out half to the quad behind");
+        assert_eq!(up(0.25), Some(1.0), "stopped by the opaque half");
+        assert!(rays.segment_clear(dvec3(-0.3, -0.2, 0.0), dvec3(-0.1, 0.3, 1.5), [u32::MAX; 2]));
+        assert!(!rays.segment_clear(dvec3(0.3, -0.2, 0.0), dvec3(0.1, 0.3, 1.5), [u32::MAX; 2]));
     }
 
     #[test]
