@@ -36,6 +36,20 @@ pub struct Texel {
     pub area: f32,
 }
 
+impl Texel {
+    /// Its interior texel indices `(i, j)` in its triangle's `region`.
+    pub fn indices(&self, region: Region) -> (u32, u32) {
+        (self.x - region.x - 1, self.y - region.y - 1)
+    }
+
+    /// Whether it lies on the hypotenuse `i + j + 1 = n`, half its square
+    /// inside the triangle.
+    pub fn on_hypotenuse(&self, region: Region) -> bool {
+        let (i, j) = self.indices(region);
+        i + j + 1 == region.size
+    }
+}
+
 /// One shooting sample: a group of covered texels of one triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Group {
@@ -45,8 +59,11 @@ pub struct Group {
     pub count: u32,
     /// Area-weighted centroid of the group's texel centres, mesh frame, m.
     pub centroid: [f32; 3],
-    /// Total area of the group, m².
+    /// Total area of the group, m² (its opaque part under an alpha mask).
     pub area: f32,
+    /// The opaque fraction of `polygon`: 1, or less where an alpha mask
+    /// removes texels ([`Atlas::cover`]).
+    pub opaque: f32,
     /// The part of the triangle the group covers, mesh frame, m: its block
     /// of texels, `[gi g, (gi + 1) g] x [gj g, (gj + 1) g] / n` in
     /// barycentrics, cut by the region's edge and the hypotenuse `u + v =
@@ -228,7 +245,7 @@ pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_si
                     for (slot, uv) in polygon.iter_mut().zip(&corners) {
                         *slot = geometry.point(*uv).as_vec3().to_array();
                     }
-                    groups.push(Group { first: start, count, centroid, area: (region.texel_area as f64 * area) as f32, polygon, corners: corners.len() as u32 });
+                    groups.push(Group { first: start, count, centroid, area: (region.texel_area as f64 * area) as f32, opaque: 1.0, polygon, corners: corners.len() as u32 });
                 }
             }
         }
@@ -240,6 +257,38 @@ pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_si
         });
     }
     Atlas { width, height, regions, triangles, texels: all_texels, groups, object_sizes: sizes }
+}
+
+impl Atlas {
+    /// Applies an alpha mask (004 Sec. 4.3.4): texel `k` keeps the
+    /// fraction `coverage[k]` of its area (0: it does not exist), and the
+    /// groups of the triangles `masked` picks get their opaque area, its
+    /// centroid (the area-weighted mean of their texels' points; a group
+    /// with nothing opaque keeps its own) and their opaque fraction. The
+    /// areas of a triangle then sum to `A n_o / n_c`, counted over
+    /// sub-samples of the texels ([`crate::detail`]).
+    pub fn cover(&mut self, coverage: &[f64], masked: &dyn Fn(usize) -> bool) {
+        for (t, range) in self.triangles.iter().enumerate() {
+            if !masked(t) {
+                continue;
+            }
+            for g in &mut self.groups[range.group_first as usize..(range.group_first + range.group_count) as usize] {
+                let (mut sum, mut area, mut nominal) = (DVec3::ZERO, 0.0f64, 0.0f64);
+                for k in g.first as usize..(g.first + g.count) as usize {
+                    let texel = &mut self.texels[k];
+                    nominal += texel.area as f64;
+                    texel.area = (texel.area as f64 * coverage[k]) as f32;
+                    sum += DVec3::from(texel.position.map(f64::from)) * texel.area as f64;
+                    area += texel.area as f64;
+                }
+                if area > 0.0 {
+                    g.centroid = (sum / area).as_vec3().to_array();
+                }
+                g.area = area as f32;
+                g.opaque = (area / nominal) as f32;
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -109,8 +109,12 @@ pub struct GpuTexel {
     pub position_area: [f32; 4],
     /// xyz: normal; w: the triangle index's bits.
     pub normal_triangle: [f32; 4],
-    /// rgb: diffuse reflectance of its material; w: 1 for a hypotenuse texel (half a square).
+    /// rgb: diffuse reflectance (its material's, or its texture's over the
+    /// texel); w: 1 for a hypotenuse texel (half a square).
     pub rho: [f32; 4],
+    /// xyz: the normal of the cosines (a normal map's perturbed normal,
+    /// else `normal`'s xyz); w: 0.
+    pub shading: [f32; 4],
 }
 
 /// Host mirror of `Tri` in solver.wgsl.
@@ -125,10 +129,12 @@ pub struct GpuTri {
     pub group_first: u32,
     /// Groups (samples) of the shooter.
     pub group_count: u32,
-    /// Triangle area, m².
+    /// Triangle area, m² (its opaque part under an alpha mask).
     pub area: f32,
+    /// Area of an interior texel, m², masks aside (`Region::texel_area`).
+    pub texel_area: f32,
     /// Padding to the WGSL layout.
-    pub _pad: [f32; 3],
+    pub _pad: [f32; 2],
     /// rgb: diffuse reflectance of its material.
     pub rho: [f32; 4],
     /// xyz: `(P1 - P0) / (2 size)`, half a texel edge, m (the near-field patch).
@@ -163,6 +169,10 @@ pub struct GpuSample {
     pub n: [f32; 4],
     /// rgb: unshot radiosity (area sample) or I_max in W/sr (light); w: 0 area, 1 light.
     pub power: [f32; 4],
+    /// xyz: the group's normal for its cosine (its texels' mean perturbed
+    /// normal under a normal map, else `n`); w: the opaque fraction of
+    /// `polygon` (1 without an alpha mask).
+    pub shading: [f32; 4],
     /// xyz: the corners of the part of the shooter the group covers
     /// ([`crate::atlas::Group::polygon`]), m; w of the first: their number
     /// (0 for a light).
@@ -260,6 +270,9 @@ pub struct Setup<'a> {
     pub sample_capacity: u32,
     /// Largest light distribution table, floats.
     pub ldt_capacity: usize,
+    /// The alpha masks for the visibility maps' test
+    /// ([`crate::detail::Detail::mask_tables`]), where some triangle has one.
+    pub masks: Option<(&'a [[f32; 4]], &'a [f32])>,
 }
 
 const SAMPLE_SIZE: u64 = std::mem::size_of::<GpuSample>() as u64;
@@ -374,19 +387,25 @@ impl Gpu {
         };
 
         let v = wgpu::ShaderStages::VERTEX;
-        let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("visibility"),
-            entries: &[uniform(0, v), storage(1, v, true), storage(2, v, true)],
+        let mut render_entries = vec![uniform(0, v), storage(1, v, true), storage(2, v, true)];
+        let mut render_bind = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: samples.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: vertices.as_entire_binding() },
+        ];
+        // Alpha masks: two more tables for the fragment stage's test, and
+        // its discarding entry point; a scene without masks allocates neither.
+        let mask_buffers = setup.masks.map(|(triangles, texels)| {
+            [init("mask_uvs", bytemuck::cast_slice(triangles), wgpu::BufferUsages::STORAGE), init("masks", bytemuck::cast_slice(texels), wgpu::BufferUsages::STORAGE)]
         });
-        let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("visibility"),
-            layout: &render_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: samples.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: vertices.as_entire_binding() },
-            ],
-        });
+        if let Some(buffers) = &mask_buffers {
+            for (k, buffer) in buffers.iter().enumerate() {
+                render_entries.push(storage(3 + k as u32, wgpu::ShaderStages::FRAGMENT, true));
+                render_bind.push(wgpu::BindGroupEntry { binding: 3 + k as u32, resource: buffer.as_entire_binding() });
+            }
+        }
+        let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("visibility"), entries: &render_entries });
+        let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("visibility"), layout: &render_layout, entries: &render_bind });
         let render_pipeline_layout =
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("visibility"), bind_group_layouts: &[Some(&render_layout)], immediate_size: 0 });
         let render = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -404,7 +423,7 @@ impl Gpu {
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &render_module,
-                entry_point: Some("fs"),
+                entry_point: Some(if mask_buffers.is_some() { "fs_masked" } else { "fs" }),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState { format: wgpu::TextureFormat::R32Float, blend: None, write_mask: wgpu::ColorWrites::ALL })],
             }),

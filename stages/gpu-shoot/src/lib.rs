@@ -34,18 +34,21 @@
 //! | `texels_per_leaf` | solution leaves: about this many texels each | 4 |
 
 pub mod atlas;
+pub mod detail;
 pub mod gpu;
 pub mod output;
 pub mod reference;
 pub mod testing;
 
 use atlas::Atlas;
+use detail::{Detail, TexelDetail};
 use glam::DVec3;
 use radiometry::geometry::frame_with_normal;
 pub use radiometry::photometry::Luminaire;
 use gpu::{Gpu, GpuGroup, GpuParams, GpuSample, GpuTexel, GpuTri, Setup};
 use schemas::lightmap::Shot;
 use schemas::mesh::{Manifest, Mesh};
+use schemas::surface::Surface;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -176,6 +179,9 @@ pub struct Work {
     pub setup_seconds: f64,
     /// Seconds spent shooting.
     pub shoot_seconds: f64,
+    /// Texels of the texture atlas uploaded for the visibility maps'
+    /// alpha test (0: no alpha mask, nothing allocated).
+    pub mask_texels: u64,
 }
 
 /// The result of a solve.
@@ -202,17 +208,30 @@ pub struct Solved {
     pub triangle_power: Vec<[f32; 4]>,
 }
 
+/// The area-weighted mean reflectance of `texels` (0 where none is
+/// opaque): a textured triangle's for the ambient term and overshooting.
+fn mean_rho(texels: &[GpuTexel]) -> [f32; 4] {
+    let area: f64 = texels.iter().map(|x| x.position_area[3] as f64).sum();
+    let mean = |c: usize| if area > 0.0 { texels.iter().map(|x| x.rho[c] as f64 * x.position_area[3] as f64).sum::<f64>() / area } else { 0.0 };
+    [mean(0) as f32, mean(1) as f32, mean(2) as f32, 0.0]
+}
+
 fn sum3(v: [f64; 3]) -> f64 {
     v[0] + v[1] + v[2]
 }
 
-/// Runs the progressive solver on `device` / `queue`. `on_shot` sees every
-/// shot as it completes (for a progress bar).
+/// Runs the progressive solver on `device` / `queue`. `surface` (from
+/// `mesh-prep --surface`) gives textures, alpha masks and normal maps
+/// ([`detail`]); without it, or where no material has a texture, every
+/// texel takes its material's reflectance and its triangle's normal.
+/// `on_shot` sees every shot as it completes (for a progress bar).
+#[allow(clippy::too_many_arguments)]
 pub fn solve(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     mesh: &Mesh,
     manifest: &Manifest,
+    surface: Option<&Surface>,
     lights: &[Luminaire],
     params: &Params,
     on_shot: &mut dyn FnMut(&Shot),
@@ -221,24 +240,46 @@ pub fn solve(
     if mesh.triangles.is_empty() {
         return Err("the mesh has no triangles".into());
     }
-    let atlas = atlas::bake(mesh, manifest, params.texels, params.min_size, params.max_size, params.shoot_level);
+    let mut atlas = atlas::bake(mesh, manifest, params.texels, params.min_size, params.max_size, params.shoot_level);
+    let detail = surface.and_then(|s| Detail::new(mesh, s));
+    // Per covered texel, what its textures make of it (None: its material has none).
+    let details: Vec<Option<TexelDetail>> = match &detail {
+        Some(d) => atlas
+            .texels
+            .iter()
+            .map(|x| {
+                let t = x.triangle as usize;
+                let (i, j) = x.indices(atlas.regions[t]);
+                d.texel(mesh, manifest, t, atlas.regions[t], i, j)
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let detail_of = |k: usize| details.get(k).copied().flatten();
+    if let Some(d) = detail.as_ref().filter(|d| d.masked(mesh)) {
+        let coverage: Vec<f64> = (0..atlas.texels.len()).map(|k| detail_of(k).map_or(1.0, |x| x.coverage)).collect();
+        atlas.cover(&coverage, &|t| d.mask(mesh, t).is_some());
+    }
     let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
     let f4 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
     let texels: Vec<GpuTexel> = atlas
         .texels
         .iter()
-        .map(|x| {
+        .enumerate()
+        .map(|(k, x)| {
             let tri = &mesh.triangles[x.triangle as usize];
+            let here = detail_of(k);
+            let normal = here.map_or(tri.normal, |d| d.normal.as_vec3().to_array());
             GpuTexel {
                 position_area: [x.position[0], x.position[1], x.position[2], x.area],
                 normal_triangle: [tri.normal[0], tri.normal[1], tri.normal[2], f32::from_bits(x.triangle)],
                 rho: {
-                    let region = atlas.regions[x.triangle as usize];
-                    let mut rho = f4(material(x.triangle as usize).diffuse);
+                    let mut rho = f4(here.map_or(material(x.triangle as usize).diffuse, |d| d.rho));
                     // w: 1 on the hypotenuse (half a texel), read by the near-field form factor.
-                    rho[3] = if x.area < 0.75 * region.texel_area { 1.0 } else { 0.0 };
+                    rho[3] = if x.on_hypotenuse(atlas.regions[x.triangle as usize]) { 1.0 } else { 0.0 };
                     rho
                 },
+                shading: [normal[0], normal[1], normal[2], 0.0],
             }
         })
         .collect();
@@ -258,8 +299,9 @@ pub fn solve(
             group_first: r.group_first,
             group_count: r.group_count,
             area: atlas.texels[r.first as usize..(r.first + r.count) as usize].iter().map(|x| x.area).sum(),
-            _pad: [0.0; 3],
-            rho: f4(material(t).diffuse),
+            texel_area: atlas.regions[t].texel_area,
+            _pad: [0.0; 2],
+            rho: if details.is_empty() { f4(material(t).diffuse) } else { mean_rho(&texels[r.first as usize..(r.first + r.count) as usize]) },
             half_u: half_edges(t)[0],
             half_v: half_edges(t)[1],
         })
@@ -300,6 +342,9 @@ pub fn solve(
     let layers = if hemicube { batch * 6 } else { (layer_budget / 6 * 6).max(6) };
     let batch_area = if hemicube { batch } else { layers };
     let ldt_capacity = lights.iter().map(|l| light_table(l).len()).max().unwrap_or(4);
+    // The alpha masks for the visibility maps (004 Sec. 4.3.4), only where
+    // some triangle is masked.
+    let masks = detail.as_ref().filter(|d| d.masked(mesh)).map(|d| d.mask_tables(mesh));
     let gpu = Gpu::new(
         device,
         &Setup {
@@ -312,6 +357,7 @@ pub fn solve(
             layers,
             sample_capacity: max_groups.max(1),
             ldt_capacity,
+            masks: masks.as_ref().map(|(t, m)| (t.as_slice(), m.as_slice())),
         },
     );
     let total_area: f64 = tris.iter().map(|t| t.area as f64).sum();
@@ -347,7 +393,8 @@ pub fn solve(
         interreflection,
         ..Default::default()
     };
-    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), ..Default::default() };
+    let mask_texels = masks.as_ref().map_or(0, |(_, m)| m.len() as u64);
+    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), mask_texels, ..Default::default() };
     let shooting = Instant::now();
     let mut shots = Vec::new();
     let mut unshot_lights: f64 = light_flux.iter().map(|f| 3.0 * f).sum();
@@ -376,6 +423,7 @@ pub fn solve(
             b: f4(u0.to_array()),
             n: f4(n0.to_array()),
             power: [i, i, i, 1.0],
+            shading: [0.0; 4],
             polygon: [[0.0; 4]; 5],
         };
         gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
@@ -398,9 +446,18 @@ pub fn solve(
         let range = atlas.triangles[shooter as usize];
         let normal = DVec3::from(mesh.triangles[shooter as usize].normal.map(f64::from));
         let [t, b, n] = frame_with_normal(normal);
+        let perturbed = detail.as_ref().is_some_and(|d| d.normal_mapped(mesh, shooter as usize));
         let samples: Vec<GpuSample> = atlas.groups[range.group_first as usize..(range.group_first + range.group_count) as usize]
             .iter()
             .map(|g| {
+                // The group's cosine: its texels' area-weighted mean perturbed normal.
+                let shading = if perturbed {
+                    let group = &texels[g.first as usize..(g.first + g.count) as usize];
+                    let sum = group.iter().fold(DVec3::ZERO, |acc, x| acc + DVec3::from([0, 1, 2].map(|c| x.shading[c] as f64)) * x.position_area[3] as f64);
+                    sum.try_normalize().unwrap_or(n)
+                } else {
+                    n
+                };
                 let c = DVec3::from(g.centroid.map(f64::from)) + n * offset;
                 let mut polygon = g.polygon.map(|p| [p[0], p[1], p[2], 0.0]);
                 polygon[0][3] = g.corners as f32;
@@ -410,6 +467,7 @@ pub fn solve(
                     b: f4(b.to_array()),
                     n: f4(n.to_array()),
                     power: [0.0; 4],
+                    shading: [shading.x as f32, shading.y as f32, shading.z as f32, g.opaque],
                     polygon,
                 }
             })

@@ -8,6 +8,7 @@ use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
 use schemas::ron_io::write_ron;
 use schemas::solution::Solution;
+use schemas::surface::Surface;
 use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -28,6 +29,10 @@ struct Args {
     /// Input: manifest.ron from mesh-prep.
     #[arg(long, required_unless_present = "print_params")]
     manifest: Option<PathBuf>,
+    /// Input: surface.exr from mesh-prep --surface (textures, alpha masks,
+    /// normal maps); without it those effects are skipped.
+    #[arg(long)]
+    surface: Option<PathBuf>,
     /// Output: the solution (elements averaging the atlas; no links).
     #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
     output: Option<PathBuf>,
@@ -116,14 +121,18 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     }
 }
 
-fn skipped(effects: &Effects) -> Vec<String> {
+/// The effects of the scene gpu-shoot does not simulate; textures, alpha
+/// masks and normal maps are simulated when `surface` (the artifact that
+/// holds them) was given.
+fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
+    let without = !surface;
     Effects::skipped(&[
         (effects.diffuse_transmission, "diffuse transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.1, a later issue)"),
         (effects.specular_reflection, "specular reflection: not simulated by gpu-shoot yet (004 Sec. 4.3.2); mirrors keep their diffuse part"),
         (effects.specular_transmission, "specular transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.3)"),
-        (effects.alpha_masks, "alpha masks: surfaces are treated as opaque (004 Sec. 4.3.4, a later issue)"),
-        (effects.normal_maps, "normal maps: texels use the geometric normal (004 Sec. 2.3.3, a later issue)"),
-        (effects.textures, "textures: radiosity uses each material's mean diffuse reflectance"),
+        (effects.alpha_masks && without, "alpha masks: surfaces are treated as opaque (no --surface given)"),
+        (effects.normal_maps && without, "normal maps: texels use the geometric normal (no --surface given)"),
+        (effects.textures && without, "textures: radiosity uses each material's diffuse reflectance (no --surface given)"),
         (effects.fine_clustered_geometry, "adaptive subdivision: not done; region sizes are fixed per object"),
     ])
 }
@@ -163,17 +172,28 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         unreachable!("clap requires the inputs and output without --print-params")
     };
     check_outputs(
-        &[args.mesh.as_deref(), args.manifest.as_deref()],
+        &[args.mesh.as_deref(), args.manifest.as_deref(), args.surface.as_deref()],
         &[Some(output), args.lightmap.as_deref(), args.convergence_log.as_deref(), args.plot.as_deref(), args.stage.report.as_deref()],
     )?;
     let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
+    let surface = match &args.surface {
+        Some(path) => {
+            let (surface, input) = Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
+            if surface.header.provenance != mesh.header.provenance {
+                return Err(schemas::Error::invalid(path, None, "not written by the mesh-prep run that wrote the mesh"));
+            }
+            run.input(input)?;
+            Some(surface)
+        }
+        None => None,
+    };
     let lights = Luminaire::all(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
     let (device, queue, info) = gpu::acquire().map_err(|m| schemas::Error::invalid(Path::new("gpu"), None, m))?;
     let adapter = gpu::describe(&info);
     let bar = progress(1000, "converged");
     let mut fired = 0usize;
-    let solved = solve(&device, &queue, &mesh, &manifest, &lights, &params, &mut |shot| {
+    let solved = solve(&device, &queue, &mesh, &manifest, surface.as_ref(), &lights, &params, &mut |shot| {
         fired += 1;
         bar.set_position(((1.0 - shot.unshot_fraction).clamp(0.0, 1.0) * 1000.0) as u64);
         bar.set_message(format!("{fired} shots"));
@@ -219,13 +239,14 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("visibility_layers".to_string(), w.layers as f64),
             ("receiver_evaluations".to_string(), w.receiver_evaluations as f64),
             ("texels".to_string(), solved.atlas.texels.len() as f64),
+            ("mask_texels".to_string(), w.mask_texels as f64),
             ("unshot_fraction".to_string(), final_unshot),
             ("setup_seconds".to_string(), w.setup_seconds),
             ("shoot_seconds".to_string(), w.shoot_seconds),
             ("seconds_per_shot".to_string(), w.shoot_seconds / (w.shots.max(1) as f64)),
         ]);
         let notes = vec![format!("adapter: {adapter}")];
-        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects), notes))?;
+        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects, surface.is_some()), notes))?;
     }
     outputs.keep()?;
     Ok(ExitCode::SUCCESS)

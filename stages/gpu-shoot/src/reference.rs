@@ -178,6 +178,5 @@ pub fn patch_of(atlas: &Atlas, mesh: &schemas::mesh::Mesh, k: usize) -> (usize, 
     let p = mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)));
     let region = atlas.regions[t];
     let n = 2.0 * region.size as f64;
-    let hypotenuse = texel.area < 0.75 * region.texel_area;
-    texel_patch(DVec3::from(texel.position.map(f64::from)), (p[1] - p[0]) / n, (p[2] - p[0]) / n, hypotenuse)
+    texel_patch(DVec3::from(texel.position.map(f64::from)), (p[1] - p[0]) / n, (p[2] - p[0]) / n, texel.on_hypotenuse(region))
 }

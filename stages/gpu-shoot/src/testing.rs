@@ -24,6 +24,21 @@ pub fn manifest(objects: usize, materials: Vec<Material>) -> Manifest {
     }
 }
 
+/// Builds a mesh from triangles `(corners, material, object)` (front face
+/// by the right-hand rule).
+pub fn triangles(list: &[([DVec3; 3], u32, u32)]) -> Mesh {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for &(corners, material, object) in list {
+        let base = positions.len() as u32;
+        positions.extend(corners.map(|p| p.as_vec3().to_array()));
+        let cross = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+        let (normal, area) = (cross.normalize().as_vec3().to_array(), (cross.length() / 2.0) as f32);
+        triangles.push(Triangle { vertices: [base, base + 1, base + 2], material, object, area, normal });
+    }
+    Mesh { header: Mesh::header(Provenance::in_memory("gpu-shoot test")), positions, triangles }
+}
+
 /// Builds a mesh from quads `(corner, edge_u, edge_v, material, object)`,
 /// each split into two triangles `[c, c+u, c+u+v]`, `[c, c+u+v, c+v]`
 /// (front face: `u x v`).

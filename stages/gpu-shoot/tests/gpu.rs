@@ -22,7 +22,7 @@ fn device() -> Option<(wgpu::Device, wgpu::Queue)> {
 
 fn run(mesh: &Mesh, manifest: &Manifest, lights: &[Luminaire], params: &Params) -> Option<Solved> {
     let (device, queue) = device()?;
-    Some(solve(&device, &queue, mesh, manifest, lights, params, &mut |_| {}).unwrap())
+    Some(solve(&device, &queue, mesh, manifest, None, lights, params, &mut |_| {}).unwrap())
 }
 
 /// A light of table `d` (cd, scale 1) at `position`, nadir down, C0 along x.
@@ -232,7 +232,7 @@ fn every_shot_in_a_closed_box_delivers_its_power() {
         // Receivers reflect everything (rho 1), so radiosity x area is received power.
         let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
         let params = Params { texels: 1500.0, shoot_level: 0, max_shots: 1, convergence_target: 1.0, overshoot: false, visibility, ..Params::default() };
-        let solved = solve(&device, &queue, &mesh, &m, &[], &params, &mut |_| {}).unwrap();
+        let solved = solve(&device, &queue, &mesh, &m, None, &[], &params, &mut |_| {}).unwrap();
         assert_eq!(solved.shots[0].shooter, format!("triangle {shooter}"));
         let received: f64 = solved
             .atlas

@@ -53,7 +53,7 @@ fn run(args: Args) -> Result<ExitCode, String> {
     for visibility in [Visibility::Hemicube, Visibility::Stereographic] {
         for overshoot in [false, true] {
             let params = Params { texels: args.texels, visibility, overshoot, convergence_target: args.convergence, ..Params::default() };
-            let solved = solve(&device, &queue, &mesh, &manifest, &[], &params, &mut |_| {})?;
+            let solved = solve(&device, &queue, &mesh, &manifest, None, &[], &params, &mut |_| {})?;
             let row = Row {
                 visibility: format!("{visibility:?}").to_lowercase(),
                 overshoot,

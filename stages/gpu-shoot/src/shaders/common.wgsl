@@ -29,6 +29,7 @@ struct Sample {
     b: vec4<f32>,        // frame: bitangent (light: u0 = n0 x r0)
     n: vec4<f32>,        // frame: normal (light: n0, the nadir)
     power: vec4<f32>,    // rgb: unshot radiosity dB of the group, W/m^2 (light: I_max, W/sr); w: kind
+    shading: vec4<f32>,  // xyz: the group's normal for its cosine (normal map; else n); w: opaque fraction of its polygon
     polygon: array<vec4<f32>, 5>, // xyz: corners of the group's part of the shooter, m; [0].w: their number
 };
 

@@ -6,7 +6,8 @@
 struct Texel {
     position: vec4<f32>, // xyz: centre, m; w: area it stands for, m^2
     normal: vec4<f32>,   // xyz: unit normal; w: triangle index (bitcast)
-    rho: vec4<f32>,      // rgb: diffuse reflectance of its material; w: 1 on the hypotenuse
+    rho: vec4<f32>,      // rgb: diffuse reflectance (material or texture); w: 1 on the hypotenuse
+    shading: vec4<f32>,  // xyz: normal of the cosines (perturbed by a normal map)
 };
 
 struct Tri {
@@ -14,8 +15,8 @@ struct Tri {
     count: u32,
     group_first: u32,
     group_count: u32,
-    area: f32,
-    _p0: f32,
+    area: f32,           // opaque area, m^2
+    texel_area: f32,     // area of an interior texel, masks aside, m^2
     _p1: f32,
     _p2: f32,
     rho: vec4<f32>,
@@ -180,7 +181,10 @@ fn prepare_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         sum += residual[g.first + k].xyz * a;
         area += a;
     }
-    samples[id.x].power = vec4<f32>(sum / area + selection.overshoot.xyz, 0.0);
+    // A group an alpha mask removes whole has no area and shoots nothing.
+    var mean = vec3<f32>(0.0);
+    if (area > 0.0) { mean = sum / area; }
+    samples[id.x].power = vec4<f32>(mean + selection.overshoot.xyz, 0.0);
 }
 
 // After the shot the shooter keeps -dB' (0 without overshooting).
@@ -378,10 +382,18 @@ fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 5>, count: u32) -
 // taken by reciprocity (area_transfer); mirrors reference::RECIPROCAL.
 const RECIPROCAL: f32 = 16.0;
 
+// The area of texel k's square (half on the hypotenuse), an alpha mask
+// aside: the patch the near field integrates over.
+fn patch_area(k: u32) -> f32 {
+    let a = tris[bitcast<u32>(texels[k].normal.w)].texel_area;
+    if (texels[k].rho.w != 0.0) { return 0.5 * a; }
+    return a;
+}
+
 // Whether texel k takes area sample s, at squared distance d2, by
 // reciprocity.
 fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
-    let a_r = texels[k].position.w;
+    let a_r = patch_area(k);
     let a_s = s.position.w;
     return d2 < NEAR_FIELD * (a_r + a_s) && a_s > RECIPROCAL * a_r;
 }
@@ -398,9 +410,12 @@ fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
 // (issue 10, item 7), and a texel patch much smaller than its distance
 // (a sliver's) lost its solid angle to f32 cancellation. At equal sizes
 // the sample's point conserves power exactly, hence the threshold
-// RECIPROCAL (see reference.rs).
-fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, s: Sample, d2: f32, cos_s: f32, cos_r: f32) -> f32 {
-    let a_r = texels[k].position.w;
+// RECIPROCAL (see reference.rs). With surface detail (004 Sec. 2.3.3,
+// 4.3.4) the receiver's cosines are its perturbed normal ns's (the patch
+// factor, whose plane is the triangle's nr, scaled by cos_r over the
+// plane's cosine), and a sample's polygon emits its opaque fraction.
+fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, ns: vec3<f32>, s: Sample, d2: f32, cos_s: f32, cos_r: f32) -> f32 {
+    let a_r = patch_area(k);
     let a_s = s.position.w;
     if (d2 >= NEAR_FIELD * (a_r + a_s)) {
         // 004 Eq. 2.2 / 4.1 with one disc per sample.
@@ -410,7 +425,7 @@ fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, s: Sample, d2: f32, cos_s:
     if (reciprocal(k, s, d2)) {
         let m = u32(s.polygon[0].w);
         for (var c = 0u; c < m; c += 1u) { corners[c] = s.polygon[c].xyz - p; }
-        return polygon_form_factor(nr, corners, m);
+        return s.shading.w * polygon_form_factor(ns, corners, m);
     }
     let tri = tris[bitcast<u32>(texels[k].normal.w)];
     let a = tri.half_u.xyz;
@@ -432,7 +447,10 @@ fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, s: Sample, d2: f32, cos_s:
     }
     // H_r = B_s A_s F_(s -> patch) / A_r: the power the patch receives
     // spread over its area, so the shares of a closed room sum to 1.
-    return a_s * polygon_form_factor(s.n.xyz, corners, count) / a_r;
+    var h = a_s * polygon_form_factor(s.shading.xyz, corners, count) / a_r;
+    let cos_plane = -dot(nr, c) / sqrt(d2);
+    if (any(ns != nr) && cos_plane > 0.0) { h *= cos_r / cos_plane; }
+    return h;
 }
 
 // The receiver pass (004 Sec. 2.3, Eq. 2.2 / 4.1-4.3): every covered texel
@@ -446,9 +464,12 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
     if (k >= params.n_texels) { return; }
     let texel = texels[k];
     let tri = bitcast<u32>(texel.normal.w);
-    if (tri == params.shooter) { return; }
+    // A texel an alpha mask removes does not exist (004 Sec. 4.3.4).
+    if (tri == params.shooter || texel.position.w <= 0.0) { return; }
     let p = texel.position.xyz;
     let nr = texel.normal.xyz;
+    let ns = texel.shading.xyz;
+    let perturbed = any(ns != nr);
     var h = vec3<f32>(0.0);
     for (var i = 0u; i < params.sample_count; i += 1u) {
         let s = samples[params.sample_first + i];
@@ -456,7 +477,10 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
         let d2 = dot(v, v);
         let d = sqrt(d2);
         if (d <= 0.0) { continue; }
-        let cos_r = -dot(nr, v) / d;
+        let cos_plane = -dot(nr, v) / d;
+        // The receiver's cosine: its perturbed normal's (004 Sec. 2.3.3).
+        var cos_r = cos_plane;
+        if (perturbed) { cos_r = max(-dot(ns, v) / d, 0.0); }
         let light = s.power.w != 0.0;
         // A sample that the receiver's plane cuts, near enough to be
         // integrated exactly from the receiver (area_transfer), gives the
@@ -465,7 +489,7 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
         // it is taken as seen (the part of a wall that a sliver touching it
         // faces got nothing).
         var straddles = false;
-        if (cos_r <= 0.0) {
+        if (cos_plane <= 0.0) {
             if (light || !reciprocal(k, s, d2)) { continue; }
             for (var c = 0u; c < u32(s.polygon[0].w); c += 1u) {
                 if (dot(nr, s.polygon[c].xyz - p) > 0.0) { straddles = true; }
@@ -481,6 +505,8 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
         var cos_s = local.z / d;
         if (!light) {
             if (dot(p - s.polygon[0].xyz, s.n.xyz) <= 0.0) { continue; }
+            // The shooter's cosine: its group's perturbed normal's.
+            if (any(s.shading.xyz != s.n.xyz)) { cos_s = dot(v, s.shading.xyz) / d; }
             cos_s = max(cos_s, 0.0);
         }
         let base = i * params.layers_per_sample;
@@ -499,7 +525,7 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
             let c = degrees(atan2(local.y, local.x));
             h += s.power.xyz * ldt_lookup(c, gamma) * cos_r / d2;
         } else {
-            h += s.power.xyz * area_transfer(k, p, nr, s, d2, cos_s, cos_r);
+            h += s.power.xyz * area_transfer(k, p, nr, ns, s, d2, cos_s, cos_r);
         }
     }
     let db = texel.rho.xyz * h;

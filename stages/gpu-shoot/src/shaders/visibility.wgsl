@@ -7,9 +7,18 @@
 @group(0) @binding(1) var<storage, read> samples: array<Sample>;
 @group(0) @binding(2) var<storage, read> vertices: array<vec4<f32>>;
 
+// Alpha masks (fs_masked only): per triangle (u0, v0, u1, v1), (u2, v2,
+// record, 0), record the bits of the offset of its mask's record in
+// `masks` or 0xffffffff; a record is [width, height, clamp, S.U, S.V, O.U,
+// O.V] then the alpha values, row 0 at the top (detail::mask_tables).
+@group(0) @binding(3) var<storage, read> mask_uvs: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> masks: array<f32>;
+
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) local: vec3<f32>,
+    @location(1) bary: vec2<f32>,
+    @location(2) @interpolate(flat) triangle: u32,
 };
 
 @vertex
@@ -20,6 +29,9 @@ fn vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) layer: u32) -> Ve
     let local = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
     var out: VertexOut;
     out.local = local;
+    let corner = vi % 3u;
+    out.bary = vec2<f32>(f32(corner == 1u), f32(corner == 2u));
+    out.triangle = vi / 3u;
     if (params.mode == 1u && s.power.w == 0.0) {
         let d = length(local);
         out.clip = vec4<f32>(stereographic(local / max(d, 1e-20)), d / params.far, 1.0);
@@ -49,7 +61,37 @@ fn vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) layer: u32) -> Ve
     return out;
 }
 
+fn distance_of(in: VertexOut) -> vec4<f32> {
+    return vec4<f32>(length(in.local), 0.0, 0.0, 0.0);
+}
+
 @fragment
 fn fs(in: VertexOut) -> @location(0) vec4<f32> {
-    return vec4<f32>(length(in.local), 0.0, 0.0, 0.0);
+    return distance_of(in);
+}
+
+// Whether the point at barycentrics `bary` of triangle t is opaque: its
+// mask's nearest texel (MTL -s, -o, -clamp) is above 0; mirrors
+// detail::lookup.
+fn opaque(t: u32, bary: vec2<f32>) -> bool {
+    let a = mask_uvs[2u * t];
+    let b = mask_uvs[2u * t + 1u];
+    let at = bitcast<u32>(b.z);
+    if (at == 0xffffffffu) { return true; }
+    let uv = a.xy + bary.x * (a.zw - a.xy) + bary.y * (b.xy - a.xy);
+    let size = vec2<f32>(masks[at], masks[at + 1u]);
+    var st = vec2<f32>(masks[at + 3u], masks[at + 4u]) * uv + vec2<f32>(masks[at + 5u], masks[at + 6u]);
+    if (masks[at + 2u] != 0.0) { st = clamp(st, vec2<f32>(0.0), vec2<f32>(1.0)); } else { st = st - floor(st); }
+    let x = min(u32(floor(st.x * size.x)), u32(size.x) - 1u);
+    let y = min(u32(floor((1.0 - st.y) * size.y)), u32(size.y) - 1u);
+    return masks[at + 7u + y * u32(size.x) + x] > 0.0;
+}
+
+// The visibility maps of a scene with alpha masks: texels with alpha 0 do
+// not exist, so their fragments are discarded and light passes (004 Sec.
+// 4.3.4).
+@fragment
+fn fs_masked(in: VertexOut) -> @location(0) vec4<f32> {
+    if (!opaque(in.triangle, in.bary)) { discard; }
+    return distance_of(in);
 }
