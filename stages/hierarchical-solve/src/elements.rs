@@ -3,12 +3,14 @@
 //! created in a deterministic order, four at a time, so element indices do
 //! not depend on threads.
 
+use crate::detail::Detail;
 use crate::nodes::ClusterTree;
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::NONE;
+use schemas::surface::Surface;
 
 /// One element.
 #[derive(Clone, Debug)]
@@ -42,7 +44,8 @@ pub struct Hierarchy {
     pub elements: Vec<Element>,
     /// Geometry of each input triangle.
     pub triangles: Vec<TriangleGeometry>,
-    /// Diffuse reflectance of each input triangle.
+    /// Diffuse reflectance of each input triangle (texture-averaged over
+    /// the triangle where a texture applies, [`crate::detail`]).
     pub reflectance: Vec<[f64; 3]>,
     /// Emitted radiosity of each input triangle, W/m².
     pub emission: Vec<[f64; 3]>,
@@ -52,11 +55,15 @@ pub struct Hierarchy {
     /// W/m² (the same in R, G, B; [`crate::luminaires`]); elements past its
     /// end have not been lit yet.
     pub direct: Vec<f64>,
+    /// Textures and alpha masks with each element's averages, where the
+    /// scene has them.
+    pub detail: Option<Detail>,
 }
 
 impl Hierarchy {
-    /// One root element per input triangle, under `clusters` if given.
-    pub fn new(mesh: &Mesh, manifest: &Manifest, clusters: Option<schemas::cluster::Clusters>) -> Self {
+    /// One root element per input triangle, under `clusters` if given,
+    /// with the textures and masks of `surface` if given.
+    pub fn new(mesh: &Mesh, manifest: &Manifest, clusters: Option<schemas::cluster::Clusters>, surface: Option<Surface>) -> Self {
         let triangles = radiometry::geometry::mesh_triangles(mesh);
         let elements = triangles
             .iter()
@@ -72,10 +79,27 @@ impl Hierarchy {
             })
             .collect();
         let material = |t: &schemas::mesh::Triangle| &manifest.materials[t.material as usize];
-        let reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| material(t).diffuse).collect();
-        let areas: Vec<f64> = triangles.iter().map(|t| t.area).collect();
+        let mut reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| material(t).diffuse).collect();
+        let mut areas: Vec<f64> = triangles.iter().map(|t| t.area).collect();
+        let mut detail = surface.and_then(|s| Detail::new(s, mesh));
+        if let Some(detail) = &mut detail {
+            for t in 0..triangles.len() as u32 {
+                detail.push(t, &ROOT);
+                let average = detail.average(t);
+                areas[t as usize] *= average.coverage;
+                if let Some(rho) = average.reflectance {
+                    reflectance[t as usize] = rho;
+                }
+            }
+        }
         let clusters = clusters.map(|c| ClusterTree::new(c, &areas, &reflectance));
-        Hierarchy { elements, reflectance, emission: mesh.triangles.iter().map(|t| material(t).emission).collect(), triangles, clusters, direct: Vec::new() }
+        let emission = mesh.triangles.iter().map(|t| material(t).emission).collect();
+        Hierarchy { elements, reflectance, emission, triangles, clusters, direct: Vec::new(), detail }
+    }
+
+    /// Opaque fraction of element `e` (1 without an alpha mask).
+    pub fn coverage(&self, e: u32) -> f64 {
+        self.detail.as_ref().map_or(1.0, |d| d.average(e).coverage)
     }
 
     /// Unit front normal of element `e` (its triangle's).
@@ -83,9 +107,11 @@ impl Hierarchy {
         self.triangles[self.elements[e as usize].triangle as usize].normal
     }
 
-    /// Diffuse reflectance of element `e`.
+    /// Diffuse reflectance of element `e` (its texture average where a
+    /// texture applies).
     pub fn reflectance_of(&self, e: u32) -> [f64; 3] {
-        self.reflectance[self.elements[e as usize].triangle as usize]
+        let own = self.detail.as_ref().and_then(|d| d.average(e).reflectance);
+        own.unwrap_or(self.reflectance[self.elements[e as usize].triangle as usize])
     }
 
     /// The source term of element `e`, W/m²: its emission plus its
@@ -93,7 +119,8 @@ impl Hierarchy {
     pub fn source(&self, e: u32) -> [f64; 3] {
         let t = self.elements[e as usize].triangle as usize;
         let d = self.direct.get(e as usize).copied().unwrap_or(0.0);
-        [0, 1, 2].map(|c| self.emission[t][c] + self.reflectance[t][c] * d)
+        let rho = self.reflectance_of(e);
+        [0, 1, 2].map(|c| self.emission[t][c] + rho[c] * d)
     }
 
     /// Creates the four children of `e` if it has none; returns the first.
@@ -114,6 +141,9 @@ impl Hierarchy {
                 points: geometry.element(&corners),
                 area: parent.area / 4.0,
             });
+            if let Some(detail) = &mut self.detail {
+                detail.push(parent.triangle, &corners);
+            }
         }
         self.elements[e as usize].first_child = first;
         first

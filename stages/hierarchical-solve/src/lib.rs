@@ -62,6 +62,7 @@
 //! 2.3% (walls and ceiling within 1%, short block +2.9%, tall block -4.1%),
 //! for 6.7x the links (122k to 823k) and about 2.5x the solve time.
 
+pub mod detail;
 pub mod elements;
 pub mod gather;
 pub mod links;
@@ -80,6 +81,7 @@ use radiometry::rays::SceneRays;
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution;
+use schemas::surface::Surface;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -296,6 +298,13 @@ pub struct Solved {
 /// pair of input triangles). `progress` is called as each phase of a pass
 /// begins and after the pass.
 pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, params: &Params, progress: &dyn Fn(&Progress)) -> Result<Solved, String> {
+    solve_with_surface(mesh, manifest, clusters, None, params, progress)
+}
+
+/// [`solve`] with the textures and alpha masks of `surface` (from
+/// `mesh-prep --surface`, read for this mesh and manifest) where given
+/// ([`detail`]).
+pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, surface: Option<Surface>, params: &Params, progress: &dyn Fn(&Progress)) -> Result<Solved, String> {
     if let Some(problem) = params.problem() {
         return Err(problem);
     }
@@ -304,12 +313,15 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clusters>, param
     if !clustered && n.saturating_mul(n) > MAX_INITIAL_PAIRS {
         return Err(format!("{n} triangles need {} initial links without clustering (limit {MAX_INITIAL_PAIRS}); give a cluster hierarchy", n * n));
     }
-    let mut h = Hierarchy::new(mesh, manifest, clusters);
+    let mut h = Hierarchy::new(mesh, manifest, clusters, surface);
     let total_area: f64 = (0..n).map(|t| h.elements[t].area).sum();
     let min_area = params.min_area * total_area;
     let floors = Floors { area: min_area, shadow: min_area * 0.25f64.powi(params.shadow_levels as i32) };
     let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed, quadrature_depth: params.quadrature_depth };
-    let scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
+    let mut scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
+    if let Some(masks) = h.detail.as_ref().and_then(detail::Detail::alpha_masks) {
+        scene = scene.with_alpha_masks(masks);
+    }
     let mut work = Work::default();
     // Luminaires first (crate::luminaires): their direct light on the input
     // triangles, which joins the emission in the scale of the threshold,

@@ -4,10 +4,11 @@
 //! whose transport is too coarse is replaced by links from or to the
 //! children of one of the two.
 
+use crate::detail::Detail;
 use crate::elements::Hierarchy;
 use crate::transfer;
 use glam::DVec3;
-use radiometry::form_factor::triangle_to_polygon;
+use radiometry::form_factor::{triangle_to_polygon, AreaFactor};
 use schemas::solution::Node;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -213,7 +214,15 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
     if receiver == sender || !in_front(&s.points, r.points[0], nr) || !in_front(&r.points, s.points[0], ns) {
         return None;
     }
-    let f = triangle_to_polygon(&r.points, nr, &s.points, ns, quadrature_depth);
+    let f = match &h.detail {
+        None => triangle_to_polygon(&r.points, nr, &s.points, ns, quadrature_depth),
+        Some(detail) => {
+            if h.coverage(receiver) == 0.0 || h.coverage(sender) == 0.0 {
+                return None;
+            }
+            masked_factor(h, detail, receiver, sender, quadrature_depth)
+        }
+    };
     (f.mean > 0.0).then_some(Link {
         receiver: Node::Element(receiver),
         sender: Node::Element(sender),
@@ -221,6 +230,23 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
         spread: f.max - f.min,
         visibility: None,
         occluder_distance: f32::INFINITY,
+    })
+}
+
+/// The factor from element `r` to the opaque part of element `s`
+/// ([`crate::detail`]): Lambert's factor summed over the polygons of its
+/// opaque texel runs, or, where it has no mask or too many runs, the
+/// factor to the whole element times its coverage. The spread is the
+/// summed pieces' (an upper bound of the point values' spread).
+fn masked_factor(h: &Hierarchy, detail: &Detail, receiver: u32, sender: u32, depth: u32) -> AreaFactor {
+    let (r, s) = (&h.elements[receiver as usize], &h.elements[sender as usize]);
+    let (nr, ns) = (h.normal(receiver), h.normal(sender));
+    let Some(parts) = detail.opaque_parts(s.triangle, &s.corners, &h.triangles[s.triangle as usize]) else {
+        let (whole, c) = (triangle_to_polygon(&r.points, nr, &s.points, ns, depth), h.coverage(sender));
+        return AreaFactor { mean: c * whole.mean, min: c * whole.min, max: c * whole.max };
+    };
+    parts.iter().map(|p| triangle_to_polygon(&r.points, nr, p, ns, depth)).fold(AreaFactor { mean: 0.0, min: 0.0, max: 0.0 }, |a, f| {
+        AreaFactor { mean: a.mean + f.mean, min: a.min + f.min, max: a.max + f.max }
     })
 }
 

@@ -2,11 +2,12 @@
 
 use clap::Parser;
 use schemas::cli::{check_outputs, main_of};
-use hierarchical_solve::{solve, Criterion, Params, Phase};
+use hierarchical_solve::{solve_with_surface, Criterion, Params, Phase};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::Effects;
 use schemas::solution::Solution;
+use schemas::surface::Surface;
 use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -33,6 +34,10 @@ struct Args {
     /// triangles starts linked (no clustering).
     #[arg(long)]
     clusters: Option<PathBuf>,
+    /// Input: surface.exr from mesh-prep --surface: elements transport with
+    /// their texture-averaged reflectance, and alpha masks cut surfaces.
+    #[arg(long)]
+    surface: Option<PathBuf>,
     /// Output: the solution (EXR tables of elements and links).
     #[arg(short = 'o', long = "output", required_unless_present = "print_params")]
     output: Option<PathBuf>,
@@ -107,15 +112,17 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     }
 }
 
-/// What this stage does not simulate, for the effects the scene has.
-fn skipped(effects: &Effects) -> Vec<String> {
+/// What this stage does not simulate, for the effects the scene has;
+/// `surface`: whether surface.exr was given (textures and alpha masks are
+/// simulated from it).
+fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
         (effects.specular_reflection, "specular reflection: not simulated by hierarchical-solve; mirrors keep their diffuse part only"),
         (effects.specular_transmission, "specular transmission: not simulated by hierarchical-solve"),
         (effects.diffuse_transmission, "diffuse transmission: not simulated by hierarchical-solve"),
-        (effects.textures, "textures: radiosity uses each material's mean diffuse reflectance"),
-        (effects.alpha_masks, "alpha masks: surfaces are treated as opaque"),
+        (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),
+        (effects.alpha_masks && !surface, "alpha masks: no --surface given; surfaces are treated as opaque"),
         (effects.normal_maps, "normal maps: radiosity uses geometric normals"),
     ])
 }
@@ -129,7 +136,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let (Some(mesh_path), Some(manifest_path), Some(output)) = (&args.mesh, &args.manifest, &args.output) else {
         unreachable!("clap requires the inputs and output without --print-params")
     };
-    check_outputs(&[args.mesh.as_deref(), args.manifest.as_deref(), args.clusters.as_deref()], &[Some(output), args.stage.report.as_deref()])?;
+    check_outputs(&[args.mesh.as_deref(), args.manifest.as_deref(), args.clusters.as_deref(), args.surface.as_deref()], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start("hierarchical-solve", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     radiometry::photometry::Luminaire::all(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
@@ -141,11 +148,20 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         }
         None => None,
     };
+    let surface = match &args.surface {
+        Some(path) => {
+            let (surface, input) = Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
+            run.input(input)?;
+            Some(surface)
+        }
+        None => None,
+    };
+    let with_surface = surface.is_some();
     let clustered = clusters.is_some();
     let bar = progress(params.max_passes as u64, "passes");
     // Ticking, so a long phase shows it is alive.
     bar.enable_steady_tick(std::time::Duration::from_millis(250));
-    let solved = solve(&mesh, &manifest, clusters, &params, &|p| {
+    let solved = solve_with_surface(&mesh, &manifest, clusters, surface, &params, &|p| {
         bar.set_position(p.pass as u64 - u64::from(p.phase != Phase::Done));
         bar.set_message(format!("pass {}: {} ({} links, {} elements)", p.pass, p.phase, p.links, p.elements));
     })
@@ -201,7 +217,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
                 counters.insert(name.to_string(), value);
             }
         }
-        let mut skipped = skipped(&manifest.effects);
+        let mut skipped = skipped(&manifest.effects, with_surface);
         if !clustered && manifest.effects.fine_clustered_geometry {
             skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
         }

@@ -110,10 +110,11 @@ impl Hierarchy {
         self.clusters.as_ref().map_or(0, ClusterTree::len)
     }
 
-    /// Surface area of a node, m².
+    /// Surface area of a node, m²: of an element, its opaque area (its
+    /// area times its coverage, [`crate::detail`]).
     pub fn area(&self, node: Node) -> f64 {
         match node {
-            Node::Element(e) => self.elements[e as usize].area,
+            Node::Element(e) => self.elements[e as usize].area * self.coverage(e),
             Node::Cluster(c) => self.tree().area[c as usize],
         }
     }

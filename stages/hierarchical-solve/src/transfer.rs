@@ -76,7 +76,8 @@ pub fn estimate(h: &Hierarchy, scene: Option<&SceneRays>, receiver: Node, sender
         // refines anyway.
         let pair = (sender_area * point_kernel(x.point, x.normal, y.point, y.normal) / PI).min(1.0);
         let value = match sender {
-            Node::Element(e) => point_to_one_sided_polygon(x.point, x.normal, &h.elements[e as usize].points, h.normal(e)),
+            // An element's opaque part, by its coverage (crate::detail).
+            Node::Element(e) => point_to_one_sided_polygon(x.point, x.normal, &h.elements[e as usize].points, h.normal(e)) * h.coverage(e),
             Node::Cluster(_) => pair,
         };
         sum += value;

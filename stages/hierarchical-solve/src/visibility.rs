@@ -67,6 +67,13 @@ pub fn of_link(h: &Hierarchy, scene: &SceneRays, link: &Link, rays: usize, linki
     }
 }
 
+/// Whether `point` of `triangle` exists: not on a transparent texel of
+/// its alpha mask ([`crate::detail`]; a pair with an end that does not
+/// exist carries no light, and no weight).
+fn exists(h: &Hierarchy, triangle: u32, point: glam::DVec3) -> bool {
+    h.detail.as_ref().is_none_or(|d| d.exists(triangle, h.triangles[triangle as usize].uv_of(point)))
+}
+
 /// A visibility estimate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Visibility {
@@ -102,7 +109,7 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
         let from = stratified_point(&r.points, k, rays, &mut stream);
         let to = stratified_point(&s.points, k_sender, rays, &mut stream);
         let g = point_kernel(from, nr, to, ns);
-        if g <= 0.0 {
+        if g <= 0.0 || !exists(h, r.triangle, from) || !exists(h, s.triangle, to) {
             continue;
         }
         cast += 1;

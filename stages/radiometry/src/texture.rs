@@ -270,6 +270,43 @@ pub fn average(maps: Maps, uv: [P2; 3]) -> Average {
     Average { coverage, reflectance }
 }
 
+/// The opaque part of the triangle with corner texture coordinates `uv`
+/// under alpha texture `t`, as convex polygons in texture coordinates: per
+/// texel row, one polygon per run of consecutive opaque texels. `None`
+/// where the footprint spans more than `limit` texels or has no area.
+pub fn opaque_pieces(t: &Texture, uv: [P2; 3], limit: usize) -> Option<Vec<Vec<P2>>> {
+    let p = uv.map(|q| texel_space(t, q));
+    if cells(&p) > limit as f64 || twice_area(&p).abs() <= 1e-12 || t.scale.contains(&0.0) {
+        return None;
+    }
+    let mut pieces = Vec::new();
+    let (lo, hi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q[1]), hi.max(q[1])));
+    for j in lo.floor() as i64..hi.ceil() as i64 {
+        let row = clip(&clip(&p, 1, j as f64, 1.0), 1, (j + 1) as f64, -1.0);
+        if row.len() < 3 {
+            continue;
+        }
+        let (x0, x1) = row.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(q[0]), hi.max(q[0])));
+        let (first, last) = (x0.floor() as i64, x1.ceil() as i64);
+        let mut i = first;
+        while i < last {
+            if texel(t, i, j)[3] <= 0.0 {
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i < last && texel(t, i, j)[3] > 0.0 {
+                i += 1;
+            }
+            let run = clip(&clip(&row, 0, start as f64, 1.0), 0, i as f64, -1.0);
+            if run.len() >= 3 {
+                pieces.push(run.iter().map(|&q| texture_space(t, q)).collect());
+            }
+        }
+    }
+    Some(pieces)
+}
+
 fn centroid(uv: &[P2; 3]) -> P2 {
     std::array::from_fn(|k| (uv[0][k] + uv[1][k] + uv[2][k]) / 3.0)
 }
@@ -412,6 +449,20 @@ mod tests {
         let blurred = (31.0 * 0.75 + (0.4375 + 0.75) / 2.0) / 32.0;
         assert!((rho - blurred).abs() < 1e-9, "{rho} vs {blurred}");
         assert!((coverage - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn opaque_pieces_are_the_runs_of_opaque_texels_and_cover_what_the_average_says() {
+        let alpha = texture(TextureKind::Alpha, 8, 2, |i, j| if i % 4 < 2 || j == 0 { 1.0 } else { 0.0 });
+        let tri = [[0.05, 0.1], [0.95, 0.2], [0.4, 0.9]];
+        let pieces = opaque_pieces(&alpha, tri, 1000).unwrap();
+        let area: f64 = pieces.iter().map(|p| 0.5 * twice_area(p).abs()).sum();
+        let coverage = average(Maps { diffuse: None, alpha: Some(&alpha) }, tri).coverage;
+        assert!((area / (0.5 * twice_area(&tri).abs()) - coverage).abs() < 1e-12);
+        // The top row is one run, the bottom row's runs are columns 0-1
+        // and 4-5 (the triangle reaches column 1 and 4 at least).
+        assert_eq!(pieces.len(), 3, "{pieces:?}");
+        assert!(opaque_pieces(&alpha, tri, 4).is_none());
     }
 
     #[test]

@@ -1,0 +1,312 @@
+//! Surface detail in hierarchical-solve (issue 13, items 2, 3 and 8),
+//! per element against closed forms written here: Lambert's polygon
+//! factor (`closed_form::lambert_polygon`) for the light, and the texture
+//! read back from `surface.exr` with a bilinear lookup written here, apart
+//! from the stages' (`radiometry::texture`).
+
+use end_to_end::artifacts::leaf_world_corners;
+use end_to_end::closed_form::{lambert_polygon, mean_over_triangle};
+use end_to_end::{run_ok, s, scratch};
+use schemas::mesh::{Manifest, Mesh};
+use schemas::ron_io::read_ron;
+use schemas::solution::{Element, Solution, NONE};
+use schemas::surface::{Surface, Texture};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// A quad of the test scenes: object name, material, corners (wound so
+/// that the right-hand rule gives the front) and, where textured, corner
+/// texture coordinates.
+struct Quad {
+    name: &'static str,
+    material: &'static str,
+    corners: [[f64; 3]; 4],
+    uv: Option<[[f64; 2]; 4]>,
+}
+
+/// The unit square `[0, 1]^2` at height `z`, facing up, with `uv = (x, y)`.
+fn floor(name: &'static str, material: &'static str, z: f64) -> Quad {
+    Quad { name, material, corners: [[0.0, 0.0, z], [1.0, 0.0, z], [1.0, 1.0, z], [0.0, 1.0, z]], uv: Some([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]) }
+}
+
+/// The square `[lo, hi]^2` at height `z`, facing down, with `uv = ((x -
+/// lo), (y - lo)) / (hi - lo)`.
+fn ceiling(name: &'static str, material: &'static str, lo: f64, hi: f64, z: f64) -> Quad {
+    Quad { name, material, corners: [[lo, hi, z], [hi, hi, z], [hi, lo, z], [lo, lo, z]], uv: Some([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]) }
+}
+
+/// Writes the quads, the MTL library `mtl` and scene.ron with `emitters`
+/// (material, exitance W/m²) into `dir`; returns the scene's path.
+fn write_scene(dir: &Path, quads: &[Quad], mtl: &str, emitters: &[(&str, f64)]) -> PathBuf {
+    let mut obj = String::from("mtllib scene.mtl\n");
+    for q in quads {
+        writeln!(obj, "o {}\nusemtl {}", q.name, q.material).unwrap();
+        for v in q.corners {
+            writeln!(obj, "v {:.17} {:.17} {:.17}", v[0], v[1], v[2]).unwrap();
+        }
+        match q.uv {
+            Some(uv) => {
+                for t in uv {
+                    writeln!(obj, "vt {:.17} {:.17}", t[0], t[1]).unwrap();
+                }
+                obj.push_str("f -4/-4 -3/-3 -2/-2 -1/-1\n");
+            }
+            None => obj.push_str("f -4 -3 -2 -1\n"),
+        }
+    }
+    let overrides: String = emitters.iter().map(|(m, e)| format!("    \"{m}\": (emission: Some(({e:?}, {e:?}, {e:?}))),\n")).collect();
+    let scene = format!(
+        "Scene(\n  meshes: [Obj(file: \"scene.obj\")],\n  camera: Camera(eye: (0.5, -2.0, 0.5), target: (0.5, 0.5, 0.2), up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 16, height: 16),\n  lights: [],\n  materials: {{\n{overrides}  }},\n)\n"
+    );
+    std::fs::write(dir.join("scene.obj"), obj).unwrap();
+    std::fs::write(dir.join("scene.mtl"), mtl).unwrap();
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, scene).unwrap();
+    path
+}
+
+/// Writes a grey `w x h` PNG whose pixel `(i, j)` (row 0 at the top) has
+/// the value `value(i, j)`.
+fn png(dir: &Path, name: &str, w: usize, h: usize, value: impl Fn(usize, usize) -> u8) {
+    let pixels: Vec<[u8; 3]> = (0..w * h).map(|k| [value(k % w, k / w); 3]).collect();
+    std::fs::write(dir.join(name), schemas::png::encode_png(w, h, &pixels).unwrap()).unwrap();
+}
+
+/// What a prepared and solved scene gives.
+struct Solved {
+    mesh: Mesh,
+    manifest: Manifest,
+    surface: Surface,
+    solution: Solution,
+    report: String,
+}
+
+/// mesh-prep with `--surface`, then hierarchical-solve with it and
+/// `solve_args`, in `dir`.
+fn prepare_and_solve(dir: &Path, scene: &Path, solve_args: &[&str]) -> Solved {
+    let p = |f: &str| dir.join(f);
+    let (mesh, manifest, surface, solution, report) = (p("mesh.exr"), p("manifest.ron"), p("surface.exr"), p("solution.exr"), p("solve.report.ron"));
+    run_ok("mesh-prep", &[s(scene), "--mesh", s(&mesh), "--manifest", s(&manifest), "--surface", s(&surface)]);
+    let mut args = vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "--surface", s(&surface), "-o", s(&solution), "--report", s(&report)];
+    args.extend_from_slice(solve_args);
+    run_ok("hierarchical-solve", &args);
+    let (mesh_data, _) = Mesh::read(&mesh).unwrap();
+    let manifest_data = read_ron::<Manifest>(&manifest).unwrap().value;
+    let (surface_data, _) = Surface::read(&surface, mesh_data.triangles.len(), manifest_data.materials.len()).unwrap();
+    let (solution_data, _) = Solution::read(&solution).unwrap();
+    Solved { mesh: mesh_data, manifest: manifest_data, surface: surface_data, solution: solution_data, report: std::fs::read_to_string(report).unwrap() }
+}
+
+impl Solved {
+    /// The leaf elements whose triangle has material `name`.
+    fn leaves_of(&self, name: &str) -> Vec<&Element> {
+        let m = self.manifest.materials.iter().position(|m| m.name == name).unwrap() as u32;
+        self.solution.elements.iter().filter(|e| e.first_child == NONE && self.mesh.triangles[e.triangle as usize].material == m).collect()
+    }
+
+    /// World corners of element `e`.
+    fn world(&self, e: &Element) -> [[f64; 3]; 3] {
+        leaf_world_corners(&self.mesh, self.manifest.world_from_mesh_translation, e)
+    }
+
+    /// Area-mean of `f(world point, texture coordinates)` over element
+    /// `e` (1,024 centroids).
+    fn mean(&self, e: &Element, f: &dyn Fn([f64; 3], [f64; 2]) -> f64) -> f64 {
+        let uv = self.surface.uvs.iter().find(|u| u.0 == e.triangle).map(|u| u.1);
+        let corners = e.corners.map(|c| [f64::from(c[0]), f64::from(c[1]), 0.0]);
+        let t = &self.mesh.triangles[e.triangle as usize];
+        let [p0, p1, p2] = t.vertices.map(|v| self.mesh.positions[v as usize].map(f64::from));
+        let o = self.manifest.world_from_mesh_translation;
+        mean_over_triangle(&corners, 5, &|b| {
+            let at = |c: [f64; 3]| (1.0 - b[0] - b[1]) * c[0] + b[0] * c[1] + b[1] * c[2];
+            let x = std::array::from_fn(|a| at([p0[a], p1[a], p2[a]]) + o[a]);
+            let tex = uv.map_or([0.0; 2], |uv| std::array::from_fn(|k| at([f64::from(uv[0][k]), f64::from(uv[1][k]), f64::from(uv[2][k])])));
+            f(x, tex)
+        })
+    }
+}
+
+/// The bilinear lookup of channel R of a texture with `-clamp on` at
+/// texture coordinates `uv`: texel `(i, j)`'s centre at `((i + 1/2) / W,
+/// 1 - (j + 1/2) / H)`, weights `(1 - |dx|)(1 - |dy|)` in texels.
+fn bilinear_clamped(t: &Texture, uv: [f64; 2]) -> f64 {
+    let (x, y) = (uv[0] * t.width as f64 - 0.5, (1.0 - uv[1]) * t.height as f64 - 0.5);
+    let (i, j) = (x.floor(), y.floor());
+    let (fx, fy) = (x - i, y - j);
+    let at = |di: f64, dj: f64| {
+        let ii = ((i + di).max(0.0) as usize).min(t.width - 1);
+        let jj = ((j + dj).max(0.0) as usize).min(t.height - 1);
+        f64::from(t.texels[jj * t.width + ii][0])
+    };
+    (1.0 - fx) * (1.0 - fy) * at(0.0, 0.0) + fx * (1.0 - fy) * at(1.0, 0.0) + (1.0 - fx) * fy * at(0.0, 1.0) + fx * fy * at(1.0, 1.0)
+}
+
+/// A 64 x 64 checkerboard of 2 x 2 checks (sRGB 200 and 90).
+fn checks_png(dir: &Path) {
+    png(dir, "checks.png", 64, 64, |i, j| if (i / 32 + j / 32) % 2 == 0 { 200 } else { 90 });
+}
+
+const UP: [f64; 3] = [0.0, 0.0, 1.0];
+
+#[test]
+fn a_checkerboard_floor_under_a_square_emitter_has_each_elements_radiosity_rho_times_lambert() {
+    let dir = scratch("surface_solver_checks");
+    checks_png(&dir);
+    let lamp = [[0.3, 0.3, 0.4], [0.7, 0.3, 0.4], [0.7, 0.7, 0.4], [0.3, 0.7, 0.4]];
+    let quads = [floor("floor", "checks", 0.0), ceiling("lamp", "lamp", 0.3, 0.7, 0.4)];
+    let mtl = "newmtl checks\nKd 0.5 0.5 0.5\nmap_Kd -clamp on checks.png\nnewmtl lamp\nKd 0 0 0\n";
+    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    let solved = prepare_and_solve(&dir, &scene, &[]);
+    assert!(!solved.report.contains("textures:"), "textures leave the skipped list: {}", solved.report);
+    let texture = &solved.surface.textures[0];
+    let leaves = solved.leaves_of("checks");
+    assert!(leaves.len() >= 64, "{}", leaves.len());
+    let mut worst = 0.0f64;
+    for e in leaves {
+        let expected = solved.mean(e, &|x, uv| bilinear_clamped(texture, uv) * 10.0 * lambert_polygon(x, UP, &lamp));
+        let got = f64::from(e.radiosity[0]);
+        worst = worst.max((got - expected).abs() / expected);
+        assert!((got - expected).abs() <= 5e-3 * expected, "element at {:?}: {got} vs rho E = {expected}", solved.world(e)[0]);
+    }
+    eprintln!("checkerboard floor: worst element {:.3}%", 100.0 * worst);
+}
+
+#[test]
+fn a_closed_box_with_a_textured_wall_keeps_its_energy_balance_with_the_texture_averaged_reflectance() {
+    let dir = scratch("surface_solver_box");
+    checks_png(&dir);
+    let scene = end_to_end::scenes::closed_box(1.0, 0.5, 1.0).write(&dir);
+    // The x = 0 wall gets the checks and texture coordinates.
+    let obj = std::fs::read_to_string(dir.join("scene.obj")).unwrap();
+    let mut lines: Vec<String> = obj.lines().map(String::from).collect();
+    let at = lines.iter().position(|l| l == "o wall0false").unwrap();
+    lines[at + 1] = "usemtl checks".into();
+    lines[at + 6] = "f -4/-4 -3/-3 -2/-2 -1/-1".into();
+    lines.insert(at + 6, "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1".into());
+    std::fs::write(dir.join("scene.obj"), lines.join("\n") + "\n").unwrap();
+    let mtl = std::fs::read_to_string(dir.join("scene.mtl")).unwrap();
+    std::fs::write(dir.join("scene.mtl"), format!("{mtl}newmtl checks\nKd 0.5 0.5 0.5\nmap_Kd -clamp on checks.png\n")).unwrap();
+    let solved = prepare_and_solve(&dir, &scene, &["--eps", "1e-3", "--min-area", "1e-3", "--tolerance", "1e-7"]);
+    let texture = &solved.surface.textures[0];
+    let textured = solved.manifest.materials.iter().position(|m| m.name == "checks").unwrap() as u32;
+    // Emitted power against absorbed: sum A (1 - rho) H, H = (B - E) / rho,
+    // rho each leaf's texture average (written here) on the textured wall.
+    let (mut emitted, mut absorbed) = (0.0, 0.0);
+    for e in solved.solution.elements.iter().filter(|e| e.first_child == NONE) {
+        let material = solved.mesh.triangles[e.triangle as usize].material;
+        let m = &solved.manifest.materials[material as usize];
+        let rho = if material == textured { solved.mean(e, &|_, uv| bilinear_clamped(texture, uv)) } else { m.diffuse[0] };
+        let (area, b, emission) = (f64::from(e.area), f64::from(e.radiosity[0]), m.emission[0]);
+        emitted += area * emission;
+        absorbed += area * (1.0 - rho) / rho * (b - emission);
+    }
+    eprintln!("closed box: absorbed / emitted = {:.5}", absorbed / emitted);
+    assert!((absorbed / emitted - 1.0).abs() < 1e-2, "absorbed {absorbed} of {emitted} emitted");
+}
+
+/// A 16 x 1 stripe mask: even columns opaque.
+fn stripes_png(dir: &Path) {
+    png(dir, "stripes.png", 16, 1, |i, _| if i % 2 == 0 { 255 } else { 0 });
+}
+
+/// Lamp `[lo, hi]^2` at height `z` under the stripe mask of
+/// [`stripes_png`]: its opaque stripes as polygons.
+fn opaque_stripes(lo: f64, hi: f64, z: f64) -> Vec<[[f64; 3]; 4]> {
+    (0..16).step_by(2).map(|k| {
+        let (a, b) = (lo + (hi - lo) * k as f64 / 16.0, lo + (hi - lo) * (k + 1) as f64 / 16.0);
+        [[a, lo, z], [b, lo, z], [b, hi, z], [a, hi, z]]
+    }).collect()
+}
+
+/// The floor under an emitter whose alpha mask removes half of it in
+/// stripes, at height `z`: each floor leaf's radiosity against rho M
+/// times Lambert's factor summed over the opaque stripes, and its ratio
+/// to the full emitter's.
+fn striped_emitter(test: &str, z: f64) -> (f64, f64) {
+    let dir = scratch(test);
+    stripes_png(&dir);
+    let quads = [floor("floor", "floor", 0.0), ceiling("lamp", "lamp", 0.3, 0.7, z)];
+    let mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nmap_d -clamp on stripes.png\n";
+    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    let solved = prepare_and_solve(&dir, &scene, &[]);
+    assert!(!solved.report.contains("alpha masks:"), "alpha masks leave the skipped list: {}", solved.report);
+    let stripes = opaque_stripes(0.3, 0.7, z);
+    let full = [[0.3, 0.3, z], [0.7, 0.3, z], [0.7, 0.7, z], [0.3, 0.7, z]];
+    let (mut worst, mut worst_half) = (0.0f64, 0.0f64);
+    for e in solved.leaves_of("floor") {
+        let expected = solved.mean(e, &|x, _| 0.5 * 10.0 * stripes.iter().map(|p| lambert_polygon(x, UP, p)).sum::<f64>());
+        let whole = solved.mean(e, &|x, _| 0.5 * 10.0 * lambert_polygon(x, UP, &full));
+        let got = f64::from(e.radiosity[0]);
+        worst = worst.max((got - expected).abs() / expected);
+        worst_half = worst_half.max((got / whole - 0.5).abs() / 0.5);
+    }
+    (worst, worst_half)
+}
+
+#[test]
+fn an_emitter_striped_by_its_alpha_mask_lights_the_floor_from_its_opaque_stripes() {
+    let (near, _) = striped_emitter("surface_solver_stripes_near", 0.2);
+    eprintln!("striped emitter near: worst element {:.3}% off Lambert over the stripes", 100.0 * near);
+    assert!(near < 1e-2, "near: {near}");
+    let (far, half) = striped_emitter("surface_solver_stripes_far", 4.0);
+    eprintln!("striped emitter far: worst element {:.3}% off the stripes, {:.3}% off half the full emitter", 100.0 * far, 100.0 * half);
+    assert!(half < 1e-2 && far < 1e-2, "far: {far}, half: {half}");
+}
+
+#[test]
+fn an_alpha_masked_occluder_with_a_hole_lets_the_holes_lambert_contribution_through() {
+    let dir = scratch("surface_solver_hole");
+    // A 10 x 10 mask, transparent in its middle 4 x 4 texels: a hole over
+    // [0.3, 0.7]^2 of the occluder.
+    png(&dir, "hole.png", 10, 10, |i, j| if (3..7).contains(&i) && (3..7).contains(&j) { 0 } else { 255 });
+    let mut occluder = floor("occluder", "screen", 0.5);
+    occluder.corners.reverse();
+    occluder.uv = occluder.uv.map(|mut uv| {
+        uv.reverse();
+        uv
+    });
+    let quads = [floor("floor", "floor", 0.0), occluder, ceiling("lamp", "lamp", 0.45, 0.55, 1.0)];
+    let mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl screen\nKd 0 0 0\nmap_d -clamp on hole.png\nnewmtl lamp\nKd 0 0 0\n";
+    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    // The floor's radiosity is about 1.5e-3 of the lamp's, so the absolute
+    // threshold (the only pass of a scene without interreflection) must be
+    // well under that for 1% per element.
+    let solved = prepare_and_solve(&dir, &scene, &["--eps", "1e-6"]);
+    let lamp = [[0.45, 0.45, 1.0], [0.55, 0.45, 1.0], [0.55, 0.55, 1.0], [0.45, 0.55, 1.0]];
+    // A floor point x sees the lamp through the hole where the segment
+    // crosses z = 1/2 inside [0.3, 0.7]^2: lamp points y in [0.6 - x, 1.4 -
+    // x] per axis, all of the lamp for x in [0.15, 0.85]^2, none outside
+    // [0.05, 0.95] in either axis.
+    let inside = |w: &[[f64; 3]; 3], lo: f64, hi: f64| w.iter().all(|p| (lo..=hi).contains(&p[0]) && (lo..=hi).contains(&p[1]));
+    let outside = |w: &[[f64; 3]; 3]| w.iter().all(|p| p[0] < 0.05 || p[0] > 0.95 || p[1] < 0.05 || p[1] > 0.95);
+    let (mut lit, mut dark) = (0, 0);
+    let mut worst = 0.0f64;
+    for e in solved.leaves_of("floor") {
+        let w = solved.world(e);
+        let got = f64::from(e.radiosity[0]);
+        if inside(&w, 0.15, 0.85) {
+            let expected = solved.mean(e, &|x, _| 0.5 * 10.0 * lambert_polygon(x, UP, &lamp));
+            worst = worst.max((got - expected).abs() / expected);
+            assert!((got - expected).abs() <= 1e-2 * expected, "lit element at {:?}: {got} vs {expected}", w[0]);
+            lit += 1;
+        } else if outside(&w) {
+            assert!(got < 1e-4, "element in the occluder's shadow at {:?}: {got}", w[0]);
+            dark += 1;
+        }
+    }
+    eprintln!("occluder with a hole: {lit} lit elements (worst {:.3}% off Lambert), {dark} dark", 100.0 * worst);
+    assert!(lit >= 16 && dark >= 16, "{lit} lit, {dark} dark");
+}
+
+#[test]
+fn a_scene_without_surface_detail_solves_the_same_with_its_empty_surface_artifact() {
+    let dir = scratch("surface_solver_plain");
+    let [mesh, manifest, surface, plain, with] = ["mesh.exr", "manifest.ron", "surface.exr", "plain.exr", "with.exr"].map(|f| dir.join(f));
+    run_ok("mesh-prep", &["--builtin", "cornell-box", "--mesh", s(&mesh), "--manifest", s(&manifest), "--surface", s(&surface)]);
+    let base = ["--mesh", s(&mesh), "--manifest", s(&manifest), "--eps", "1e-2"];
+    run_ok("hierarchical-solve", &[&base[..], &["-o", s(&plain)]].concat());
+    run_ok("hierarchical-solve", &[&base[..], &["--surface", s(&surface), "-o", s(&with)]].concat());
+    let (plain, _) = Solution::read(&plain).unwrap();
+    let (with, _) = Solution::read(&with).unwrap();
+    assert!(plain.elements == with.elements && plain.links == with.links && plain.clusters == with.clusters, "the tables differ");
+}
