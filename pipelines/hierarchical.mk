@@ -21,9 +21,12 @@ $(eval $(call params_file,tonemap,--operator $(OPERATOR)))
 $(OUT)/params/scene: FORCE | $(OUT)/params
 	@echo "$(SCENE_ARGS)" > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
 
-$(OUT)/mesh.exr $(OUT)/manifest.ron &: $(BIN)/mesh-prep $(OUT)/params/mesh-prep.ron $(OUT)/params/scene | $(OUT)
+# surface.exr: texture coordinates, shading normals and decoded textures
+# (empty for a scene without surface detail), for the stages that simulate
+# them.
+$(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr &: $(BIN)/mesh-prep $(OUT)/params/mesh-prep.ron $(OUT)/params/scene | $(OUT)
 	$(BIN)/mesh-prep $(SCENE_ARGS) --params $(OUT)/params/mesh-prep.ron \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --report $(OUT)/mesh-prep.report.ron --depfile $(OUT)/mesh.d
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr --report $(OUT)/mesh-prep.report.ron --depfile $(OUT)/mesh.d
 -include $(OUT)/mesh.d
 
 $(OUT)/clusters.exr: $(BIN)/cluster $(OUT)/params/cluster.ron $(OUT)/mesh.exr $(OUT)/manifest.ron
@@ -34,9 +37,9 @@ $(OUT)/clusters.exr: $(BIN)/cluster $(OUT)/params/cluster.ron $(OUT)/mesh.exr $(
 $(OUT)/params/clusters: FORCE | $(OUT)/params
 	@echo "$(CLUSTERS)" > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
 
-$(OUT)/solution.exr: $(BIN)/hierarchical-solve $(OUT)/params/hierarchical-solve.ron $(OUT)/params/clusters $(OUT)/mesh.exr $(OUT)/manifest.ron $(CLUSTERS_EXR)
+$(OUT)/solution.exr: $(BIN)/hierarchical-solve $(OUT)/params/hierarchical-solve.ron $(OUT)/params/clusters $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(CLUSTERS_EXR)
 	$(BIN)/hierarchical-solve --params $(OUT)/params/hierarchical-solve.ron \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) -o $@ --report $(OUT)/solve.report.ron
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) -o $@ --report $(OUT)/solve.report.ron
 
 $(OUT)/preview.exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/solution.exr
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview \
