@@ -2,6 +2,7 @@
 //! that sizes the grid and averages the mask's threshold per vertex, the
 //! camera rays, the per-pixel diagnostics.
 
+use crate::detail::Detail;
 use crate::full::{brute_irradiance, FullGather, Surface, Work, CLASS_NAMES};
 use crate::grid::Grid;
 use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
@@ -12,7 +13,6 @@ use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::photometry::{DirectLight, Luminaire};
-use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use rayon::prelude::*;
 use schemas::cluster::Clusters;
@@ -90,6 +90,9 @@ pub struct FullScene<'a> {
     pub threshold: Option<&'a ContrastImage>,
     /// The camera.
     pub camera: &'a Pinhole,
+    /// Surface detail (textures, alpha masks, normal maps), where the scene
+    /// has some and the surface artifact was given.
+    pub detail: Option<&'a Detail<'a>>,
     /// The goniometric point lights (luminaires). The solution's element
     /// radiosity holds the light they reflect; their direct light on the
     /// receiver is not in the links (a point light is no sender), so each
@@ -114,7 +117,7 @@ pub struct FullImage {
 /// Renders `scene` at `width` x `height` by `params.mode` (full or brute).
 pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, rows_done: &(dyn Fn(u64) + Sync)) -> FullImage {
     let (w, h) = (width as usize, height as usize);
-    let rays = SceneRays::new(&scene.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
+    let rays = crate::scene_rays(scene.triangles, scene.detail);
     let senders = Senders::new(scene.triangles, scene.solution, scene.clusters, params.seed);
     let camera = scene.camera;
     // Pre-pass: one ray through each pixel centre, for the depth range and
@@ -177,19 +180,22 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                         }
                         tally.front(scene.ids[hit.triangle as usize], tri.normal);
                         let p = camera.eye + d * f64::from(hit.t);
-                        let leaf = senders.chain(hit.triangle, tri.uv_of(p), &mut links);
+                        let uv = tri.uv_of(p);
+                        let leaf = senders.chain(hit.triangle, uv, &mut links);
+                        let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(hit.triangle, uv, tri.normal));
                         let mut sample = Work::default();
                         let irradiance = match params.mode {
                             Mode::Brute => {
-                                brute_irradiance(&senders, &rays, p, tri.normal, hit.triangle, &links, params.brute_samples, &mut gather_stream, &mut sample)
+                                brute_irradiance(&senders, &rays, p, normal, hit.triangle, &links, params.brute_samples, &mut gather_stream, &mut sample)
                             }
-                            _ => gather.irradiance(p, tri.normal, hit.triangle, leaf, &links, k, &mut sample),
+                            _ => gather.irradiance(p, normal, hit.triangle, leaf, &links, k, &mut sample),
                         };
-                        let (direct, cast) = luminaires.at_point(p, tri.normal, hit.triangle);
+                        let (direct, cast) = luminaires.at_point(p, normal, hit.triangle);
                         sample.visibility_rays += cast;
                         work.add(&sample);
                         let s = scene.surfaces[hit.triangle as usize];
-                        (0..3).for_each(|c| sum[c] += (s.emission[c] + s.reflectance[c] * (irradiance[c] + direct)) / PI);
+                        let rho = scene.detail.and_then(|detail| detail.reflectance(hit.triangle, uv)).unwrap_or(s.reflectance);
+                        (0..3).for_each(|c| sum[c] += (s.emission[c] + rho[c] * (irradiance[c] + direct)) / PI);
                     }
                     let n = f64::from(spp);
                     (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, work, tally.finish())

@@ -105,6 +105,21 @@ impl Gouraud {
         solution_path: &Path,
         smoothing: Smoothing,
     ) -> Result<Self> {
+        Self::of(triangles, materials, solution, solution_path, smoothing, &|_, e| e.radiosity.map(f64::from))
+    }
+
+    /// [`Self::new`] interpolating `value(corners, element)` of each leaf
+    /// element (barycentric corners in its triangle) instead of its
+    /// radiosity: the display of a textured scene interpolates the
+    /// irradiance this way ([`crate::detail`]).
+    pub fn of(
+        triangles: &[TriangleGeometry],
+        materials: &[u32],
+        solution: &Solution,
+        solution_path: &Path,
+        smoothing: Smoothing,
+        value: &(dyn Fn(&Corners, &schemas::solution::Element) -> [f64; 3] + Sync),
+    ) -> Result<Self> {
         let leaves = leaves(triangles.len(), solution).map_err(|why| {
             Error::invalid(solution_path, None, format!("solution does not belong to this mesh: {why}"))
         })?;
@@ -124,8 +139,7 @@ impl Gouraud {
         let material: Vec<u32> = leaves.iter().map(|l| materials[l.triangle as usize]).collect();
         let area: Vec<f64> =
             leaves.iter().map(|l| triangles[l.triangle as usize].area * 0.25f64.powi(l.level as i32)).collect();
-        let radiosity: Vec<[f64; 3]> =
-            leaves.iter().map(|l| elements[l.element as usize].radiosity.map(f64::from)).collect();
+        let radiosity: Vec<[f64; 3]> = leaves.par_iter().map(|l| value(&l.corners, &elements[l.element as usize])).collect();
 
         let cell = weld_cell(triangles, smoothing.weld_tolerance);
         let key = |p: DVec3| -> [i64; 3] { (p / cell).round().to_array().map(|x| x as i64) };

@@ -45,6 +45,7 @@
 //! Same inputs and parameters give bit-identical images, whatever the
 //! number of threads.
 
+pub mod detail;
 pub mod final_gather;
 pub mod full;
 pub mod gouraud;
@@ -264,6 +265,9 @@ pub struct Extras<'a> {
     pub clusters: Option<&'a schemas::cluster::Clusters>,
     /// The mask stage's contrast threshold per pixel.
     pub threshold: Option<&'a final_gather::ContrastImage>,
+    /// Surface detail (textures, alpha masks, normal maps) from mesh-prep's
+    /// surface artifact, for a scene that has some.
+    pub detail: Option<&'a detail::Detail<'a>>,
 }
 
 /// The inputs of a gather. The paths only name the files in error
@@ -363,9 +367,22 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     };
     let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
     let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
-    let rays = (!triangles.is_empty()).then(|| SceneRays::new(&triangles.iter().map(|t| t.corners).collect::<Vec<_>>()));
+    let rays = (!triangles.is_empty()).then(|| scene_rays(&triangles, extras.detail));
+    let textures = extras.detail.filter(|_| scene.manifest.effects.textures);
+    let emission: Vec<[f64; 3]> = match textures {
+        Some(_) => scene.mesh.triangles.iter().map(|t| scene.manifest.materials[t.material as usize].emission).collect(),
+        None => Vec::new(),
+    };
+    let irradiance = match textures {
+        Some(detail) => Some(Gouraud::of(&triangles, &materials, scene.solution, scene.solution_path, smoothing, &|corners, e| {
+            let m = &scene.manifest.materials[scene.mesh.triangles[e.triangle as usize].material as usize];
+            detail.irradiance(e.triangle, corners, e.radiosity.map(f64::from), m.emission, m.diffuse)
+        })?),
+        None => None,
+    };
+    let textured = textures.zip(irradiance.as_ref()).map(|(detail, irradiance)| render::Textured { detail, irradiance, emission: &emission });
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
-    let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading, surfaces: &ids, crease_angle_deg: params.crease_angle_deg };
+    let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading, textured, surfaces: &ids, crease_angle_deg: params.crease_angle_deg };
     let film = render::render(&view, Sampling { width, height, spp: params.spp, seed: params.seed }, rows_done);
 
     let pixels = f64::from(width) * f64::from(height);
@@ -388,10 +405,20 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
             coverage: film.coverage,
             surfaces: film.surfaces,
             counters,
-            skipped: skipped_in_preview(scene.manifest),
+            skipped: skipped(scene.manifest, Mode::Preview, extras.detail.is_some()),
         },
         None,
     ))
+}
+
+/// The BVH over `triangles`, whose rays pass through alpha-masked holes
+/// where `detail` has alpha masks.
+pub fn scene_rays(triangles: &[radiometry::geometry::TriangleGeometry], detail: Option<&detail::Detail>) -> SceneRays {
+    let corners: Vec<_> = triangles.iter().map(|t| t.corners).collect();
+    match detail {
+        Some(detail) => detail.rays(&corners),
+        None => SceneRays::new(&corners),
+    }
 }
 
 /// The full or brute-force gather.
@@ -436,35 +463,41 @@ fn full_gather(
     } else {
         Vec::new()
     };
-    let full_scene = final_gather::FullScene { triangles, surfaces: &surfaces, ids: &ids, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera, lights: &lights };
+    let full_scene =
+        final_gather::FullScene { triangles, surfaces: &surfaces, ids: &ids, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera, detail: extras.detail, lights: &lights };
     let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
     let mut counters = image.counters;
     counters.insert("triangles".into(), triangles.len() as f64);
     counters.insert("elements".into(), scene.solution.elements.len() as f64);
     counters.insert("links".into(), scene.solution.links.len() as f64);
-    let mut skipped = skipped_in_preview(scene.manifest);
-    skipped.remove(0);
+    let skipped = skipped(scene.manifest, params.mode, extras.detail.is_some());
     Ok((
         Rendered { width: width as usize, height: height as usize, rgb: image.rgb, coverage: image.coverage, surfaces: image.surfaces, counters, skipped },
         image.diagnostics,
     ))
 }
 
-/// What preview mode leaves out, and why, given the scene's effects.
-pub fn skipped_in_preview(manifest: &Manifest) -> Vec<String> {
+/// What a gather in `mode` leaves out, and why, given the scene's effects;
+/// `detail`: the surface artifact was given (`--surface`), so textures and
+/// alpha masks are applied, and normal maps in the full and brute gathers,
+/// which compute cosines (the preview shows the solver's).
+pub fn skipped(manifest: &Manifest, mode: Mode, detail: bool) -> Vec<String> {
     let e = &manifest.effects;
-    let mut skipped = vec![
-        "full gather (perspective grid, sender classification, resampling): preview mode interpolates the radiosity of the solution".to_string(),
-    ];
+    let mut skipped = Vec::new();
+    if mode == Mode::Preview {
+        skipped.push("full gather (perspective grid, sender classification, resampling): preview mode interpolates the radiosity of the solution".to_string());
+    }
+    let no_surface = "present but not applied: pass mesh-prep's surface artifact with --surface";
     let present = [
-        (e.textures, "diffuse textures: present but not applied; preview shows element radiosity only"),
-        (e.normal_maps, "normal maps: present but not applied; preview shades with the triangle normals"),
-        (e.alpha_masks, "alpha masks: present but not applied; camera rays hit the whole triangles"),
-        (e.specular_reflection, "specular reflection: present but not traced; mirrors show their diffuse radiosity"),
-        (e.specular_transmission, "specular transmission: present but not traced; glass shows its diffuse radiosity"),
-        (e.diffuse_transmission, "diffuse transmission: back faces shade black, radiosity in the solution is one-sided"),
+        (e.textures && !detail, format!("diffuse textures: {no_surface}; the image shows element radiosity only")),
+        (e.normal_maps && !detail, format!("normal maps: {no_surface}; cosines use the triangle normals")),
+        (e.normal_maps && detail && mode == Mode::Preview, "normal maps: the preview shows the solver's element radiosity; the full gather applies them".to_string()),
+        (e.alpha_masks && !detail, format!("alpha masks: {no_surface}; rays hit the whole triangles")),
+        (e.specular_reflection, "specular reflection: present but not traced; mirrors show their diffuse radiosity".to_string()),
+        (e.specular_transmission, "specular transmission: present but not traced; glass shows its diffuse radiosity".to_string()),
+        (e.diffuse_transmission, "diffuse transmission: back faces shade black, radiosity in the solution is one-sided".to_string()),
     ];
-    skipped.extend(present.iter().filter(|(on, _)| *on).map(|(_, why)| why.to_string()));
+    skipped.extend(present.into_iter().filter(|(on, _)| *on).map(|(_, why)| why));
     skipped
 }
 

@@ -9,7 +9,10 @@ use schemas::cluster::Clusters;
 use schemas::exr_io::{write_exr, Channel, ExrArtifact, Layer, LayerKind};
 use schemas::header::{Header, Schema};
 use schemas::image::HdrImage;
+use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
+use schemas::surface::Surface;
+use grid_gather::detail::Detail;
 use schemas::threshold::ThresholdImage;
 use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use schemas::Result;
@@ -81,6 +84,10 @@ struct Args {
     /// Manifest (manifest.ron from mesh-prep): camera, effects.
     #[arg(long, value_name = "MANIFEST.ron", required_unless_present = "print_params")]
     manifest: Option<PathBuf>,
+    /// Surface detail (surface.exr from mesh-prep --surface): textures,
+    /// alpha masks and normal maps, read only when the scene has some.
+    #[arg(long, value_name = "SURFACE.exr")]
+    surface: Option<PathBuf>,
     /// Radiosity solution (solution.exr from hierarchical-solve).
     #[arg(long, value_name = "SOLUTION.exr", required_unless_present = "print_params")]
     solution: Option<PathBuf>,
@@ -258,7 +265,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     };
 
     check_outputs(
-        &[args.mesh.as_deref(), args.manifest.as_deref(), args.solution.as_deref()],
+        &[args.mesh.as_deref(), args.manifest.as_deref(), args.solution.as_deref(), args.surface.as_deref()],
         &[Some(output), args.diagnostics.as_deref(), args.stage.report.as_deref()],
     )?;
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));
@@ -283,8 +290,14 @@ fn run(args: &Args) -> Result<ExitCode> {
         None => None,
     };
 
+    let e = &manifest.effects;
+    let surface = match &args.surface {
+        Some(path) if e.textures || e.alpha_masks || e.normal_maps => Some(read_surface(&mut run, path, &mesh, &manifest, &solution)?),
+        _ => None,
+    };
+    let detail = surface.as_ref().map(|(s, solved_with)| Detail::new(s, &mesh, &manifest, *solved_with));
     let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path, solution: &solution, solution_path };
-    let extras = Extras { clusters: clusters.as_ref(), threshold: threshold.as_ref() };
+    let extras = Extras { clusters: clusters.as_ref(), threshold: threshold.as_ref(), detail: detail.as_ref() };
     let bar = progress(image_size(&params, &manifest).1.into(), "rows");
     let rendered = gather_with(&params, &scene, extras, &|rows| bar.inc(rows));
     bar.finish_and_clear();
@@ -312,6 +325,24 @@ fn run(args: &Args) -> Result<ExitCode> {
     }
     outputs.keep()?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// Reads the surface artifact at `path` for `mesh`: it must come from the
+/// mesh-prep run that wrote the mesh. Also says whether `solution` was
+/// solved with it (an input of the solve has the same content), so that its
+/// element radiosity reflects the texture averages ([`Detail::new`]).
+fn read_surface(run: &mut Run, path: &std::path::Path, mesh: &Mesh, manifest: &Manifest, solution: &Solution) -> Result<(Surface, bool)> {
+    let (surface, input) = Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
+    if surface.header.provenance != mesh.header.provenance {
+        return Err(schemas::Error::invalid(path, None, "does not belong with the mesh: they come from different mesh-prep runs (their provenance differs); rerun it to write both"));
+    }
+    let solved_with = solution.header.provenance.inputs.iter().any(|i| i.sha256 == input.sha256);
+    // Recorded without the provenance it carries, which is the mesh's
+    // (checked above, and recorded with the mesh): a solution solved
+    // without the surface artifact (a solver that does not read it) then
+    // is not refused as made from another mesh-prep run.
+    run.input(schemas::header::Input { made_by: None, ..input })?;
+    Ok((surface, solved_with))
 }
 
 /// A warning when more than 1% of the camera's hits are back faces, which

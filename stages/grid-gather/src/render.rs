@@ -1,5 +1,6 @@
 //! Camera rays through the pixels, closest hits, and the per-pixel mean.
 
+use crate::detail::Detail;
 use crate::gouraud::Gouraud;
 use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
 use radiometry::camera::Pinhole;
@@ -15,14 +16,30 @@ pub struct View<'a> {
     pub camera: &'a Pinhole,
     /// Triangle geometry, mesh frame.
     pub triangles: &'a [TriangleGeometry],
-    /// BVH over `triangles`; `None` for an empty scene.
+    /// BVH over `triangles` (its rays pass through alpha-masked holes);
+    /// `None` for an empty scene.
     pub rays: Option<&'a SceneRays>,
     /// Radiosity over the surfaces.
     pub shading: &'a Gouraud,
+    /// Textures, in a scene that has them.
+    pub textured: Option<Textured<'a>>,
     /// The surface of each triangle, for the image's surface layer.
     pub surfaces: &'a [SurfaceId],
     /// Hit normals further apart than this make a pixel an edge, degrees.
     pub crease_angle_deg: f64,
+}
+
+/// What the display of a textured scene adds ([`crate::detail`]): at a
+/// hit on a textured triangle, `B(x) = E + rho(x) H(x)` with the texture's
+/// `rho(x)` and `H` interpolated like the radiosity.
+#[derive(Clone, Copy)]
+pub struct Textured<'a> {
+    /// The texture lookups.
+    pub detail: &'a Detail<'a>,
+    /// Irradiance `H` over the surfaces (Gouraud over the elements' `H_e`).
+    pub irradiance: &'a Gouraud,
+    /// Emitted radiosity of each triangle's material, W/m².
+    pub emission: &'a [[f64; 3]],
 }
 
 /// How pixels are sampled.
@@ -136,6 +153,14 @@ fn trace(view: &View, x: f64, y: f64) -> Option<(u32, Option<[f64; 3]>)> {
         return Some((hit.triangle, None));
     }
     let point = view.camera.eye + direction * f64::from(hit.t);
-    let radiosity = view.shading.radiosity(hit.triangle, triangle.uv_of(point));
+    let uv = triangle.uv_of(point);
+    let textured = view.textured.and_then(|t| Some((t, t.detail.reflectance(hit.triangle, uv)?)));
+    let radiosity = match textured {
+        Some((t, rho)) => {
+            let (e, h) = (t.emission[hit.triangle as usize], t.irradiance.radiosity(hit.triangle, uv));
+            std::array::from_fn(|c| e[c] + rho[c] * h[c])
+        }
+        None => view.shading.radiosity(hit.triangle, uv),
+    };
     Some((hit.triangle, Some(radiosity.map(|b| b / PI))))
 }

@@ -243,7 +243,7 @@ pub(crate) fn clustered_box(triangles: usize, eps: f64) -> (Mesh, Manifest, Solu
 
 fn run_clustered(mesh: &Mesh, manifest: &Manifest, solution: &Solution, clusters: &schemas::cluster::Clusters, params: &Params) -> (Rendered, Diagnostics) {
     let scene = Scene { mesh, manifest, manifest_path: Path::new("m.ron"), solution, solution_path: Path::new("s.exr") };
-    let extras = Extras { clusters: Some(clusters), threshold: None };
+    let extras = Extras { clusters: Some(clusters), ..Extras::default() };
     let (r, d) = gather_with(params, &scene, extras, &|_| {}).expect("gather");
     (r, d.expect("diagnostics"))
 }
