@@ -1,6 +1,8 @@
-//! Measuring helpers the benchmark binaries share, and the sweep of error
-//! against time ([`sweep`], the `sweep` binary).
+//! Measuring helpers the benchmark binaries share, the sweep of error
+//! against time ([`sweep`], the `sweep` binary), and paper 002's
+//! benchmark of structured sampling ([`structured`], `bench-structured`).
 
+pub mod structured;
 pub mod sweep;
 
 /// The process's peak resident memory (VmHWM), MiB; `None` off Linux.

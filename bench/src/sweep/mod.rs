@@ -68,6 +68,7 @@ use knobs::{Gather, Knob, Setting, Solver, Target};
 use pareto::Spread;
 use schemas::header::{Input, Schema};
 use schemas::mesh::{Manifest, Mesh};
+use schemas::report::Report;
 use schemas::ron_io::read_bytes;
 use schemas::stage::{bad_parameter, read_prepared, Run};
 use schemas::{Error, Result};
@@ -235,23 +236,28 @@ fn s(path: &Path) -> String {
 }
 
 /// The prepared scene every run reads.
-struct Prepared {
-    mesh: PathBuf,
-    manifest: PathBuf,
+pub struct Prepared {
+    /// mesh-prep's mesh.exr.
+    pub mesh: PathBuf,
+    /// mesh-prep's manifest.ron.
+    pub manifest: PathBuf,
 }
 
 /// One run of a solver and its gathers: times per stage and the files.
-struct RunOutput {
+pub struct RunOutput {
     /// (stage, seconds), pipeline order, gathers excluded.
-    solve_stages: Vec<(String, f64)>,
-    solution: PathBuf,
+    pub solve_stages: Vec<(String, f64)>,
+    /// The solver's output (solution.exr, or structured-sample's samples.exr).
+    pub solution: PathBuf,
     /// Per gather mode: seconds and image.
-    gathers: Vec<(Gather, f64, PathBuf)>,
+    pub gathers: Vec<(Gather, f64, PathBuf)>,
+    /// The solver stage's report.
+    pub solve_report: Report,
 }
 
 /// Runs the solver at `setting` and then each gather, in `dir`.
 #[allow(clippy::too_many_arguments)]
-fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solver: Solver, setting: &Setting, gathers: &[Gather], seeds: (u64, u64), dir: &Path) -> Result<RunOutput> {
+pub fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solver: Solver, setting: &Setting, gathers: &[Gather], seeds: (u64, u64), dir: &Path) -> Result<RunOutput> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let scene = ["--mesh".to_string(), s(&prepared.mesh), "--manifest".to_string(), s(&prepared.manifest)];
     let mut solve_stages = Vec::new();
@@ -276,8 +282,8 @@ fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solver: S
         args.extend(config.height.map(|h| format!("--height={h}")));
     }
     args.extend(solve_flags(solver, setting, seeds.0));
-    let report = stages.run(solver.stage(), &args, &dir.join("solve.report.ron"))?;
-    solve_stages.push((solver.stage().to_string(), report.wall_time_s));
+    let solve_report = stages.run(solver.stage(), &args, &dir.join("solve.report.ron"))?;
+    solve_stages.push((solver.stage().to_string(), solve_report.wall_time_s));
     let mut images = Vec::new();
     for &gather in gathers {
         if gather == Gather::Own {
@@ -295,7 +301,7 @@ fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solver: S
         let report = stages.run("grid-gather", &args, &dir.join(format!("{}.report.ron", gather.name())))?;
         images.push((gather, report.wall_time_s, image));
     }
-    Ok(RunOutput { solve_stages, solution, gathers: images })
+    Ok(RunOutput { solve_stages, solution, gathers: images, solve_report })
 }
 
 /// compare's `relative_rmse` of `a` against `b`, its report in `report`.
@@ -307,7 +313,7 @@ fn error(stages: &Stages, a: &Path, b: &Path, flags: &[&str], report: &Path) -> 
 }
 
 /// How points are compared with the reference.
-enum Measure {
+pub enum Measure {
     /// Solutions against the closed-form solution.
     Solution(PathBuf),
     /// Images against a reference image, with compare's flags.
@@ -331,12 +337,13 @@ impl Measure {
     }
 }
 
-fn knob_values(setting: &Setting) -> Vec<KnobValue> {
+/// A setting's knob values as the table records them.
+pub fn knob_values(setting: &Setting) -> Vec<KnobValue> {
     setting.iter().map(|(k, v)| KnobValue { name: k.name.to_string(), value: *v }).collect()
 }
 
 /// The directory name of a setting.
-fn setting_dir(setting: &Setting) -> String {
+pub fn setting_dir(setting: &Setting) -> String {
     let label = knobs::label(setting);
     if label.is_empty() {
         "default".to_string()
@@ -346,7 +353,7 @@ fn setting_dir(setting: &Setting) -> String {
 }
 
 /// Checks every point's flags with the stages themselves before running.
-fn check_flags(stages: &Stages, config: &Config, plans: &[Plan]) -> Result<()> {
+pub fn check_flags(stages: &Stages, config: &Config, plans: &[Plan]) -> Result<()> {
     for plan in plans {
         for setting in &plan.settings {
             let named = |e: Error| bad_parameter(format!("--knob {}: {e}", knobs::label(setting)));
@@ -357,6 +364,20 @@ fn check_flags(stages: &Stages, config: &Config, plans: &[Plan]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Prepares the scene into the output directory (mesh-prep) and reads it
+/// back as an input of `record`; returns the files, their content and
+/// mesh-prep's report.
+pub fn prepare(stages: &Stages, config: &Config, record: &mut Run, progress: &mut dyn FnMut(&str)) -> Result<(Prepared, Mesh, Manifest, Report)> {
+    let out = &config.out;
+    let prepared = Prepared { mesh: out.join("mesh.exr"), manifest: out.join("manifest.ron") };
+    let mut args = config.scene_args();
+    args.extend(["--mesh".into(), s(&prepared.mesh), "--manifest".into(), s(&prepared.manifest)]);
+    let mesh_prep = stages.run("mesh-prep", &args, &out.join("mesh-prep.report.ron"))?;
+    let (mesh, manifest) = read_prepared(record, &prepared.mesh, &prepared.manifest)?;
+    progress(&format!("mesh-prep: {} triangles, {:.2} s", mesh.triangles.len(), mesh_prep.wall_time_s));
+    Ok((prepared, mesh, manifest, mesh_prep))
 }
 
 /// Runs the sweep of `plans` (from [`plan`]); `progress` gets one line per run.
@@ -373,12 +394,7 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
     let mut record = Run::start("sweep", env!("CARGO_PKG_VERSION"));
 
     // The scene, once.
-    let prepared = Prepared { mesh: out.join("mesh.exr"), manifest: out.join("manifest.ron") };
-    let mut args = config.scene_args();
-    args.extend(["--mesh".into(), s(&prepared.mesh), "--manifest".into(), s(&prepared.manifest)]);
-    let mesh_prep = stages.run("mesh-prep", &args, &out.join("mesh-prep.report.ron"))?;
-    let (mesh, manifest) = read_prepared(&mut record, &prepared.mesh, &prepared.manifest)?;
-    progress(&format!("mesh-prep: {} triangles, {:.2} s", mesh.triangles.len(), mesh_prep.wall_time_s));
+    let (prepared, mesh, manifest, mesh_prep) = prepare(stages, config, &mut record, progress)?;
 
     // The reference.
     let reference_dir = out.join("reference");
@@ -541,7 +557,7 @@ pub const EXACT_BOUNCES: u32 = 20;
 
 /// The exact image as the reference, if the `exact` stage renders the
 /// scene; else its refusal, one line.
-fn exact_reference(stages: &Stages, config: &Config, prepared: &Prepared, dir: &Path) -> std::result::Result<(Reference, Measure), String> {
+pub fn exact_reference(stages: &Stages, config: &Config, prepared: &Prepared, dir: &Path) -> std::result::Result<(Reference, Measure), String> {
     let image = dir.join("exact.exr");
     let mut args = vec!["--mesh".to_string(), s(&prepared.mesh), "--manifest".into(), s(&prepared.manifest), "-o".into(), s(&image)];
     args.push(format!("--bounces={EXACT_BOUNCES}"));
@@ -555,7 +571,7 @@ fn exact_reference(stages: &Stages, config: &Config, prepared: &Prepared, dir: &
 /// The reference of a scene with neither a closed form nor an exact image:
 /// the `--reference` EXR, else the strictest run of `plan`.
 #[allow(clippy::too_many_arguments)]
-fn other_reference(
+pub fn other_reference(
     stages: &Stages,
     config: &Config,
     plan: &Plan,
@@ -583,7 +599,7 @@ fn other_reference(
 /// knob beyond its strictest value and SPP 4x, in the most accurate
 /// gather swept, with seeds no point uses. Returns the reference and its
 /// image.
-fn strictest_run(stages: &Stages, config: &Config, plan: &Plan, prepared: &Prepared, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<(Reference, PathBuf)> {
+pub fn strictest_run(stages: &Stages, config: &Config, plan: &Plan, prepared: &Prepared, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<(Reference, PathBuf)> {
     let mut setting: Setting = plan.knobs.iter().map(|(k, values)| (*k, k.beyond(values))).collect();
     if !setting.iter().any(|(k, _)| k.name == "SPP") {
         let spp = knobs::knob("SPP").expect("SPP is a knob");
