@@ -1,4 +1,4 @@
-//! Surface detail in hierarchical-solve (issue 13, items 2, 3 and 8),
+//! Surface detail in hierarchical-solve (issue 13, items 2, 3, 4 and 8),
 //! per element against closed forms written here: Lambert's polygon
 //! factor (`closed_form::lambert_polygon`) for the light, and the texture
 //! read back from `surface.exr` with a bilinear lookup written here, apart
@@ -296,6 +296,40 @@ fn an_alpha_masked_occluder_with_a_hole_lets_the_holes_lambert_contribution_thro
     }
     eprintln!("occluder with a hole: {lit} lit elements (worst {:.3}% off Lambert), {dark} dark", 100.0 * worst);
     assert!(lit >= 16 && dark >= 16, "{lit} lit, {dark} dark");
+}
+
+#[test]
+fn a_floor_whose_normal_map_tilts_every_normal_matches_lambert_for_the_tilted_normal() {
+    let dir = scratch("surface_solver_normal_map");
+    // Every texel the tangent-space normal tilted 20 degrees towards +u
+    // (the floor's +x), 8-bit: c = (n + 1) / 2.
+    let (sin, cos) = 20f64.to_radians().sin_cos();
+    let byte = |x: f64| ((x + 1.0) / 2.0 * 255.0).round() as u8;
+    let pixels = vec![[byte(sin), byte(0.0), byte(cos)]; 4];
+    std::fs::write(dir.join("tilt.png"), schemas::png::encode_png(2, 2, &pixels).unwrap()).unwrap();
+    let lamp = [[0.3, 0.3, 0.4], [0.7, 0.3, 0.4], [0.7, 0.7, 0.4], [0.3, 0.7, 0.4]];
+    let quads = [floor("floor", "bumpy", 0.0), ceiling("lamp", "lamp", 0.3, 0.7, 0.4)];
+    let mtl = "newmtl bumpy\nKd 0.5 0.5 0.5\nnorm tilt.png\nnewmtl lamp\nKd 0 0 0\n";
+    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    let solved = prepare_and_solve(&dir, &scene, &[]);
+    assert!(!solved.report.contains("normal maps:"), "normal maps leave the skipped list: {}", solved.report);
+    // The normal the map holds, from the texel as read back: tangent +x,
+    // bitangent +y on this floor (u = x, v = y).
+    let c = solved.surface.textures[0].texels[0].map(f64::from);
+    let n = [2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0];
+    let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let tilted = n.map(|x| x / length);
+    assert!((tilted[0].atan2(tilted[2]).to_degrees() - 20.0).abs() < 0.3, "{tilted:?}");
+    let mut worst = 0.0f64;
+    for e in solved.leaves_of("bumpy") {
+        // The whole lamp lies above every tilted tangent plane here, so
+        // Lambert's contour formula needs no clipping.
+        let expected = solved.mean(e, &|x, _| 0.5 * 10.0 * lambert_polygon(x, tilted, &lamp));
+        let got = f64::from(e.radiosity[0]);
+        worst = worst.max((got - expected).abs() / expected);
+        assert!((got - expected).abs() <= 5e-3 * expected, "element at {:?}: {got} vs {expected}", solved.world(e)[0]);
+    }
+    eprintln!("normal-mapped floor: worst element {:.3}% off Lambert for the tilted normal", 100.0 * worst);
 }
 
 #[test]

@@ -8,7 +8,7 @@ use crate::detail::Detail;
 use crate::elements::Hierarchy;
 use crate::transfer;
 use glam::DVec3;
-use radiometry::form_factor::{triangle_to_polygon, AreaFactor};
+use radiometry::form_factor::{point_to_one_sided_polygon, triangle_to_polygon, AreaFactor};
 use schemas::solution::Node;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -220,7 +220,7 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
             if h.coverage(receiver) == 0.0 || h.coverage(sender) == 0.0 {
                 return None;
             }
-            masked_factor(h, detail, receiver, sender, quadrature_depth)
+            detailed_factor(h, detail, receiver, sender, quadrature_depth)
         }
     };
     (f.mean > 0.0).then_some(Link {
@@ -233,21 +233,53 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
     })
 }
 
-/// The factor from element `r` to the opaque part of element `s`
-/// ([`crate::detail`]): Lambert's factor summed over the polygons of its
-/// opaque texel runs, or, where it has no mask or too many runs, the
-/// factor to the whole element times its coverage. The spread is the
-/// summed pieces' (an upper bound of the point values' spread).
-fn masked_factor(h: &Hierarchy, detail: &Detail, receiver: u32, sender: u32, depth: u32) -> AreaFactor {
+/// The factor from element `receiver` to the opaque part of element
+/// `sender` ([`crate::detail`]): summed over the polygons of the sender's
+/// opaque texel runs, or, where it has no mask or too many runs, the factor
+/// to the whole element times its coverage; each polygon's by
+/// [`triangle_to_polygon`], or by [`normal_mapped_factor`] where the
+/// receiver has a normal map. The spread is the summed pieces' (an upper
+/// bound of the point values' spread).
+fn detailed_factor(h: &Hierarchy, detail: &Detail, receiver: u32, sender: u32, depth: u32) -> AreaFactor {
     let (r, s) = (&h.elements[receiver as usize], &h.elements[sender as usize]);
     let (nr, ns) = (h.normal(receiver), h.normal(sender));
-    let Some(parts) = detail.opaque_parts(s.triangle, &s.corners, &h.triangles[s.triangle as usize]) else {
-        let (whole, c) = (triangle_to_polygon(&r.points, nr, &s.points, ns, depth), h.coverage(sender));
-        return AreaFactor { mean: c * whole.mean, min: c * whole.min, max: c * whole.max };
+    let (parts, scale) = match detail.opaque_parts(s.triangle, &s.corners, &h.triangles[s.triangle as usize]) {
+        Some(parts) => (parts, 1.0),
+        None => (vec![s.points.to_vec()], h.coverage(sender)),
     };
-    parts.iter().map(|p| triangle_to_polygon(&r.points, nr, p, ns, depth)).fold(AreaFactor { mean: 0.0, min: 0.0, max: 0.0 }, |a, f| {
-        AreaFactor { mean: a.mean + f.mean, min: a.min + f.min, max: a.max + f.max }
+    let factor = |part: &[DVec3]| {
+        if detail.normal_mapped(r.triangle) {
+            normal_mapped_factor(h, detail, receiver, part, ns)
+        } else {
+            triangle_to_polygon(&r.points, nr, part, ns, depth)
+        }
+    };
+    parts.iter().map(|p| factor(p)).fold(AreaFactor { mean: 0.0, min: 0.0, max: 0.0 }, |a, f| AreaFactor {
+        mean: a.mean + scale * f.mean,
+        min: a.min + scale * f.min,
+        max: a.max + scale * f.max,
     })
+}
+
+/// The factor from normal-mapped element `receiver` to the one-sided
+/// polygon `sender` (front `front`): Lambert's point factor with the
+/// perturbed normal, averaged by the centroid rule of [`crate::detail`].
+fn normal_mapped_factor(h: &Hierarchy, detail: &Detail, receiver: u32, sender: &[DVec3], front: DVec3) -> AreaFactor {
+    let r = &h.elements[receiver as usize];
+    let (g, n) = (&h.triangles[r.triangle as usize], h.normal(receiver));
+    let mut parts = vec![r.corners];
+    for _ in 0..crate::detail::NORMAL_MAP_LEVELS {
+        parts = parts.iter().flat_map(radiometry::subdivision::children).collect();
+    }
+    let mut f = AreaFactor { mean: 0.0, min: f64::INFINITY, max: 0.0 };
+    for p in &parts {
+        let at = [0, 1].map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
+        let value = point_to_one_sided_polygon(g.point(at), detail.normal_at(r.triangle, at, n), sender, front);
+        f.mean += value / parts.len() as f64;
+        f.min = f.min.min(value);
+        f.max = f.max.max(value);
+    }
+    f
 }
 
 /// The smallest element areas a split may make (m²).

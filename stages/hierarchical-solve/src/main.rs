@@ -113,8 +113,8 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
 }
 
 /// What this stage does not simulate, for the effects the scene has;
-/// `surface`: whether surface.exr was given (textures and alpha masks are
-/// simulated from it).
+/// `surface`: whether surface.exr was given (textures, alpha masks and
+/// normal maps are simulated from it).
 fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
@@ -123,7 +123,7 @@ fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
         (effects.diffuse_transmission, "diffuse transmission: not simulated by hierarchical-solve"),
         (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),
         (effects.alpha_masks && !surface, "alpha masks: no --surface given; surfaces are treated as opaque"),
-        (effects.normal_maps, "normal maps: radiosity uses geometric normals"),
+        (effects.normal_maps && !surface, "normal maps: no --surface given; radiosity uses geometric normals"),
     ])
 }
 
