@@ -24,8 +24,10 @@ $(GPU_OUT)/params/gpu-shoot.ron: $(BIN)/gpu-shoot FORCE | $(GPU_OUT)/params
 	@$(BIN)/gpu-shoot --print-params --texels $(GPU_TEXELS) --visibility $(GPU_VISIBILITY) --convergence-target $(GPU_CONVERGENCE) \
 	  --shoot-level $(GPU_SHOOT_LEVEL) --resolution $(GPU_RESOLUTION) $(GPU_OVERSHOOT) > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
 
-$(GPU_OUT)/solution.exr $(GPU_OUT)/lightmap.exr &: $(BIN)/gpu-shoot $(GPU_OUT)/params/gpu-shoot.ron $(OUT)/mesh.exr $(OUT)/manifest.ron | $(GPU_OUT)
-	$(BIN)/gpu-shoot --params $(GPU_OUT)/params/gpu-shoot.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron \
+# surface.exr: textures, alpha masks and normal maps, which gpu-shoot
+# simulates per texel (read only for a scene that has them).
+$(GPU_OUT)/solution.exr $(GPU_OUT)/lightmap.exr &: $(BIN)/gpu-shoot $(GPU_OUT)/params/gpu-shoot.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr | $(GPU_OUT)
+	$(BIN)/gpu-shoot --params $(GPU_OUT)/params/gpu-shoot.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr \
 	  -o $(GPU_OUT)/solution.exr --lightmap $(GPU_OUT)/lightmap.exr --convergence-log $(GPU_OUT)/convergence.ron \
 	  --plot $(GPU_OUT)/convergence.svg --report $(GPU_OUT)/gpu-shoot.report.ron
 

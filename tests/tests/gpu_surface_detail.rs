@@ -115,3 +115,14 @@ fn an_alpha_masked_half_floor_does_not_exist_end_to_end() {
     assert!(!report.skipped.iter().any(|s| s.starts_with("alpha")), "{:?}", report.skipped);
     assert!(report.counters["mask_texels"] > 0.0);
 }
+
+/// A surface artifact from another mesh-prep run is refused, naming it,
+/// and nothing is written.
+#[test]
+fn a_surface_from_another_run_is_refused() {
+    let (dir, other) = (prepared("gpu_surface_refused", "map_Kd halves.png\n", 255, 188), prepared("gpu_surface_other", "map_d halves.png\n", 255, 0));
+    let [mesh, manifest, solution] = ["mesh.exr", "manifest.ron", "solution.exr"].map(|f| dir.join(f));
+    let surface = other.join("surface.exr");
+    let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "--surface", s(&surface), "-o", s(&solution)];
+    end_to_end::assert_refused("gpu-shoot", &args, &["surface.exr", "not written by the mesh-prep run that wrote the mesh"], &[&solution]);
+}

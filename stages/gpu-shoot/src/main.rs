@@ -30,7 +30,8 @@ struct Args {
     #[arg(long, required_unless_present = "print_params")]
     manifest: Option<PathBuf>,
     /// Input: surface.exr from mesh-prep --surface (textures, alpha masks,
-    /// normal maps); without it those effects are skipped.
+    /// normal maps), read only when the manifest says the scene has one of
+    /// them; without it those effects are skipped.
     #[arg(long)]
     surface: Option<PathBuf>,
     /// Output: the solution (elements averaging the atlas; no links).
@@ -177,7 +178,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     )?;
     let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
-    let surface = match &args.surface {
+    let e = &manifest.effects;
+    let detailed = e.textures || e.alpha_masks || e.normal_maps;
+    let surface = match args.surface.as_ref().filter(|_| detailed) {
         Some(path) => {
             let (surface, input) = Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
             if surface.header.provenance != mesh.header.provenance {
@@ -245,7 +248,10 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("shoot_seconds".to_string(), w.shoot_seconds),
             ("seconds_per_shot".to_string(), w.shoot_seconds / (w.shots.max(1) as f64)),
         ]);
-        let notes = vec![format!("adapter: {adapter}")];
+        let mut notes = vec![format!("adapter: {adapter}")];
+        if args.surface.is_some() && !detailed {
+            notes.push("surface.exr not read: the scene has no texture, alpha mask or normal map".into());
+        }
         outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects, surface.is_some()), notes))?;
     }
     outputs.keep()?;
