@@ -41,9 +41,11 @@ $(OUT)/solution.exr: $(BIN)/hierarchical-solve $(OUT)/params/hierarchical-solve.
 	$(BIN)/hierarchical-solve --params $(OUT)/params/hierarchical-solve.ron \
 	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) -o $@ --report $(OUT)/solve.report.ron
 
-$(OUT)/preview.exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/solution.exr
+# grid-gather reads surface.exr only for a scene with textures, alpha masks
+# or normal maps (the display modulates by the texture per hit).
+$(OUT)/preview.exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(OUT)/solution.exr
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --solution $(OUT)/solution.exr -o $@ --report $(OUT)/gather.report.ron
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr --solution $(OUT)/solution.exr -o $@ --report $(OUT)/gather.report.ron
 
 $(OUT)/image.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(OUT)/preview.exr
 	$(BIN)/tonemap --params $(OUT)/params/tonemap.ron $(OUT)/preview.exr -o $@ --report $(OUT)/tonemap.report.ron
@@ -69,9 +71,9 @@ $(OUT)/threshold.exr: $(BIN)/mask $(OUT)/params/mask.ron $(OUT)/image.png
 $(OUT)/params/grid-gather-full.ron: $(BIN)/grid-gather FORCE | $(OUT)/params
 	@$(BIN)/grid-gather --print-params --mode full --spp $(SPP) $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT)) $(GATHER_FLAGS) > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
 
-$(OUT)/final.exr $(OUT)/final.diagnostics.exr &: $(BIN)/grid-gather $(OUT)/params/grid-gather-full.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/solution.exr $(if $(MASK),$(OUT)/threshold.exr) $(CLUSTERS_EXR)
+$(OUT)/final.exr $(OUT)/final.diagnostics.exr &: $(BIN)/grid-gather $(OUT)/params/grid-gather-full.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(OUT)/solution.exr $(if $(MASK),$(OUT)/threshold.exr) $(CLUSTERS_EXR)
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather-full.ron \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --solution $(OUT)/solution.exr $(if $(MASK),--threshold $(OUT)/threshold.exr) $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) \
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr --solution $(OUT)/solution.exr $(if $(MASK),--threshold $(OUT)/threshold.exr) $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) \
 	  -o $(OUT)/final.exr --diagnostics $(OUT)/final.diagnostics.exr --report $(OUT)/final.report.ron
 
 $(OUT)/final.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(OUT)/final.exr

@@ -133,7 +133,9 @@ fn gather(dir: &Path, mode: &str) -> HdrImage {
         &["--mode", mode, "--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "--surface", s(&surface), "-o", s(&image), "--report", s(&report), "--spp", "16"],
     );
     let text = std::fs::read_to_string(&report).unwrap();
-    for effect in ["diffuse textures", "alpha masks"] {
+    // The preview shows the solver's cosines; the full gather applies the normal map.
+    let simulated: &[&str] = if mode == "full" { &["diffuse textures", "alpha masks", "normal maps"] } else { &["diffuse textures", "alpha masks"] };
+    for effect in simulated {
         assert!(!text.contains(effect), "the report lists {effect} as skipped: {text}");
     }
     HdrImage::read(&image).unwrap().0
@@ -328,4 +330,27 @@ fn a_material_scattering_more_than_it_receives_is_refused_naming_file_material_a
     let args = [s(&scene), "--mesh", s(&mesh), "--manifest", s(&manifest)];
     let needles = ["scene.ron", "material 'sheet'", "diffuse + diffuse_transmittance is 1.25 in channel 1"];
     assert_refused("mesh-prep", &args, &needles, &[&mesh, &manifest]);
+}
+
+#[test]
+fn a_scene_without_surface_detail_renders_the_same_pixels_and_never_reads_the_surface_artifact() {
+    let (dir, scene) = display_scene("display_plain", "Kd 0.5\n", None, &[]);
+    prepare_and_solve(&dir, &scene, true);
+    let [mesh, manifest] = outputs(&dir);
+    let solution = dir.join("solution.exr");
+    for mode in ["preview", "full"] {
+        let render = |surface: Option<&Path>, name: &str| {
+            let image = dir.join(name);
+            let mut args = vec!["--mode", mode, "--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "-o", s(&image), "--width", "24", "--height", "24"];
+            if let Some(surface) = surface {
+                args.extend(["--surface", s(surface)]);
+            }
+            run_ok("grid-gather", &args);
+            HdrImage::read(&image).unwrap().0
+        };
+        let (plain, given) = (render(None, "plain.exr"), render(Some(&dir.join("surface.exr")), "given.exr"));
+        assert_eq!((&plain.rgb, &plain.coverage, &plain.surfaces), (&given.rgb, &given.coverage, &given.surfaces), "{mode}");
+        let inputs: Vec<&str> = given.header.provenance.inputs.iter().map(|i| i.path.as_str()).collect();
+        assert!(!inputs.iter().any(|p| p.ends_with("surface.exr")), "{mode}: the surface artifact was read: {inputs:?}");
+    }
 }
