@@ -104,6 +104,19 @@ impl Solved {
         self.solution.elements.iter().filter(|e| e.first_child == NONE && self.mesh.triangles[e.triangle as usize].material == m).collect()
     }
 
+    /// The largest relative difference of the radiosity of the leaves of
+    /// material `name` from the area-mean of `expected` over each;
+    /// asserts each is within `tolerance`.
+    fn check_leaves(&self, name: &str, tolerance: f64, expected: &dyn Fn([f64; 3], [f64; 2]) -> f64) -> f64 {
+        let mut worst = 0.0f64;
+        for e in self.leaves_of(name) {
+            let (got, expected) = (f64::from(e.radiosity[0]), self.mean(e, expected));
+            worst = worst.max((got - expected).abs() / expected);
+            assert!((got - expected).abs() <= tolerance * expected, "element at {:?}: {got} vs {expected}", self.world(e)[0]);
+        }
+        worst
+    }
+
     /// World corners of element `e`.
     fn world(&self, e: &Element) -> [[f64; 3]; 3] {
         leaf_world_corners(&self.mesh, self.manifest.world_from_mesh_translation, e)
@@ -159,15 +172,8 @@ fn a_checkerboard_floor_under_a_square_emitter_has_each_elements_radiosity_rho_t
     let solved = prepare_and_solve(&dir, &scene, &[]);
     assert!(!solved.report.contains("textures:"), "textures leave the skipped list: {}", solved.report);
     let texture = &solved.surface.textures[0];
-    let leaves = solved.leaves_of("checks");
-    assert!(leaves.len() >= 64, "{}", leaves.len());
-    let mut worst = 0.0f64;
-    for e in leaves {
-        let expected = solved.mean(e, &|x, uv| bilinear_clamped(texture, uv) * 10.0 * lambert_polygon(x, UP, &lamp));
-        let got = f64::from(e.radiosity[0]);
-        worst = worst.max((got - expected).abs() / expected);
-        assert!((got - expected).abs() <= 5e-3 * expected, "element at {:?}: {got} vs rho E = {expected}", solved.world(e)[0]);
-    }
+    assert!(solved.leaves_of("checks").len() >= 64);
+    let worst = solved.check_leaves("checks", 5e-3, &|x, uv| bilinear_clamped(texture, uv) * 10.0 * lambert_polygon(x, UP, &lamp));
     eprintln!("checkerboard floor: worst element {:.3}%", 100.0 * worst);
 }
 
@@ -320,15 +326,9 @@ fn a_floor_whose_normal_map_tilts_every_normal_matches_lambert_for_the_tilted_no
     let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
     let tilted = n.map(|x| x / length);
     assert!((tilted[0].atan2(tilted[2]).to_degrees() - 20.0).abs() < 0.3, "{tilted:?}");
-    let mut worst = 0.0f64;
-    for e in solved.leaves_of("bumpy") {
-        // The whole lamp lies above every tilted tangent plane here, so
-        // Lambert's contour formula needs no clipping.
-        let expected = solved.mean(e, &|x, _| 0.5 * 10.0 * lambert_polygon(x, tilted, &lamp));
-        let got = f64::from(e.radiosity[0]);
-        worst = worst.max((got - expected).abs() / expected);
-        assert!((got - expected).abs() <= 5e-3 * expected, "element at {:?}: {got} vs {expected}", solved.world(e)[0]);
-    }
+    // The whole lamp lies above every tilted tangent plane here, so
+    // Lambert's contour formula needs no clipping.
+    let worst = solved.check_leaves("bumpy", 5e-3, &|x, _| 0.5 * 10.0 * lambert_polygon(x, tilted, &lamp));
     eprintln!("normal-mapped floor: worst element {:.3}% off Lambert for the tilted normal", 100.0 * worst);
 }
 
