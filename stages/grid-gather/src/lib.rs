@@ -17,6 +17,11 @@
 //!   link of the hit point's element chain resampled at every camera
 //!   sample ([`full::brute_irradiance`]).
 //!
+//! With mesh-prep's surface artifact (`--surface`), every mode shows
+//! textures (`B = E + rho(x) H` per hit) and lets rays through alpha-masked
+//! holes, and the full and brute gathers take normal maps in their cosines
+//! ([`detail`]).
+//!
 //! ## Parameters
 //!
 //! | name | type | meaning | default |
