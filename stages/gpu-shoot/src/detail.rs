@@ -13,31 +13,24 @@
 //!   of the triangle's tangent, bitangent `w n x t` and normal, for the
 //!   receiver's and the shooter's cosines.
 //!
-//! Each texel is sampled on a `k x k` grid of its barycentric square (the
-//! part inside the triangle), `k` from the number of texture texels it
-//! spans, so a texture finer than the atlas is averaged, not aliased (the
-//! paper asks for matching resolutions; this keeps each texel's mean).
-//! Lookups take the nearest texture texel (MTL `-s`, `-o`, `-clamp`), the
-//! rule the visibility maps' alpha test mirrors (`visibility.wgsl`).
+//! Reflectance and coverage are the exact averages of `radiometry::texture`
+//! (the bilinear reflectance over the opaque part; a point exists where its
+//! alpha texel is above 0, the rule the visibility maps' alpha test
+//! mirrors in `visibility.wgsl`) over the texel's square in barycentrics
+//! (half of it on the hypotenuse), so a texture finer than the atlas is
+//! averaged, not aliased (the paper asks for matching resolutions; this
+//! keeps each texel's mean). The normal is the mean of the normal map's
+//! bilinear normals on a `k x k` grid of the texel, `k` from the number of
+//! map texels it spans.
 
 use glam::DVec3;
+use radiometry::texture::{average, bilinear, element_uv, Maps};
 use schemas::lightmap::Region;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::surface::{Surface, Texture, TextureKind, NONE};
 
-/// Most sub-samples per texel side.
+/// Most sub-samples per texel side of a normal map.
 const MAX_SUBSAMPLES: u32 = 8;
-
-/// The texture texel at `uv` (nearest): `scale uv + offset`, clamped to
-/// [0, 1] or repeated, row 0 at the top (`v = 1`).
-pub fn lookup(texture: &Texture, uv: [f64; 2]) -> [f32; 4] {
-    let st = [0, 1].map(|c| texture.scale[c] as f64 * uv[c] + texture.offset[c] as f64);
-    let wrap = |x: f64| if texture.clamp { x.clamp(0.0, 1.0) } else { x - x.floor() };
-    let (s, t) = (wrap(st[0]), wrap(st[1]));
-    let x = ((s * texture.width as f64).floor() as usize).min(texture.width - 1);
-    let y = (((1.0 - t) * texture.height as f64).floor() as usize).min(texture.height - 1);
-    texture.texels[y * texture.width + x]
-}
 
 /// A texel's detail.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,58 +91,66 @@ impl<'a> Detail<'a> {
     }
 
     /// The detail of covered texel `(i, j)` of triangle `t` (region
-    /// `region`), or `None` where its material has no texture. The texel's
-    /// barycentric square `[i, i+1] x [j, j+1] / n` is sampled at the
-    /// centres of a `k x k` grid, weight 1 inside the triangle and 1/2 on
-    /// its hypotenuse.
+    /// `region`), or `None` where its material has no texture (or the
+    /// triangle no texture coordinates). The texel's barycentric square
+    /// `[i, i+1] x [j, j+1] / n` is the triangles `(i, j), (i+1, j), (i,
+    /// j+1)` and, off the hypotenuse, `(i+1, j), (i+1, j+1), (i, j+1)`, of
+    /// equal area.
     pub fn texel(&self, mesh: &Mesh, manifest: &Manifest, t: usize, region: Region, i: u32, j: u32) -> Option<TexelDetail> {
-        let maps = [TextureKind::Diffuse, TextureKind::Alpha, TextureKind::Normal].map(|k| self.map(mesh, t, k));
-        if maps.iter().all(Option::is_none) {
+        let tri = &mesh.triangles[t];
+        let uv = self.uvs[t]?;
+        let maps = Maps::of(self.surface, tri.material);
+        let normal_map = self.map(mesh, t, TextureKind::Normal);
+        if maps.is_empty() && normal_map.is_none() {
             return None;
         }
-        let n = region.size;
-        // Texture texels one atlas texel spans, along its two edges.
-        let span = |(texture, uv): (&Texture, [[f32; 2]; 3])| {
-            let size = [texture.width as f64 * texture.scale[0].abs() as f64, texture.height as f64 * texture.scale[1].abs() as f64];
-            let edge = |c: usize| ((0..2).map(|a| ((uv[c][a] - uv[0][a]) as f64 * size[a]).powi(2)).sum::<f64>()).sqrt() / n as f64;
-            edge(1).max(edge(2))
-        };
-        let k = maps.iter().flatten().map(|&m| (2.0 * span(m)).ceil() as u32).max().unwrap_or(1).clamp(2, MAX_SUBSAMPLES);
-        let tri = &mesh.triangles[t];
+        let n = region.size as f64;
+        let at = |a: u32, b: u32| [a as f64 / n, b as f64 / n];
+        let mut halves = vec![[at(i, j), at(i + 1, j), at(i, j + 1)]];
+        if i + j + 1 < region.size {
+            halves.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+        let (mut coverage, mut rho) = (0.0, [0.0; 3]);
+        let diffuse = manifest.materials[tri.material as usize].diffuse;
+        for half in &halves {
+            let mean = average(maps, element_uv(&uv, half));
+            coverage += mean.coverage / halves.len() as f64;
+            let r = mean.reflectance.unwrap_or(diffuse);
+            (0..3).for_each(|c| rho[c] += r[c] * mean.coverage);
+        }
         let geometric = DVec3::from(tri.normal.map(f64::from));
-        let material = &manifest.materials[tri.material as usize];
-        let (mut weight, mut opaque) = (0.0f64, 0.0f64);
-        let (mut rho, mut normal) = ([0.0f64; 3], DVec3::ZERO);
+        if coverage == 0.0 {
+            return Some(TexelDetail { rho: [0.0; 3], coverage, normal: geometric });
+        }
+        let rho = rho.map(|r| r / (coverage * halves.len() as f64));
+        let normal = normal_map.map_or(geometric, |(texture, _)| self.mean_normal(t, geometric, texture, &uv, region, i, j));
+        Some(TexelDetail { rho, coverage, normal })
+    }
+
+    /// The mean perturbed normal over texel `(i, j)`: the centres of a `k
+    /// x k` grid of its square, weight 1 inside the triangle and 1/2 on
+    /// its hypotenuse, `k` twice the normal map texels it spans (at least
+    /// 2, at most [`MAX_SUBSAMPLES`]).
+    #[allow(clippy::too_many_arguments)]
+    fn mean_normal(&self, t: usize, geometric: DVec3, texture: &Texture, uv: &[[f32; 2]; 3], region: Region, i: u32, j: u32) -> DVec3 {
+        let n = region.size;
+        let size = [texture.width as f64 * texture.scale[0].abs() as f64, texture.height as f64 * texture.scale[1].abs() as f64];
+        let edge = |c: usize| ((0..2).map(|a| ((uv[c][a] - uv[0][a]) as f64 * size[a]).powi(2)).sum::<f64>()).sqrt() / n as f64;
+        let k = ((2.0 * edge(1).max(edge(2))).ceil() as u32).clamp(2, MAX_SUBSAMPLES);
         let nk = n * k;
+        let mut sum = DVec3::ZERO;
         for b in 0..k {
             for a in 0..k {
-                let s = (i * k + a) + (j * k + b) + 1;
-                let w = match s.cmp(&nk) {
+                let w = match ((i * k + a) + (j * k + b) + 1).cmp(&nk) {
                     std::cmp::Ordering::Less => 1.0,
                     std::cmp::Ordering::Equal => 0.5,
                     std::cmp::Ordering::Greater => continue,
                 };
                 let bary = [(i * k + a) as f64 + 0.5, (j * k + b) as f64 + 0.5].map(|x| x / nk as f64);
-                let at = |uv: [[f32; 2]; 3]| [0, 1].map(|c| uv[0][c] as f64 + bary[0] * (uv[1][c] - uv[0][c]) as f64 + bary[1] * (uv[2][c] - uv[0][c]) as f64);
-                weight += w;
-                if let Some((mask, uv)) = maps[1] {
-                    if lookup(mask, at(uv))[0] <= 0.0 {
-                        continue;
-                    }
-                }
-                opaque += w;
-                let colour = maps[0].map(|(texture, uv)| lookup(texture, at(uv)).map(f64::from)).unwrap_or([material.diffuse[0], material.diffuse[1], material.diffuse[2], 1.0]);
-                for c in 0..3 {
-                    rho[c] += w * colour[c];
-                }
-                normal += w * self.perturbed(t, geometric, bary, maps[2].map(|(texture, uv)| (texture, at(uv))));
+                sum += w * self.perturbed(t, geometric, bary, texture, element_uv(uv, &[bary; 3])[0]);
             }
         }
-        let coverage = opaque / weight;
-        if opaque == 0.0 {
-            return Some(TexelDetail { rho: [0.0; 3], coverage, normal: geometric });
-        }
-        Some(TexelDetail { rho: rho.map(|r| r / opaque), coverage, normal: normal.try_normalize().unwrap_or(geometric) })
+        sum.try_normalize().unwrap_or(geometric)
     }
 
     /// Whether triangle `t` has a normal map it can read: texture
@@ -159,21 +160,22 @@ impl<'a> Detail<'a> {
     }
 
     /// The unit normal at barycentric `bary` of triangle `t`: `geometric`
-    /// without a normal map; with one, the normal map texel at `at`
-    /// perturbs the shading normal (or `geometric`) in the tangent frame:
+    /// without a tangent; with one, the normal map's bilinear value at
+    /// texture coordinates `at` perturbs the shading normal (or
+    /// `geometric`) in the tangent frame:
     /// `m = 2 c - 1`, its tangential part scaled by the map's strength
     /// (MTL `-bm`), `n' = m.x t + m.y (w n x t) + m.z n` (004 Sec. 2.3.3).
-    fn perturbed(&self, t: usize, geometric: DVec3, bary: [f64; 2], at: Option<(&Texture, [f64; 2])>) -> DVec3 {
-        let (Some((texture, uv)), Some(tangent)) = (at, self.tangents[t]) else { return geometric };
+    fn perturbed(&self, t: usize, geometric: DVec3, bary: [f64; 2], texture: &Texture, at: [f64; 2]) -> DVec3 {
+        let Some(tangent) = self.tangents[t] else { return geometric };
         let base = self.normals[t]
             .map(|c| {
                 let c = c.map(|v| DVec3::from(v.map(f64::from)));
                 (c[0] + bary[0] * (c[1] - c[0]) + bary[1] * (c[2] - c[0])).normalize_or(geometric)
             })
             .unwrap_or(geometric);
-        let c = lookup(texture, uv);
+        let c = bilinear(texture, at);
         let s = texture.strength as f64;
-        let m = DVec3::new(s * (2.0 * c[0] as f64 - 1.0), s * (2.0 * c[1] as f64 - 1.0), 2.0 * c[2] as f64 - 1.0);
+        let m = DVec3::new(s * (2.0 * c[0] - 1.0), s * (2.0 * c[1] - 1.0), 2.0 * c[2] - 1.0);
         let handedness = tangent[3].signum() as f64;
         let tangent = DVec3::from([tangent[0], tangent[1], tangent[2]].map(f64::from));
         let tangent = (tangent - base * tangent.dot(base)).normalize_or(tangent);
@@ -186,7 +188,8 @@ impl<'a> Detail<'a> {
     /// with `mask` the bits of the offset of its texture's record in the
     /// second table, or `u32::MAX` for an unmasked triangle; the second
     /// table holds per alpha texture `[width, height, clamp, S.U, S.V, O.U,
-    /// O.V]` then its `width x height` alpha values, row 0 at the top.
+    /// O.V]` then its `width x height` alpha values (channel A), row 0 at
+    /// the top.
     pub fn mask_tables(&self, mesh: &Mesh) -> (Vec<[f32; 4]>, Vec<f32>) {
         let mut records = Vec::new();
         let mut offsets = vec![None; self.surface.textures.len()];
@@ -201,7 +204,7 @@ impl<'a> Detail<'a> {
                 let at = records.len() as u32;
                 records.extend([texture.width as f32, texture.height as f32, f32::from(u8::from(texture.clamp))]);
                 records.extend(texture.scale.iter().chain(&texture.offset));
-                records.extend(texture.texels.iter().map(|x| x[0]));
+                records.extend(texture.texels.iter().map(|x| x[3]));
                 at
             });
             triangles.extend([[uv[0][0], uv[0][1], uv[1][0], uv[1][1]], [uv[2][0], uv[2][1], f32::from_bits(offset), 0.0]]);

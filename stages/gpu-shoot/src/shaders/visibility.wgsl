@@ -70,9 +70,9 @@ fn fs(in: VertexOut) -> @location(0) vec4<f32> {
     return distance_of(in);
 }
 
-// Whether the point at barycentrics `bary` of triangle t is opaque: its
-// mask's nearest texel (MTL -s, -o, -clamp) is above 0; mirrors
-// detail::lookup.
+// Whether the point at barycentrics `bary` of triangle t is opaque: the
+// mask's texel holding it (MTL -s, -o, -clamp) is above 0; mirrors
+// radiometry::texture::opaque.
 fn opaque(t: u32, bary: vec2<f32>) -> bool {
     let a = mask_uvs[2u * t];
     let b = mask_uvs[2u * t + 1u];
