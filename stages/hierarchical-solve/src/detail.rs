@@ -51,6 +51,10 @@ pub const NORMAL_MAP_LEVELS: u32 = 3;
 /// The average of an element without texture or mask.
 const PLAIN: Average = Average { coverage: 1.0, reflectance: None };
 
+/// A triangle's normal map: its corners' texture coordinates, the map's
+/// texture index, the tangent and handedness.
+type NormalMap = ([[f32; 2]; 3], u32, [f32; 4]);
+
 /// What the solve reads of `surface.exr`, and each element's averages.
 pub struct Detail {
     surface: Surface,
@@ -60,7 +64,7 @@ pub struct Detail {
     /// Per input triangle: corner texture coordinates, normal map and
     /// tangent frame, where its material has a normal map and mesh-prep
     /// gave it a tangent.
-    normal_mapped: Vec<Option<([[f32; 2]; 3], u32, [f32; 4])>>,
+    normal_mapped: Vec<Option<NormalMap>>,
     /// Per element (arena order): its texture average.
     averages: Vec<Average>,
 }

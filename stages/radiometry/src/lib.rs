@@ -9,10 +9,9 @@
 //! - [`rays`]: ray casting over obvhs's CWBVH.
 //! - [`photometry`]: goniometric point lights: the type C distribution,
 //!   its Catmull-Rom lookup and flux, irradiance from a luminaire.
+//! - [`texture`]: texture lookups and their exact averages over elements.
 //! - [`camera`]: pinhole camera rays.
 //! - [`color`]: luminance.
-//! - [`texture`]: texture lookups (bilinear reflectance, alpha coverage)
-//!   and their exact averages over triangles and elements.
 //!
 //! Everything here takes data, not paths, and never prints.
 

@@ -352,7 +352,7 @@ mod tests {
     /// 2 x 2 checks of `n x n` texels each: 0.25 at top left and bottom
     /// right, 0.625 elsewhere (exact in f32).
     fn checks(n: usize) -> Texture {
-        texture(TextureKind::Diffuse, 2 * n, 2 * n, |i, j| if (i / n + j / n) % 2 == 0 { 0.25 } else { 0.625 })
+        texture(TextureKind::Diffuse, 2 * n, 2 * n, |i, j| if (i / n + j / n).is_multiple_of(2) { 0.25 } else { 0.625 })
     }
 
     #[test]
