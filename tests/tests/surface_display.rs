@@ -297,6 +297,17 @@ fn a_dissolved_diffuse_mtl_material_transmits_diffusely() {
     assert_eq!((sheet.diffuse, sheet.diffuse_transmittance), ([0.3; 3], [0.6, 0.3, 0.15]), "tau_d = (1 - d) Tf");
     assert_eq!(sheet.specular_transmittance, [0.0; 3]);
     assert!(effect, "the manifest lists diffuse transmission");
+    // Not simulated yet: the solve's and the display's reports say so.
+    let solve_report = dir.join("solve.report.ron");
+    solve_prepared(&dir, &["--report", s(&solve_report), "--eps", "1e-2", "--min-area", "1e-2"], None);
+    let [mesh, manifest] = outputs(&dir);
+    let (image, gather_report) = (dir.join("image.exr"), dir.join("gather.report.ron"));
+    let solution = dir.join("solution.exr");
+    run_ok("grid-gather", &["--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "-o", s(&image), "--report", s(&gather_report), "--width", "8", "--height", "8"]);
+    for report in [solve_report, gather_report] {
+        let text = std::fs::read_to_string(&report).unwrap();
+        assert!(text.contains("diffuse transmission"), "{} does not list diffuse transmission as skipped: {text}", report.display());
+    }
 }
 
 #[test]
