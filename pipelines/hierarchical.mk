@@ -87,11 +87,12 @@ full: $(OUT)/final.png
 # unclustered Cornell box at BENCH_SIZE^2 pixels (the surface-based
 # gather's case: walls refined finer than the grid) and on the clustered plant room
 # (mesh-prep's plants-10k, cluster, hierarchical-solve --clusters at eps
-# 1e-2) at BENCH_PLANT_SIZE^2. Figures: each run's report (visibility_rays,
+# 1e-2) at BENCH_PLANT_SIZE^2. Figures (bench-gather, bench/src/gather.rs):
+# each run's report (visibility_rays, classification_visibility_rays,
 # form_factor_evaluations, wall_time_s) and compare's relative RMSE, in
 # out/bench-gather/summary.txt and out/bench-gather-plants/summary.txt;
-# `equal_error_brute_rays` is the brute-force ray count at the run's error,
-# interpolated on the brute runs' log(rays)-log(error) line.
+# `brute_rays@err` is the brute-force ray count at the run's error, on the
+# brute runs' least-squares log(rays)-log(error) line.
 BENCH_SIZE ?= 128
 # Contrast thresholds of the unmasked full runs (`full<c>`): the price of
 # accuracy.
@@ -109,22 +110,10 @@ define bench_runs
 	for n in $(4); do $(BIN)/grid-gather $(2) --brute --brute-samples $$n -o $(1)/brute$$n.exr --report $(1)/brute$$n.report.ron; done
 	for c in $(BENCH_CONTRASTS); do $(BIN)/grid-gather $(2) --mode full --contrast $$c --diagnostics $(1)/full$$c.diagnostics.exr -o $(1)/full$$c.exr --report $(1)/full$$c.report.ron; done
 	$(BIN)/grid-gather $(2) --mode full --threshold $(1)/threshold.exr --diagnostics $(1)/masked.diagnostics.exr -o $(1)/masked.exr --report $(1)/masked.report.ron
-	@for r in $(addprefix brute,$(4)) $(addprefix full,$(BENCH_CONTRASTS)) masked; do \
-	  rays=$$(grep -oE '"visibility_rays": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
-	  ffs=$$(grep -oE '"form_factor_evaluations": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
-	  crays=$$(grep -oE '"classification_visibility_rays": [0-9.e+]+' $(1)/$$r.report.ron | grep -oE '[0-9.e+]+$$'); \
-	  time=$$(grep -oE 'wall_time_s: [0-9.]+' $(1)/$$r.report.ron | grep -oE '[0-9.]+$$'); \
-	  err=$$($(BIN)/compare $(1)/$$r.exr $(1)/reference.exr -o $(1)/$$r.compare.ron 2>&1 | grep -oE 'relative_rmse [0-9.e-]+' | grep -oE '[0-9.e-]+$$'); \
-	  echo "$$r $$rays $$crays $$ffs $$time $$err"; \
-	done | awk 'BEGIN { printf "%-9s %14s %14s %14s %8s %12s %14s %8s\n", "run", "vis_rays", "class_rays", "ff_evals", "time_s", "rel_rmse", "brute_rays@err", "ratio" } \
-	  { name[NR] = $$1; rays[NR] = $$2 + $$3; line[NR] = sprintf("%-9s %14d %14d %14d %8.2f %12.3e", $$1, $$2, $$3, $$4, $$5, $$6); err[NR] = $$6; \
-	    if ($$1 ~ /^brute/) { nb++; lx[nb] = log($$2); ly[nb] = log($$6) } } \
-	  END { sx = sy = sxx = sxy = 0; for (i = 1; i <= nb; i++) { sx += lx[i]; sy += ly[i]; sxx += lx[i]^2; sxy += lx[i] * ly[i] } \
-	    b = (nb * sxy - sx * sy) / (nb * sxx - sx^2); a = (sy - b * sx) / nb; \
-	    for (i = 1; i <= NR; i++) { eq = exp((log(err[i]) - a) / b); printf "%s %14d %8.3f\n", line[i], eq, rays[i] / eq } }' | tee $(1)/summary.txt
+	$(BIN)/bench-gather --dir $(1) -o $(1)/summary.txt $(addprefix brute,$(4)) $(addprefix full,$(BENCH_CONTRASTS)) masked
 endef
 
-bench-gather: $(BINS) $(BIN)/mask
+bench-gather: $(BINS) $(BENCH_BINS) $(BIN)/mask
 	@mkdir -p $(BENCH_OUT) $(BENCH_PLANTS)
 	$(MAKE) --no-print-directory OUT=$(BENCH_OUT) CLUSTERS=0 WIDTH=$(BENCH_SIZE) HEIGHT=$(BENCH_SIZE) $(BENCH_OUT)/threshold.exr
 	$(call bench_runs,$(BENCH_OUT),$(BG_ARGS),256,4 8 16 64)

@@ -1,7 +1,9 @@
 //! Measuring helpers the benchmark binaries share, the sweep of error
 //! against time ([`sweep`], the `sweep` binary), and paper 002's
-//! benchmark of structured sampling ([`structured`], `bench-structured`).
+//! benchmark of structured sampling ([`structured`], `bench-structured`),
+//! and the summary of `make bench-gather` ([`gather`], `bench-gather`).
 
+pub mod gather;
 pub mod structured;
 pub mod sweep;
 

@@ -200,9 +200,12 @@ pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> 
     })
 }
 
-/// Per surface: (samples or leaf elements, element vertices, secondary
-/// emitters), from the solver's output file.
-fn counts(solver: Solver, output: &Path, mesh: &schemas::mesh::Mesh, groups: &[SurfaceGroup]) -> Result<Vec<(usize, Option<usize>, Option<usize>)>> {
+/// A surface's samples (or leaf elements), element vertices and secondary
+/// emitters.
+type Counts = (usize, Option<usize>, Option<usize>);
+
+/// Per surface, its [`Counts`] from the solver's output file.
+fn counts(solver: Solver, output: &Path, mesh: &schemas::mesh::Mesh, groups: &[SurfaceGroup]) -> Result<Vec<Counts>> {
     Ok(match solver {
         Solver::Structured => {
             let (samples, _) = Samples::read(output)?;
