@@ -59,8 +59,9 @@ all: $(OUT)/image.png
 $(BINS) &: FORCE
 	@cargo build --release --quiet $(addprefix -p ,$(STAGES)) --bins
 
-# The benchmark drivers (bench-solve, bench-scale, sweep).
-BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep)
+# The benchmark drivers (bench-solve, bench-scale, sweep, bench-gather's
+# summary, bench-structured).
+BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep bench-gather bench-structured)
 $(BENCH_BINS) &: FORCE
 	@cargo build --release --quiet -p bench --bins
 

@@ -43,3 +43,34 @@ $(STRUCTURED_OUT)/image.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(STRUCTUR
 $(STRUCTURED_OUT)/compare.ron: $(BIN)/compare $(STRUCTURED_OUT)/image.exr $(OUT)/exact/image.exr
 	$(BIN)/compare $(STRUCTURED_OUT)/image.exr $(OUT)/exact/image.exr --tau 0.02,0.05,0.1,0.15 --exclude-emitters --exclude-edges 1 \
 	  --manifest $(OUT)/manifest.ron --diff $(STRUCTURED_OUT)/difference.png -o $@
+
+# `make bench-structured`: paper 002's Tables 2 and 3 in shape
+# (bench-structured, bench/src/structured/): structured-sample at its
+# defaults against hierarchical-solve (preview gather) over an EPS grid,
+# with the hierarchical runs at the same speed, at the same quality and,
+# per surface, with the fewest element vertices for structured sampling's
+# figure there; percent of pixels over tau per surface, samples and
+# element vertices per surface, the light-to-A / A-to-B time split where
+# the reports have one. First the simple environment against the exact
+# image (quality compared at tau 5% and paper 002's 10%), then the Cornell
+# box (Table 3's 15%) against BENCH_STRUCTURED_REFERENCE: by default
+# `make bench-peer`'s Mitsuba image where it has been rendered, else a
+# converged hierarchical-solve full gather (EPS a quarter of the smallest
+# swept, SPP 16), which the table says is not an independent truth.
+# Writes bench.ron, bench.csv and bench.txt (printed too) under
+# $(BENCH_STRUCTURED_OUT)/<scene>/. About 8 minutes on 2 cores, most of
+# it the Cornell box's converged reference. A benchmark only: never in
+# `make test`.
+BENCH_STRUCTURED_OUT ?= out/bench-structured
+BENCH_STRUCTURED_EPS ?= 0.3,0.1,0.03,0.01,0.003,0.001
+BENCH_STRUCTURED_CORNELL_EPS ?= 0.01,0.003,0.001,0.0003
+BENCH_STRUCTURED_REFERENCE ?= $(wildcard out/cornell/peer/reference.exr)
+BENCH_STRUCTURED_CORNELL_SURFACES := --surface floor=floor --surface walls=back_wall,green_wall,red_wall \
+  --surface ceiling=ceiling --surface blocks=short_block,tall_block
+
+.PHONY: bench-structured
+bench-structured: $(BINS) $(BENCH_BINS) $(BIN)/structured-sample $(BIN)/exact
+	$(BIN)/bench-structured --scene simple-environment --eps $(BENCH_STRUCTURED_EPS) --quality-tau 0.05,0.1 \
+	  -o $(BENCH_STRUCTURED_OUT)/simple-environment
+	$(BIN)/bench-structured --scene cornell --eps $(BENCH_STRUCTURED_CORNELL_EPS) --quality-tau 0.15 $(BENCH_STRUCTURED_CORNELL_SURFACES) \
+	  $(if $(BENCH_STRUCTURED_REFERENCE),--reference $(BENCH_STRUCTURED_REFERENCE)) -o $(BENCH_STRUCTURED_OUT)/cornell
