@@ -9,7 +9,10 @@
 //! gather; an alpha-masked quad between the camera and the floor lets the
 //! pixels through its cut-out half see the floor and shows its opaque half
 //! (lit by nothing) black; a normal map tilting every normal by a known
-//! angle gives the full gather `rho E(n') / pi` with the tilted normal.
+//! angle gives the full gather `rho E(n') / pi` with the tilted normal; a
+//! scene without detail renders the same pixels with and without the
+//! surface artifact, which it does not read; one from another mesh-prep
+//! run is refused.
 //!
 //! mesh-prep: a translucent MTL material (`illum` 0 to 2, `d` < 1, `Tf`)
 //! and a `scene.ron` override give the diffuse transmittance the manifest
@@ -364,4 +367,19 @@ fn a_scene_without_surface_detail_renders_the_same_pixels_and_never_reads_the_su
         let inputs: Vec<&str> = given.header.provenance.inputs.iter().map(|i| i.path.as_str()).collect();
         assert!(!inputs.iter().any(|p| p.ends_with("surface.exr")), "{mode}: the surface artifact was read: {inputs:?}");
     }
+}
+
+#[test]
+fn a_surface_artifact_from_another_mesh_prep_run_is_refused() {
+    let texture = png(|u, v| [CHECKS[check(u, v)]; 3]);
+    let (dir, scene) = display_scene("display_other_surface", "Kd 0.5\nmap_Kd checks.png\n", None, &[("checks.png", texture)]);
+    prepare_and_solve(&dir, &scene, false);
+    // Another run of the same scene (other flags) writes another surface.
+    let other = dir.join("other.surface.exr");
+    let (mesh2, manifest2) = (dir.join("other.mesh.exr"), dir.join("other.manifest.ron"));
+    run_ok("mesh-prep", &[s(&scene), "--mesh", s(&mesh2), "--manifest", s(&manifest2), "--surface", s(&other)]);
+    let [mesh, manifest] = outputs(&dir);
+    let (image, solution) = (dir.join("image.exr"), dir.join("solution.exr"));
+    let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "--surface", s(&other), "-o", s(&image)];
+    assert_refused("grid-gather", &args, &["other.surface.exr", "does not belong with the mesh"], &[&image]);
 }
