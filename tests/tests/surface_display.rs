@@ -213,6 +213,25 @@ fn a_checkerboard_floor_shows_its_checks_per_pixel_in_preview_and_full_gathers()
             let (checked, worst) = per_pixel(&image, rho, [0.0, 0.0, 1.0], |_, _| true, tolerance, &what);
             eprintln!("{what}: {checked} pixels, largest error {worst:.4}");
             assert!(checked > (SIZE * SIZE) as usize / 2, "{what}: only {checked} pixels checked");
+            // Every pixel on the floor, those the checks' edges touch
+            // included: its reflectance, radiance x pi / E, is nearer the
+            // check at its centre than the other check.
+            let mut edge_pixels = 0;
+            for y in 0..SIZE {
+                for x in 0..SIZE {
+                    let corners = footprint(x, y, 0.0);
+                    if !corners.iter().all(|c| c.iter().all(|&v| (0.0..=1.0).contains(&v))) {
+                        continue;
+                    }
+                    let p = ray_at(f64::from(x) + 0.5, f64::from(y) + 0.5, 0.0);
+                    let seen = f64::from(image.rgb[(y * SIZE + x) as usize][0]) * std::f64::consts::PI / irradiance(p, [0.0, 0.0, 1.0]);
+                    let right = check(p[0], p[1]);
+                    let nearer = (seen - linear(CHECKS[right])).abs() < (seen - linear(CHECKS[1 - right])).abs();
+                    assert!(nearer, "{what}: pixel ({x}, {y}) shows reflectance {seen}, the other check's");
+                    edge_pixels += usize::from(corners.iter().any(|c| check(c[0], c[1]) != right || (c[0] - 0.5).abs() < 1e-9 || (c[1] - 0.5).abs() < 1e-9));
+                }
+            }
+            assert!(edge_pixels >= 4 * (SIZE as usize - 4), "{what}: only {edge_pixels} pixels touch the checks' edges");
         }
     }
 }
