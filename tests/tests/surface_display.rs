@@ -263,8 +263,9 @@ fn pixels_through_an_alpha_masked_quads_holes_see_the_lit_floor() {
 #[test]
 fn a_normal_map_tilts_the_full_gathers_cosines() {
     // Every texel's tangent-space normal tilted toward +x (the tangent,
-    // along increasing u): bytes (200, 128, 230).
-    let bytes = [200u8, 128, 230];
+    // along increasing u) and -y (against the bitangent, increasing v):
+    // bytes (200, 90, 230), 38.5 degrees from the face normal.
+    let bytes = [200u8, 90, 230];
     let map = png(|_, _| bytes);
     let (dir, scene) = display_scene("display_normal_map", "Kd 0.5\nnorm normal.png\n", None, &[("normal.png", map)]);
     prepare_and_solve(&dir, &scene, false);
