@@ -14,7 +14,8 @@ use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
 use schemas::report::Report;
 use schemas::ron_io::read_ron;
-use schemas::stage::{bad_parameter, check_writable, exit_code};
+use schemas::cli::main_of;
+use schemas::stage::{bad_parameter, check_writable};
 use schemas::{Error, Result};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -61,5 +62,5 @@ fn run(args: Args) -> Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("bench-gather", run(Args::parse()))
+    main_of("bench-gather", run)
 }

@@ -13,7 +13,8 @@ use bench::structured::{run, Config};
 use bench::sweep::stages::Stages;
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
-use schemas::stage::{bad_parameter, check_writable, exit_code};
+use schemas::cli::main_of;
+use schemas::stage::{bad_parameter, check_writable};
 use schemas::{Error, Result};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -105,5 +106,5 @@ fn run_args(args: Args) -> Result<ExitCode> {
 }
 
 fn main() -> ExitCode {
-    exit_code("bench-structured", run_args(Args::parse()))
+    main_of("bench-structured", run_args)
 }

@@ -256,7 +256,7 @@ pub fn select(runs: &[RunFigures], quality_tau: f64) -> Comparison {
                 let theirs = runs[i].surface(&name).expect("a qualifying run has the surface");
                 let verdict = if surface.samples < theirs.display_points() { "fewer samples for structured sampling" } else { "not fewer samples for structured sampling" };
                 format!(
-                    "{name}: structured sampling has {} over {tau} with {} samples; hierarchical-solve needs {} element vertices ({} leaves, {}) for at most that: {verdict}",
+                    "{name}: structured sampling has {} over {tau} with {} samples; the hierarchical-solve run swept with the fewest element vertices there at most that has {} ({} leaves, {}): {verdict}",
                     percent_text(surface.over(quality_tau)),
                     surface.samples,
                     theirs.display_points(),
@@ -335,8 +335,8 @@ impl Bench {
             lines.push((format!("samples {name}"), cell(&|r| r.surface(name).map_or_else(|| "-".into(), samples_cell))));
         }
         let seconds = |v: Option<f64>| v.map_or_else(|| "not split".into(), |v| format!("{v:.3}"));
-        lines.push(("time light->A (s)".into(), cell(&|r| seconds(r.light_to_a_s))));
-        lines.push(("time A->B (s)".into(), cell(&|r| seconds(r.a_to_b_s))));
+        lines.push(("time direct, light->A (s)".into(), cell(&|r| seconds(r.light_to_a_s))));
+        lines.push(("time reflected, A->B (s)".into(), cell(&|r| seconds(r.a_to_b_s))));
         lines.push(("time total (s)".into(), cell(&|r| format!("{:.3}", r.total_s))));
 
         let label_width = lines.iter().map(|(l, _)| l.len()).max().unwrap_or(0);
@@ -471,8 +471,8 @@ mod tests {
         assert_eq!(of(Role::FewestOn("B".into())), Some(1), "B <= 0.5%: 8 vertices at EPS 0.01 are the fewest");
         assert_eq!(findings.len(), 4);
         assert!(findings[1].contains("EPS=0.001 takes 4.000 s, 4.00x"), "{}", findings[1]);
-        assert!(findings[2].contains("48 samples") && findings[2].contains("needs 100 element vertices (50 leaves, EPS=0.001)") && findings[2].ends_with(": fewer samples for structured sampling"), "{}", findings[2]);
-        assert!(findings[3].contains("needs 8 element vertices") && findings[3].ends_with("not fewer samples for structured sampling"), "{}", findings[3]);
+        assert!(findings[2].contains("48 samples") && findings[2].contains("at most that has 100 (50 leaves, EPS=0.001)") && findings[2].ends_with(": fewer samples for structured sampling"), "{}", findings[2]);
+        assert!(findings[3].contains("at most that has 8 (4 leaves, EPS=0.01)") && findings[3].ends_with("not fewer samples for structured sampling"), "{}", findings[3]);
     }
 
     #[test]
@@ -509,7 +509,7 @@ mod tests {
         assert_eq!(words(lines[5]), ["% px > 10% (image)", "1.50", "3.00", "1.00", "1.00", "9.00"]);
         assert_eq!(words(lines[7]), ["% px > 10% (B)", "0.50", "0.50", "0.10", "0.10", "0.40"]);
         assert_eq!(words(lines[8]), ["samples A", "48 (4 polys)", "60 v (30 el)", "100 v (50 el)", "100 v (50 el)", "20 v (10 el)"]);
-        assert_eq!(words(lines[10]), ["time light->A (s)", "0.250", "not split", "not split", "not split", "not split"]);
+        assert_eq!(words(lines[10]), ["time direct, light->A (s)", "0.250", "not split", "not split", "not split", "not split"]);
         assert_eq!(words(lines[12]), ["time total (s)", "1.000", "1.500", "4.000", "4.000", "0.500"]);
         assert!(lines[13].starts_with("- same speed: hierarchical-solve EPS=0.003"), "{}", lines[13]);
         assert_eq!(lines.last().copied(), Some("- a note"));

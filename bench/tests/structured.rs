@@ -1,0 +1,91 @@
+//! The `bench-structured` binary end to end on paper 002's simple
+//! environment at a small image size: the table holds structured
+//! sampling's run and hierarchical-solve's, its per-surface figures add up
+//! to the image's, and bad options are one-line errors. No timing is
+//! asserted beyond its being measured.
+//!
+//! The benchmark drives the release stage binaries beside it in
+//! `target/release`, which `make test` builds before the tests.
+
+use bench::structured::table::{Bench, Role};
+use bench::sweep::knobs::Solver;
+use schemas::ron_io::read_ron;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bench_structured(args: &[&str]) -> Output {
+    let exe = Path::new(env!("CARGO_BIN_EXE_bench-structured"));
+    let dir = exe.parent().expect("target directory");
+    for stage in ["mesh-prep", "cluster", "hierarchical-solve", "grid-gather", "compare", "exact", "structured-sample"] {
+        assert!(dir.join(stage).exists(), "{} is missing: run `make test` (it builds the stages first)", dir.join(stage).display());
+    }
+    Command::new(exe).args(args).output().expect("bench-structured runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn the_simple_environment_table_has_both_solvers_and_its_surfaces_add_up_to_the_image() {
+    let out = scratch("bench_structured");
+    let run = bench_structured(&["--scene", "simple-environment", "--eps", "0.3,0.1", "--width", "40", "--height", "40", "--quality-tau", "0.05,0.1", "-o", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "bench-structured failed:\n{stderr}");
+    let bench: Bench = read_ron(&out.join("bench.ron")).unwrap().value;
+    assert!(bench.reference.contains("exact image"), "{}", bench.reference);
+    let solvers: Vec<(Solver, &str)> = bench.runs.iter().map(|r| (r.solver, r.setting.as_str())).collect();
+    assert_eq!(solvers, [(Solver::Structured, "STRUCTURED_LEVELS=8"), (Solver::Hierarchical, "EPS=0.3"), (Solver::Hierarchical, "EPS=0.1")]);
+    for r in &bench.runs {
+        let names: Vec<&str> = r.surfaces.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["A", "B"], "every non-emitting object, each its own surface");
+        assert!(r.surfaces.iter().all(|s| s.samples > 0 && s.pixels > 0), "{r:?}");
+        assert_eq!(r.surfaces.iter().all(|s| s.vertices.is_some()), r.solver == Solver::Hierarchical, "element vertices for hierarchical-solve only");
+        // Emitters are left out, so A's and B's pixels are the image's and
+        // their pixel-weighted shares over each tau make up the image's.
+        for tau in &bench.taus {
+            let image = r.over(*tau).expect("measured");
+            let pixels: usize = r.surfaces.iter().map(|s| s.pixels).sum();
+            let weighted: f64 = r.surfaces.iter().map(|s| s.pixels as f64 * s.over(*tau).unwrap()).sum::<f64>() / pixels as f64;
+            assert!((weighted - image).abs() < 1e-9, "{} at tau {tau}: surfaces {weighted} image {image}", r.setting);
+        }
+        assert!(r.total_s > 0.0);
+        assert_eq!(r.light_to_a_s.is_some(), r.solver == Solver::Structured, "only structured-sample's report splits the transfers");
+        if let (Some(a), Some(b)) = (r.light_to_a_s, r.a_to_b_s) {
+            assert!(a + b <= r.total_s, "the split is part of the stage's time: {a} + {b} > {}", r.total_s);
+        }
+    }
+    assert_eq!(bench.comparisons.len(), 2);
+    for c in &bench.comparisons {
+        let roles: Vec<&Role> = c.rows.iter().map(|r| &r.role).collect();
+        assert_eq!(roles, [&Role::Structured, &Role::SameSpeed, &Role::SameQuality, &Role::FewestOn("A".into()), &Role::FewestOn("B".into())]);
+        assert_eq!(c.findings.len(), 4, "{:?}", c.findings);
+    }
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    let text = std::fs::read_to_string(out.join("bench.txt")).unwrap();
+    assert!(text.contains("quality compared at tau = 5%:") && text.contains("quality compared at tau = 10%:"), "{text}");
+}
+
+#[test]
+fn bad_options_are_one_line_errors_naming_them() {
+    let out = scratch("bench_structured_bad");
+    let o = out.to_str().unwrap();
+    for (args, expected) in [
+        (vec!["--tau", "0.1", "--quality-tau", "0.15", "-o", o], "--quality-tau 0.15"),
+        (vec!["--eps", "-1", "-o", o], "positive numbers"),
+        (vec!["--surface", "walls", "-o", o], "--surface walls"),
+        (vec!["--surface", "floor=floor", "-o", o], "no object \"floor\""),
+    ] {
+        let run = bench_structured(&args);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
+        // Progress lines may come first; the error is one line, the last.
+        let errors: Vec<&str> = stderr.lines().filter(|l| l.contains("error")).collect();
+        assert_eq!(errors.len(), 1, "{args:?}: {stderr}");
+        assert_eq!(stderr.trim().lines().last(), Some(errors[0]), "{args:?}: {stderr}");
+        assert!(errors[0].contains(expected), "{args:?}: {stderr}");
+    }
+}
