@@ -1,4 +1,4 @@
-//! Surface detail in hierarchical-solve (issue 13, items 2, 3, 4 and 8),
+//! Surface detail in hierarchical-solve (issue 13, items 2 to 5 and 8),
 //! per element against closed forms written here: Lambert's polygon
 //! factor (`closed_form::lambert_polygon`) for the light, and the texture
 //! read back from `surface.exr` with a bilinear lookup written here, apart
@@ -35,9 +35,14 @@ fn ceiling(name: &'static str, material: &'static str, lo: f64, hi: f64, z: f64)
     Quad { name, material, corners: [[lo, hi, z], [hi, hi, z], [hi, lo, z], [lo, lo, z]], uv: Some([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]) }
 }
 
-/// Writes the quads, the MTL library `mtl` and scene.ron with `emitters`
-/// (material, exitance W/m²) into `dir`; returns the scene's path.
-fn write_scene(dir: &Path, quads: &[Quad], mtl: &str, emitters: &[(&str, f64)]) -> PathBuf {
+/// scene.ron's override making material `name` emit `e` W/m².
+fn emits(name: &str, e: f64) -> String {
+    format!("    \"{name}\": (emission: Some(({e:?}, {e:?}, {e:?}))),\n")
+}
+
+/// Writes the quads, the MTL library `mtl` and scene.ron with the material
+/// `overrides` into `dir`; returns the scene's path.
+fn write_scene(dir: &Path, quads: &[Quad], mtl: &str, overrides: &[String]) -> PathBuf {
     let mut obj = String::from("mtllib scene.mtl\n");
     for q in quads {
         writeln!(obj, "o {}\nusemtl {}", q.name, q.material).unwrap();
@@ -54,7 +59,7 @@ fn write_scene(dir: &Path, quads: &[Quad], mtl: &str, emitters: &[(&str, f64)]) 
             None => obj.push_str("f -4 -3 -2 -1\n"),
         }
     }
-    let overrides: String = emitters.iter().map(|(m, e)| format!("    \"{m}\": (emission: Some(({e:?}, {e:?}, {e:?}))),\n")).collect();
+    let overrides: String = overrides.concat();
     let scene = format!(
         "Scene(\n  meshes: [Obj(file: \"scene.obj\")],\n  camera: Camera(eye: (0.5, -2.0, 0.5), target: (0.5, 0.5, 0.2), up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 16, height: 16),\n  lights: [],\n  materials: {{\n{overrides}  }},\n)\n"
     );
@@ -125,12 +130,17 @@ impl Solved {
     /// Area-mean of `f(world point, texture coordinates)` over element
     /// `e` (1,024 centroids).
     fn mean(&self, e: &Element, f: &dyn Fn([f64; 3], [f64; 2]) -> f64) -> f64 {
+        self.mean_at(e, 5, f)
+    }
+
+    /// [`Solved::mean`] over the centroids of `4^levels` sub-triangles.
+    fn mean_at(&self, e: &Element, levels: u32, f: &dyn Fn([f64; 3], [f64; 2]) -> f64) -> f64 {
         let uv = self.surface.uvs.iter().find(|u| u.0 == e.triangle).map(|u| u.1);
         let corners = e.corners.map(|c| [f64::from(c[0]), f64::from(c[1]), 0.0]);
         let t = &self.mesh.triangles[e.triangle as usize];
         let [p0, p1, p2] = t.vertices.map(|v| self.mesh.positions[v as usize].map(f64::from));
         let o = self.manifest.world_from_mesh_translation;
-        mean_over_triangle(&corners, 5, &|b| {
+        mean_over_triangle(&corners, levels, &|b| {
             let at = |c: [f64; 3]| (1.0 - b[0] - b[1]) * c[0] + b[0] * c[1] + b[1] * c[2];
             let x = std::array::from_fn(|a| at([p0[a], p1[a], p2[a]]) + o[a]);
             let tex = uv.map_or([0.0; 2], |uv| std::array::from_fn(|k| at([f64::from(uv[0][k]), f64::from(uv[1][k]), f64::from(uv[2][k])])));
@@ -168,7 +178,7 @@ fn a_checkerboard_floor_under_a_square_emitter_has_each_elements_radiosity_rho_t
     let lamp = [[0.3, 0.3, 0.4], [0.7, 0.3, 0.4], [0.7, 0.7, 0.4], [0.3, 0.7, 0.4]];
     let quads = [floor("floor", "checks", 0.0), ceiling("lamp", "lamp", 0.3, 0.7, 0.4)];
     let mtl = "newmtl checks\nKd 0.5 0.5 0.5\nmap_Kd -clamp on checks.png\nnewmtl lamp\nKd 0 0 0\n";
-    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    let scene = write_scene(&dir, &quads, mtl, &[emits("lamp", 10.0)]);
     let solved = prepare_and_solve(&dir, &scene, &[]);
     assert!(!solved.report.contains("textures:"), "textures leave the skipped list: {}", solved.report);
     let texture = &solved.surface.textures[0];
@@ -233,7 +243,7 @@ fn striped_emitter(test: &str, z: f64) -> (f64, f64) {
     stripes_png(&dir);
     let quads = [floor("floor", "floor", 0.0), ceiling("lamp", "lamp", 0.3, 0.7, z)];
     let mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nmap_d -clamp on stripes.png\n";
-    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    let scene = write_scene(&dir, &quads, mtl, &[emits("lamp", 10.0)]);
     let solved = prepare_and_solve(&dir, &scene, &[]);
     assert!(!solved.report.contains("alpha masks:"), "alpha masks leave the skipped list: {}", solved.report);
     let stripes = opaque_stripes(0.3, 0.7, z);
@@ -273,7 +283,7 @@ fn an_alpha_masked_occluder_with_a_hole_lets_the_holes_lambert_contribution_thro
     });
     let quads = [floor("floor", "floor", 0.0), occluder, ceiling("lamp", "lamp", 0.45, 0.55, 1.0)];
     let mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl screen\nKd 0 0 0\nmap_d -clamp on hole.png\nnewmtl lamp\nKd 0 0 0\n";
-    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    let scene = write_scene(&dir, &quads, mtl, &[emits("lamp", 10.0)]);
     // The floor's radiosity is about 1.5e-3 of the lamp's, so the absolute
     // threshold (the only pass of a scene without interreflection) must be
     // well under that for 1% per element.
@@ -316,7 +326,7 @@ fn a_floor_whose_normal_map_tilts_every_normal_matches_lambert_for_the_tilted_no
     let lamp = [[0.3, 0.3, 0.4], [0.7, 0.3, 0.4], [0.7, 0.7, 0.4], [0.3, 0.7, 0.4]];
     let quads = [floor("floor", "bumpy", 0.0), ceiling("lamp", "lamp", 0.3, 0.7, 0.4)];
     let mtl = "newmtl bumpy\nKd 0.5 0.5 0.5\nnorm tilt.png\nnewmtl lamp\nKd 0 0 0\n";
-    let scene = write_scene(&dir, &quads, mtl, &[("lamp", 10.0)]);
+    let scene = write_scene(&dir, &quads, mtl, &[emits("lamp", 10.0)]);
     let solved = prepare_and_solve(&dir, &scene, &[]);
     assert!(!solved.report.contains("normal maps:"), "normal maps leave the skipped list: {}", solved.report);
     // The normal the map holds, from the texel as read back: tangent +x,
@@ -330,6 +340,97 @@ fn a_floor_whose_normal_map_tilts_every_normal_matches_lambert_for_the_tilted_no
     // Lambert's contour formula needs no clipping.
     let worst = solved.check_leaves("bumpy", 5e-3, &|x, _| 0.5 * 10.0 * lambert_polygon(x, tilted, &lamp));
     eprintln!("normal-mapped floor: worst element {:.3}% off Lambert for the tilted normal", 100.0 * worst);
+}
+
+/// The irradiance of solution leaf `e`: what the links into it and its
+/// ancestors bring, `sum V F B_s`.
+fn irradiance(solution: &Solution, e: &Element) -> f64 {
+    let mut chain = vec![e];
+    while chain[chain.len() - 1].parent != NONE {
+        chain.push(&solution.elements[chain[chain.len() - 1].parent as usize]);
+    }
+    let index = |x: &Element| solution.elements.iter().position(|y| std::ptr::eq(x, y)).unwrap() as u32;
+    let nodes: Vec<u32> = chain.iter().map(|x| index(x)).collect();
+    solution
+        .links
+        .iter()
+        .filter(|l| matches!(l.receiver, schemas::solution::Node::Element(r) if nodes.contains(&r)))
+        .map(|l| f64::from(l.visibility) * f64::from(l.unoccluded_irradiance[0]))
+        .sum()
+}
+
+/// A translucent MTL material (`Kd` 0.3, `d` 0.5: `tau_d` 0.5).
+const SHEET: &str = "newmtl sheet\nKd 0.3 0.3 0.3\nillum 2\nd 0.5\nTf 1 1 1\n";
+
+#[test]
+fn a_translucent_sheet_between_a_lamp_and_a_floor_transmits_tau_times_its_irradiance_from_its_back() {
+    let dir = scratch("surface_solver_sheet");
+    // Lamp at z = 1, the two-sided sheet at z = 1/2, a floor reflecting
+    // 1% (so that its radiosity shows its irradiance, and it returns
+    // almost nothing to the sheet's back).
+    let quads = [floor("floor", "floor", 0.0), floor("sheet", "sheet", 0.5), ceiling("lamp", "lamp", 0.25, 0.75, 1.0)];
+    let mtl = format!("newmtl floor\nKd 0.01 0.01 0.01\n{SHEET}newmtl lamp\nKd 0 0 0\n");
+    let overrides = [emits("lamp", 10.0), "    \"sheet\": (two_sided: Some(true)),\n".to_string()];
+    let scene = write_scene(&dir, &quads, &mtl, &overrides);
+    // The floor is dim next to the sheet: the relative criterion must not
+    // floor its radiosity at the scene's mean for its links to refine.
+    let solved = prepare_and_solve(&dir, &scene, &["--relative-floor", "1e-4", "--eps-relative", "2e-3"]);
+    assert!(!solved.report.contains("diffuse transmission:"), "{}", solved.report);
+    let lamp = [[0.25, 0.25, 1.0], [0.75, 0.25, 1.0], [0.75, 0.75, 1.0], [0.25, 0.75, 1.0]];
+    let (rho, tau, m) = (0.3, 0.5, 10.0);
+    // The faces: the upper one reflects rho of the lamp's light, the lower
+    // one transmits tau of it (Eq. 4.4; the floor's 1% return is under
+    // 0.1% of it).
+    let (mut worst, mut faces) = ([0.0f64; 2], [0usize; 2]);
+    for e in solved.leaves_of("sheet") {
+        let up = solved.mesh.triangles[e.triangle as usize].normal[2] > 0.0;
+        let lit = solved.mean(e, &|x, _| m * lambert_polygon(x, UP, &lamp));
+        let (expected, k) = if up { (rho * lit, 0) } else { (tau * lit, 1) };
+        let got = f64::from(e.radiosity[0]);
+        worst[k] = worst[k].max((got - expected).abs() / expected);
+        faces[k] += 1;
+        assert!((got - expected).abs() <= 5e-3 * expected, "sheet face (up: {up}) at {:?}: {got} vs {expected}", solved.world(e)[0]);
+    }
+    assert!(faces[0] == faces[1] && faces[0] >= 16, "the faces refine alike: {faces:?}");
+    // The floor's irradiance: the lower face's radiosity tau m F(x, lamp)
+    // over the sheet, 32 x 32 patches each sending its centre's value.
+    let patches: Vec<([[f64; 3]; 4], f64)> = (0..32 * 32)
+        .map(|k| {
+            let (x0, y0, d) = ((k % 32) as f64 / 32.0, (k / 32) as f64 / 32.0, 1.0 / 32.0);
+            let centre = [x0 + 0.5 * d, y0 + 0.5 * d, 0.5];
+            ([[x0, y0, 0.5], [x0 + d, y0, 0.5], [x0 + d, y0 + d, 0.5], [x0, y0 + d, 0.5]], tau * m * lambert_polygon(centre, [0.0, 0.0, -1.0], &lamp))
+        })
+        .collect();
+    let mut worst_floor = 0.0f64;
+    for e in solved.leaves_of("floor") {
+        let expected = solved.mean_at(e, 1, &|x, _| patches.iter().map(|(p, b)| b * lambert_polygon(x, UP, p)).sum::<f64>());
+        let got = f64::from(e.radiosity[0]) / 0.01;
+        worst_floor = worst_floor.max((got - expected).abs() / expected);
+        assert!((got - expected).abs() <= 1e-2 * expected, "floor at {:?}: irradiance {got} vs {expected}", solved.world(e)[0]);
+    }
+    eprintln!("translucent sheet: upper face {:.3}%, lower face {:.3}%, floor irradiance {:.3}% (worst elements)", 100.0 * worst[0], 100.0 * worst[1], 100.0 * worst_floor);
+}
+
+#[test]
+fn a_closed_box_with_a_translucent_internal_wall_conserves_energy() {
+    let dir = scratch("surface_solver_translucent_box");
+    let mut scene = end_to_end::scenes::closed_box(1.0, 0.5, 10.0);
+    scene.material("sheet", 0.3, 0.0).two_sided.push("sheet".into());
+    scene.quad("sheet", "sheet", end_to_end::scenes::rectangle(0, 0.5, [0.0, 0.0], [1.0, 1.0]), [1.0, 0.0, 0.0]);
+    let path = scene.write(&dir);
+    let mtl = std::fs::read_to_string(dir.join("scene.mtl")).unwrap();
+    std::fs::write(dir.join("scene.mtl"), format!("{mtl}illum 2\nd 0.5\nTf 1 1 1\n")).unwrap();
+    let solved = prepare_and_solve(&dir, &path, &["--eps", "1e-3", "--min-area", "1e-3", "--tolerance", "1e-7"]);
+    // Absorbed: sum A (1 - rho - tau) H over the leaves, H from the links.
+    let (mut emitted, mut absorbed) = (0.0, 0.0);
+    for e in solved.solution.elements.iter().filter(|e| e.first_child == NONE) {
+        let m = &solved.manifest.materials[solved.mesh.triangles[e.triangle as usize].material as usize];
+        let area = f64::from(e.area);
+        emitted += area * m.emission[0];
+        absorbed += area * (1.0 - m.diffuse[0] - m.diffuse_transmittance[0]) * irradiance(&solved.solution, e);
+    }
+    eprintln!("closed box with a translucent wall: absorbed / emitted = {:.5}", absorbed / emitted);
+    assert!((absorbed / emitted - 1.0).abs() < 1e-2, "absorbed {absorbed} of {emitted} emitted");
 }
 
 #[test]

@@ -5,6 +5,7 @@
 
 use crate::detail::Detail;
 use crate::nodes::ClusterTree;
+use crate::transmission::Transmission;
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
@@ -58,6 +59,8 @@ pub struct Hierarchy {
     /// Textures and alpha masks with each element's averages, where the
     /// scene has them.
     pub detail: Option<Detail>,
+    /// Translucent faces and their pairing, where a material transmits.
+    pub transmission: Option<Transmission>,
 }
 
 impl Hierarchy {
@@ -94,7 +97,8 @@ impl Hierarchy {
         }
         let clusters = clusters.map(|c| ClusterTree::new(c, &areas, &reflectance));
         let emission = mesh.triangles.iter().map(|t| material(t).emission).collect();
-        Hierarchy { elements, reflectance, emission, triangles, clusters, direct: Vec::new(), detail }
+        let transmission = Transmission::new(mesh, manifest);
+        Hierarchy { elements, reflectance, emission, triangles, clusters, direct: Vec::new(), detail, transmission }
     }
 
     /// Opaque fraction of element `e` (1 without an alpha mask).
@@ -115,12 +119,18 @@ impl Hierarchy {
     }
 
     /// The source term of element `e`, W/m²: its emission plus its
-    /// reflected direct light from the luminaires, `E + rho D`.
+    /// reflected direct light from the luminaires, `E + rho D`, plus, on a
+    /// translucent face, the direct light its twin transmits, `tau D_twin`
+    /// ([`crate::transmission`]).
     pub fn source(&self, e: u32) -> [f64; 3] {
         let t = self.elements[e as usize].triangle as usize;
-        let d = self.direct.get(e as usize).copied().unwrap_or(0.0);
+        let direct = |e: u32| self.direct.get(e as usize).copied().unwrap_or(0.0);
         let rho = self.reflectance_of(e);
-        [0, 1, 2].map(|c| self.emission[t][c] + rho[c] * d)
+        let mut s = [0, 1, 2].map(|c| self.emission[t][c] + rho[c] * direct(e));
+        if let Some((tau, twin)) = self.transmission_of(e) {
+            (0..3).for_each(|c| s[c] += tau[c] * direct(twin));
+        }
+        s
     }
 
     /// Creates the four children of `e` if it has none; returns the first.

@@ -71,11 +71,22 @@ struct Topology {
     /// Reflectance and source (emission plus reflected luminaire light,
     /// [`Hierarchy::source`]) of leaf elements; `None` for inner nodes.
     leaf: Vec<Option<([f64; 3], [f64; 3])>>,
+    /// Transmittance and the dense index of the twin leaf of the leaves of
+    /// translucent faces ([`crate::transmission`]); empty without any.
+    transmit: Vec<Option<([f64; 3], usize)>>,
 }
 
 impl Topology {
     fn new(h: &Hierarchy, n: usize) -> Self {
-        let mut t = Topology { parent: vec![usize::MAX; n], child_start: vec![0; n + 1], children: Vec::new(), area: vec![0.0; n], leaf: vec![None; n] };
+        let mut t = Topology { parent: vec![usize::MAX; n], child_start: vec![0; n + 1], children: Vec::new(), area: vec![0.0; n], leaf: vec![None; n], transmit: Vec::new() };
+        if h.transmission.is_some() {
+            t.transmit = (0..n)
+                .map(|i| match node(h, i) {
+                    Node::Element(e) if h.elements[e as usize].is_leaf() => h.transmission_of(e).map(|(tau, twin)| (tau, h.flat(Node::Element(twin)))),
+                    _ => None,
+                })
+                .collect();
+        }
         for i in 0..n {
             let this = node(h, i);
             t.area[i] = h.area(this);
@@ -235,7 +246,13 @@ pub fn solve(h: &Hierarchy, links: &[Link], offsets: &[usize], b: &mut [[f64; 3]
             let above = if topology.parent[i] == usize::MAX { [0.0; 3] } else { h_down[topology.parent[i]] };
             h_down[i] = [0, 1, 2].map(|c| gathered[i][c] + above[c]);
             if let Some((rho, source)) = topology.leaf[i] {
-                let new = [0, 1, 2].map(|c| source[c] + rho[c] * h_down[i][c]);
+                let mut new = [0, 1, 2].map(|c| source[c] + rho[c] * h_down[i][c]);
+                // A translucent face also leaves what its twin receives
+                // (this iteration's where the twin comes first, else the
+                // last one's).
+                if let Some(Some((tau, twin))) = topology.transmit.get(i) {
+                    (0..3).for_each(|c| new[c] += tau[c] * h_down[*twin][c]);
+                }
                 for c in 0..3 {
                     delta[i][c] = new[c] - b[i][c];
                     change[c] = change[c].max(delta[i][c].abs());
@@ -395,6 +412,14 @@ fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize]) -> [f64; 3
         if let Some((rho, _)) = topology.leaf[i] {
             for c in 0..3 {
                 norm[c] = norm[c].max(rho[c] * chain[i]);
+            }
+        }
+    }
+    // A translucent leaf's row also holds tau times its twin's chain.
+    for (i, transmit) in topology.transmit.iter().enumerate() {
+        if let (Some((rho, _)), Some((tau, twin))) = (topology.leaf[i], transmit) {
+            for c in 0..3 {
+                norm[c] = norm[c].max(rho[c] * chain[i] + tau[c] * chain[*twin]);
             }
         }
     }

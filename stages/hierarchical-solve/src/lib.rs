@@ -69,6 +69,7 @@ pub mod links;
 pub mod luminaires;
 pub mod nodes;
 pub mod transfer;
+pub mod transmission;
 pub mod visibility;
 
 use elements::Hierarchy;
@@ -340,6 +341,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let allowance = allowance(params, threshold, Some(mean_reflected(&h, &sources)));
         work.luminaire_rays += luminaires::refine(&mut h, &direct, &allowance, min_area, params.quadrature_depth);
     }
+    h.pair_faces();
     work.luminaire_seconds += started.elapsed().as_secs_f64();
     let mut b: Vec<[f64; 3]> = vec![[0.0; 3]; h.cluster_count()];
     b.extend((0..h.elements.len() as u32).map(|e| h.source(e)));
@@ -403,6 +405,13 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
             work.form_factors += active.len() as u64;
             if split == 0 {
                 break;
+            }
+        }
+        // The faces of translucent surfaces refine alike (crate::transmission).
+        if h.pair_faces() {
+            while b.len() < h.cluster_count() + h.elements.len() {
+                let parent = h.elements[b.len() - h.cluster_count()].parent;
+                b.push(b[h.flat(Node::Element(parent))]);
             }
         }
         work.refine_seconds += started.elapsed().as_secs_f64();

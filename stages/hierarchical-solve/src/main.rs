@@ -2,6 +2,7 @@
 
 use clap::Parser;
 use schemas::cli::{check_outputs, main_of};
+use hierarchical_solve::transmission::Transmission;
 use hierarchical_solve::{solve_with_surface, Criterion, Params, Phase};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
@@ -114,13 +115,15 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
 
 /// What this stage does not simulate, for the effects the scene has;
 /// `surface`: whether surface.exr was given (textures, alpha masks and
-/// normal maps are simulated from it).
-fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
+/// normal maps are simulated from it); `one_sided`: triangles of
+/// translucent materials that are not two-sided (they cannot transmit).
+fn skipped(effects: &Effects, surface: bool, one_sided: usize) -> Vec<String> {
+    let transmits = format!("diffuse transmission: {one_sided} triangles of translucent materials that are not two-sided transmit nothing (their back face has no elements; make the material two_sided)");
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
         (effects.specular_reflection, "specular reflection: not simulated by hierarchical-solve; mirrors keep their diffuse part only"),
         (effects.specular_transmission, "specular transmission: not simulated by hierarchical-solve"),
-        (effects.diffuse_transmission, "diffuse transmission: not simulated by hierarchical-solve"),
+        (effects.diffuse_transmission && one_sided > 0, &transmits),
         (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),
         (effects.alpha_masks && !surface, "alpha masks: no --surface given; surfaces are treated as opaque"),
         (effects.normal_maps && !surface, "normal maps: no --surface given; radiosity uses geometric normals"),
@@ -217,7 +220,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
                 counters.insert(name.to_string(), value);
             }
         }
-        let mut skipped = skipped(&manifest.effects, with_surface);
+        let one_sided = Transmission::new(&mesh, &manifest).map_or(0, |t| t.one_sided);
+        let mut skipped = skipped(&manifest.effects, with_surface, one_sided);
         if !clustered && manifest.effects.fine_clustered_geometry {
             skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
         }
