@@ -7,6 +7,30 @@ pub mod gather;
 pub mod structured;
 pub mod sweep;
 
+use std::path::PathBuf;
+
+/// The options of the drivers that run the pipeline on a scene (sweep,
+/// bench-structured): the reference, the solver's clustering, the image
+/// size and the output directory.
+#[derive(clap::Args, Debug)]
+pub struct PipelineArgs {
+    /// A reference image (EXR, e.g. another renderer's, such as make bench-peer's Mitsuba image) for scenes with neither a closed form nor an exact image.
+    #[arg(long, value_name = "REFERENCE.exr")]
+    pub reference: Option<PathBuf>,
+    /// Solve without the cluster hierarchy (the Makefile's CLUSTERS=0).
+    #[arg(long)]
+    pub no_clusters: bool,
+    /// Image width, pixels [default: the scene camera's].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height, pixels [default: the scene camera's].
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Output directory.
+    #[arg(short = 'o', long = "output", value_name = "DIR")]
+    pub output: PathBuf,
+}
+
 /// The process's peak resident memory (VmHWM), MiB; `None` off Linux.
 pub fn peak_memory_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;

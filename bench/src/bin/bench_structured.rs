@@ -11,12 +11,12 @@
 
 use bench::structured::{run, Config};
 use bench::sweep::stages::Stages;
+use bench::PipelineArgs;
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
 use schemas::cli::main_of;
 use schemas::stage::{bad_parameter, check_writable};
 use schemas::{Error, Result};
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Structured sampling (structured-sample) against hierarchical radiosity
@@ -44,21 +44,8 @@ struct Args {
     /// Tolerances quality is compared at, comma-separated, each one of --tau (paper 002: 0.1 in Table 2, 0.15 in Table 3).
     #[arg(long, value_delimiter = ',', default_value = "0.1")]
     quality_tau: Vec<f64>,
-    /// A reference image (EXR, e.g. make bench-peer's Mitsuba image) for scenes the exact stage cannot render.
-    #[arg(long, value_name = "REFERENCE.exr")]
-    reference: Option<PathBuf>,
-    /// Solve without the cluster hierarchy (the Makefile's CLUSTERS=0).
-    #[arg(long)]
-    no_clusters: bool,
-    /// Image width, pixels [default: the scene camera's].
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height, pixels [default: the scene camera's].
-    #[arg(long)]
-    height: Option<u32>,
-    /// Output directory.
-    #[arg(short = 'o', long = "output", value_name = "DIR")]
-    output: PathBuf,
+    #[command(flatten)]
+    pipeline: PipelineArgs,
 }
 
 /// `NAME=object,object` as a surface of the table.
@@ -80,13 +67,13 @@ fn run_args(args: Args) -> Result<ExitCode> {
         surfaces: args.surface.iter().map(|s| parse_surface(s)).collect::<Result<_>>()?,
         eps: args.eps.clone(),
         levels: args.levels,
-        reference: args.reference.clone(),
+        reference: args.pipeline.reference.clone(),
         taus: args.tau.clone(),
         quality_taus: args.quality_tau.clone(),
-        clusters: !args.no_clusters,
-        width: args.width,
-        height: args.height,
-        out: args.output.clone(),
+        clusters: !args.pipeline.no_clusters,
+        width: args.pipeline.width,
+        height: args.pipeline.height,
+        out: args.pipeline.output.clone(),
     };
     let out = &config.out;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;

@@ -11,11 +11,11 @@
 use bench::sweep::knobs::{knob, Gather, Knob, Solver, KNOBS};
 use bench::sweep::stages::Stages;
 use bench::sweep::{plot, Config};
+use bench::PipelineArgs;
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
 use schemas::stage::{bad_parameter, check_writable, exit_code};
 use schemas::{Error, Result};
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Runs the pipeline's stages over a grid of knob values and tabulates and
@@ -40,21 +40,8 @@ struct Args {
     /// Runs per point; each figure is their median.
     #[arg(long, default_value_t = 3)]
     reps: usize,
-    /// A reference image (EXR, e.g. another renderer's) for scenes without a closed form.
-    #[arg(long, value_name = "REFERENCE.exr")]
-    reference: Option<PathBuf>,
-    /// Solve without the cluster hierarchy (the Makefile's CLUSTERS=0).
-    #[arg(long)]
-    no_clusters: bool,
-    /// Image width, pixels [default: the scene camera's].
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height, pixels [default: the scene camera's].
-    #[arg(long)]
-    height: Option<u32>,
-    /// Output directory.
-    #[arg(short = 'o', long = "output", value_name = "DIR")]
-    output: PathBuf,
+    #[command(flatten)]
+    pipeline: PipelineArgs,
 }
 
 /// `NAME=v1,v2,...` as a knob and its values.
@@ -95,11 +82,11 @@ fn config(args: &Args) -> Result<Config> {
         gathers,
         knobs,
         reps: args.reps,
-        reference: args.reference.clone(),
-        clusters: !args.no_clusters,
-        width: args.width,
-        height: args.height,
-        out: args.output.clone(),
+        reference: args.pipeline.reference.clone(),
+        clusters: !args.pipeline.no_clusters,
+        width: args.pipeline.width,
+        height: args.pipeline.height,
+        out: args.pipeline.output.clone(),
     })
 }
 

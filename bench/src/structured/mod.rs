@@ -122,21 +122,11 @@ pub fn run(config: &Config, stages: &Stages, progress: &mut dyn FnMut(&str)) -> 
     let mut notes = Vec::new();
     let reference_dir = out.join("reference");
     std::fs::create_dir_all(&reference_dir).map_err(|e| Error::io(&reference_dir, e))?;
+    // The converged run of the last resort is hierarchical-solve's full
+    // gather, which the runs themselves do not sweep.
     let hierarchical = plans.iter().find(|p| p.solver == Solver::Hierarchical).expect("the plan has the hierarchical solver");
-    let (mut reference, measure) = match sweep::exact_reference(stages, &sweep_config, &prepared, &reference_dir) {
-        Ok(found) => {
-            if let Some(given) = &config.reference {
-                notes.push(format!("--reference {} not used: the scene has an exact image, which comes first", given.display()));
-            }
-            found
-        }
-        Err(refused) => {
-            notes.push(format!("no exact image: {refused}"));
-            // A converged run is the full gather's, which the runs do not sweep.
-            let converged = sweep::Plan { gathers: vec![Gather::Preview, Gather::Full], ..hierarchical.clone() };
-            sweep::other_reference(stages, &sweep_config, &converged, &prepared, &reference_dir, &mut record, progress)?
-        }
-    };
+    let converged = sweep::Plan { gathers: vec![Gather::Preview, Gather::Full], ..hierarchical.clone() };
+    let (mut reference, measure) = sweep::image_reference(stages, &sweep_config, &converged, &prepared, &reference_dir, &mut record, &mut notes, progress)?;
     if let (ReferenceKind::StrictestRun, Some(run)) = (reference.kind, &reference.run) {
         let knobs: Vec<String> = run.knobs.iter().map(|k| format!("{}={}", k.name, k.value)).collect();
         reference.label = format!("reference: hierarchical-solve converged run, {} gather, {} (no --reference EXR given; not an independent truth)", run.gather, knobs.join(" "));

@@ -412,18 +412,7 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
         }
         Err(why) => {
             notes.push(format!("no closed form per element: {why}"));
-            match exact_reference(stages, config, &prepared, &reference_dir) {
-                Ok(found) => {
-                    if let Some(given) = &config.reference {
-                        notes.push(format!("--reference {} not used: the scene has an exact image, which comes first", given.display()));
-                    }
-                    found
-                }
-                Err(refused) => {
-                    notes.push(format!("no exact image: {refused}"));
-                    other_reference(stages, config, &plans[0], &prepared, &reference_dir, &mut record, progress)?
-                }
-            }
+            image_reference(stages, config, &plans[0], &prepared, &reference_dir, &mut record, &mut notes, progress)?
         }
     };
     if let (Measure::Solution(_), Some(plan)) = (&measure, plans.iter().find(|p| !p.solver.has_solution())) {
@@ -566,6 +555,35 @@ pub fn exact_reference(stages: &Stages, config: &Config, prepared: &Prepared, di
     stages.run("exact", &args, &dir.join("exact.report.ron")).map_err(|e| e.to_string())?;
     let label = format!("reference: exact image (paper 002, {EXACT_BOUNCES} bounces, within its stated bound)");
     Ok((Reference { kind: ReferenceKind::Exact, label, file: s(&image), run: None }, Measure::Image(image, vec!["--exclude-emitters", "--exclude-edges", "1"])))
+}
+
+/// The reference image of a scene without a closed form: the exact image
+/// where the `exact` stage renders the scene, else [`other_reference`]
+/// (with `plan`'s strictest run as the last resort). `notes` get why the
+/// exact image is missing, or that a `--reference` given is not used.
+#[allow(clippy::too_many_arguments)]
+pub fn image_reference(
+    stages: &Stages,
+    config: &Config,
+    plan: &Plan,
+    prepared: &Prepared,
+    dir: &Path,
+    record: &mut Run,
+    notes: &mut Vec<String>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Reference, Measure)> {
+    match exact_reference(stages, config, prepared, dir) {
+        Ok(found) => {
+            if let Some(given) = &config.reference {
+                notes.push(format!("--reference {} not used: the scene has an exact image, which comes first", given.display()));
+            }
+            Ok(found)
+        }
+        Err(refused) => {
+            notes.push(format!("no exact image: {refused}"));
+            other_reference(stages, config, plan, prepared, dir, record, progress)
+        }
+    }
 }
 
 /// The reference of a scene with neither a closed form nor an exact image:
