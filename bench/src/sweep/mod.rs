@@ -546,7 +546,7 @@ pub const EXACT_BOUNCES: u32 = 20;
 
 /// The exact image as the reference, if the `exact` stage renders the
 /// scene; else its refusal, one line.
-pub fn exact_reference(stages: &Stages, config: &Config, prepared: &Prepared, dir: &Path) -> std::result::Result<(Reference, Measure), String> {
+fn exact_reference(stages: &Stages, config: &Config, prepared: &Prepared, dir: &Path) -> std::result::Result<(Reference, Measure), String> {
     let image = dir.join("exact.exr");
     let mut args = vec!["--mesh".to_string(), s(&prepared.mesh), "--manifest".into(), s(&prepared.manifest), "-o".into(), s(&image)];
     args.push(format!("--bounces={EXACT_BOUNCES}"));
@@ -589,7 +589,7 @@ pub fn image_reference(
 /// The reference of a scene with neither a closed form nor an exact image:
 /// the `--reference` EXR, else the strictest run of `plan`.
 #[allow(clippy::too_many_arguments)]
-pub fn other_reference(
+fn other_reference(
     stages: &Stages,
     config: &Config,
     plan: &Plan,
@@ -617,7 +617,7 @@ pub fn other_reference(
 /// knob beyond its strictest value and SPP 4x, in the most accurate
 /// gather swept, with seeds no point uses. Returns the reference and its
 /// image.
-pub fn strictest_run(stages: &Stages, config: &Config, plan: &Plan, prepared: &Prepared, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<(Reference, PathBuf)> {
+fn strictest_run(stages: &Stages, config: &Config, plan: &Plan, prepared: &Prepared, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<(Reference, PathBuf)> {
     let mut setting: Setting = plan.knobs.iter().map(|(k, values)| (*k, k.beyond(values))).collect();
     if !setting.iter().any(|(k, _)| k.name == "SPP") {
         let spp = knobs::knob("SPP").expect("SPP is a knob");
