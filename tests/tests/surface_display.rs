@@ -10,6 +10,7 @@
 //! pixels through its cut-out half see the floor and shows its opaque half
 //! (lit by nothing) black; a normal map tilting every normal by a known
 //! angle gives the full gather `rho E(n') / pi` with the tilted normal; a
+//! two-sided translucent sheet seen from behind shows `tau E / pi`; a
 //! scene without detail renders the same pixels with and without the
 //! surface artifact, which it does not read; one from another mesh-prep
 //! run is refused.
@@ -402,4 +403,48 @@ fn a_surface_artifact_from_another_mesh_prep_run_is_refused() {
     let (image, solution) = (dir.join("image.exr"), dir.join("solution.exr"));
     let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "--surface", s(&other), "-o", s(&image)];
     assert_refused("grid-gather", &args, &["other.surface.exr", "does not belong with the mesh"], &[&image]);
+}
+
+#[test]
+fn a_translucent_sheet_seen_from_behind_shows_the_light_it_transmits_in_the_full_gather() {
+    // The floor as a two-sided sheet (rho 0.25, tau 0.5) seen from below:
+    // its lower face receives nothing, so it shows tau E / pi, E the
+    // upper face's irradiance from the lamp (004 Eq. 4.4).
+    let (rho, tau) = (0.25, 0.5);
+    let (dir, scene) = display_scene("display_translucent", &format!("Kd {rho}\n"), None, &[]);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let overrides = format!(", materials: {{ \"floor\": (two_sided: Some(true), diffuse_transmittance: Some(({tau:?}, {tau:?}, {tau:?}))) }})");
+    let below = text.replacen("eye: (0.5, 0.5, 2.0)", "eye: (0.5, 0.5, -2.0)", 1);
+    std::fs::write(&scene, format!("{}{overrides}", below.strip_suffix(')').unwrap())).unwrap();
+    prepare_and_solve(&dir, &scene, false);
+    let image = gather(&dir, "full");
+    // Seen from below (up +y), the image's x runs along -x: the floor point
+    // is the point from above mirrored in x.
+    let under = |x: f64, y: f64| {
+        let p = ray_at(x, y, 0.0);
+        [1.0 - p[0], p[1]]
+    };
+    let (mut checked, mut worst) = (0, 0.0f64);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(a, b)| under(f64::from(x) + a, f64::from(y) + b));
+            if !corners.iter().all(|c| c.iter().all(|&v| (0.0..=1.0).contains(&v))) {
+                continue;
+            }
+            let mut expected = 0.0;
+            for k in 0..64 {
+                let p = under(f64::from(x) + (f64::from(k % 8) + 0.5) / 8.0, f64::from(y) + (f64::from(k / 8) + 0.5) / 8.0);
+                expected += tau * irradiance(p, [0.0, 0.0, 1.0]) / std::f64::consts::PI / 64.0;
+            }
+            let got = f64::from(image.rgb[(y * SIZE + x) as usize][0]);
+            let error = (got - expected).abs() / expected;
+            assert!(error < 0.0075, "pixel ({x}, {y}): radiance {got}, expected tau E / pi = {expected} (error {error})");
+            checked += 1;
+            worst = worst.max(error);
+        }
+    }
+    eprintln!("translucent sheet from below: {checked} pixels, largest error {worst:.4}");
+    assert!(checked > (SIZE * SIZE) as usize / 2);
+    let report = std::fs::read_to_string(dir.join("full.report.ron")).unwrap();
+    assert!(!report.contains("diffuse transmission"), "simulated, yet listed as skipped: {report}");
 }

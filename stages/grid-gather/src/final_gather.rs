@@ -93,6 +93,10 @@ pub struct FullScene<'a> {
     /// Surface detail (textures, alpha masks, normal maps), where the scene
     /// has some and the surface artifact was given.
     pub detail: Option<&'a Detail<'a>>,
+    /// Per triangle of a two-sided translucent material: its diffuse
+    /// transmittance and its twin (the other face); empty for a scene
+    /// without diffuse transmission.
+    pub transmission: &'a [Option<([f64; 3], u32)>],
     /// The goniometric point lights (luminaires). The solution's element
     /// radiosity holds the light they reflect; their direct light on the
     /// receiver is not in the links (a point light is no sender), so each
@@ -154,7 +158,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let rows: Vec<(Vec<([f32; 3], f32, Work, [u32; 3])>, u64)> = (0..height)
         .into_par_iter()
         .map(|y| {
-            let mut links = Vec::new();
+            let (mut links, mut back_links) = (Vec::new(), Vec::new());
             let mut hits = 0u64;
             let row = (0..width)
                 .map(|x| {
@@ -192,10 +196,26 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                         };
                         let (direct, cast) = luminaires.at_point(p, normal, hit.triangle);
                         sample.visibility_rays += cast;
+                        // 004 Eq. 4.4: a translucent surface also emits
+                        // tau times the irradiance of its other face, gathered
+                        // there (the twin's links and normal, the same point).
+                        let transmitted = scene.transmission.get(hit.triangle as usize).copied().flatten().map(|(tau, twin)| {
+                            let back = &scene.triangles[twin as usize];
+                            let back_uv = back.uv_of(p);
+                            let back_leaf = senders.chain(twin, back_uv, &mut back_links);
+                            let h = match params.mode {
+                                Mode::Brute => brute_irradiance(&senders, &rays, p, back.normal, twin, &back_links, params.brute_samples, &mut gather_stream, &mut sample),
+                                _ => gather.irradiance(p, back.normal, twin, back_leaf, &back_links, k, &mut sample),
+                            };
+                            let (direct, cast) = luminaires.at_point(p, back.normal, twin);
+                            sample.visibility_rays += cast;
+                            std::array::from_fn::<f64, 3, _>(|c| tau[c] * (h[c] + direct))
+                        });
                         work.add(&sample);
                         let s = scene.surfaces[hit.triangle as usize];
                         let rho = scene.detail.and_then(|detail| detail.reflectance(hit.triangle, uv)).unwrap_or(s.reflectance);
-                        (0..3).for_each(|c| sum[c] += (s.emission[c] + rho[c] * (irradiance[c] + direct)) / PI);
+                        let t = transmitted.unwrap_or([0.0; 3]);
+                        (0..3).for_each(|c| sum[c] += (s.emission[c] + rho[c] * (irradiance[c] + direct) + t[c]) / PI);
                     }
                     let n = f64::from(spp);
                     (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, work, tally.finish())

@@ -20,7 +20,9 @@
 //! With mesh-prep's surface artifact (`--surface`), every mode shows
 //! textures (`B = E + rho(x) H` per hit) and lets rays through alpha-masked
 //! holes, and the full and brute gathers take normal maps in their cosines
-//! ([`detail`]).
+//! ([`detail`]). The full and brute gathers add a two-sided translucent
+//! surface's transmitted light, `tau H_back` gathered on its other face
+//! (paper 004 Eq. 4.4; [`final_gather::FullScene::transmission`]).
 //!
 //! ## Parameters
 //!
@@ -416,6 +418,18 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     ))
 }
 
+/// Per triangle of a two-sided translucent material, its diffuse
+/// transmittance and its twin (see [`final_gather::FullScene`]); empty for
+/// a scene without diffuse transmission.
+fn transmission(scene: &Scene) -> Vec<Option<([f64; 3], u32)>> {
+    if !scene.manifest.effects.diffuse_transmission {
+        return Vec::new();
+    }
+    let tau = |t: &schemas::mesh::Triangle| scene.manifest.materials[t.material as usize].diffuse_transmittance;
+    let twins = scene.mesh.twins();
+    scene.mesh.triangles.iter().zip(twins).map(|(t, twin)| twin.filter(|_| tau(t).iter().any(|&x| x > 0.0)).map(|twin| (tau(t), twin))).collect()
+}
+
 /// The BVH over `triangles`, whose rays pass through alpha-masked holes
 /// where `detail` has alpha masks.
 pub fn scene_rays(triangles: &[radiometry::geometry::TriangleGeometry], detail: Option<&detail::Detail>) -> SceneRays {
@@ -468,8 +482,19 @@ fn full_gather(
     } else {
         Vec::new()
     };
-    let full_scene =
-        final_gather::FullScene { triangles, surfaces: &surfaces, ids: &ids, solution: scene.solution, clusters: extras.clusters, threshold: extras.threshold, camera, detail: extras.detail, lights: &lights };
+    let transmission = transmission(scene);
+    let full_scene = final_gather::FullScene {
+        triangles,
+        surfaces: &surfaces,
+        ids: &ids,
+        solution: scene.solution,
+        clusters: extras.clusters,
+        threshold: extras.threshold,
+        camera,
+        detail: extras.detail,
+        transmission: &transmission,
+        lights: &lights,
+    };
     let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
     let mut counters = image.counters;
     counters.insert("triangles".into(), triangles.len() as f64);
@@ -480,6 +505,11 @@ fn full_gather(
         Rendered { width: width as usize, height: height as usize, rgb: image.rgb, coverage: image.coverage, surfaces: image.surfaces, counters, skipped },
         image.diagnostics,
     ))
+}
+
+/// Whether some translucent material is not two-sided.
+fn one_sided_translucent(manifest: &Manifest) -> bool {
+    manifest.materials.iter().any(|m| !m.two_sided && m.diffuse_transmittance.iter().any(|&x| x > 0.0))
 }
 
 /// What a gather in `mode` leaves out, and why, given the scene's effects;
@@ -500,7 +530,8 @@ pub fn skipped(manifest: &Manifest, mode: Mode, detail: bool) -> Vec<String> {
         (e.alpha_masks && !detail, format!("alpha masks: {no_surface}; rays hit the whole triangles")),
         (e.specular_reflection, "specular reflection: present but not traced; mirrors show their diffuse radiosity".to_string()),
         (e.specular_transmission, "specular transmission: present but not traced; glass shows its diffuse radiosity".to_string()),
-        (e.diffuse_transmission, "diffuse transmission: back faces shade black, radiosity in the solution is one-sided".to_string()),
+        (e.diffuse_transmission && mode == Mode::Preview, "diffuse transmission: the preview shows the radiosity the solver transmitted; a translucent material that is not two-sided has no back face and shows black from behind".to_string()),
+        (e.diffuse_transmission && mode != Mode::Preview && one_sided_translucent(manifest), "diffuse transmission: a translucent material that is not two-sided has no back face, transmits nothing and shows black from behind".to_string()),
     ];
     skipped.extend(present.into_iter().filter(|(on, _)| *on).map(|(_, why)| why));
     skipped
