@@ -117,7 +117,7 @@ fn timed_phases(solver: Solver) -> &'static [(&'static str, &'static str, Option
             ("placement", "placement_seconds", None),
             ("direct", "direct_seconds", Some('A')),
             ("shooting", "shooting_seconds", Some('B')),
-            ("indirect display samples", "indirect_placement_seconds", Some('B')),
+            ("indirect_display", "indirect_placement_seconds", Some('B')),
             ("display", "display_seconds", None),
         ],
         // Every link is refined, tested and gathered in the same passes,
@@ -235,7 +235,7 @@ mod tests {
         let (phases, to_a, to_b) = time_split(Solver::Structured, &[("structured-sample".into(), 7.0)], &structured);
         assert_eq!((to_a, to_b), (Some(2.0), Some(3.5)));
         let names: Vec<&str> = phases.iter().map(|p| p.name.as_str()).collect();
-        assert_eq!(names, ["structured-sample", "structured-sample/placement", "structured-sample/direct", "structured-sample/shooting", "structured-sample/indirect display samples", "structured-sample/display"]);
+        assert_eq!(names, ["structured-sample", "structured-sample/placement", "structured-sample/direct", "structured-sample/shooting", "structured-sample/indirect_display", "structured-sample/display"]);
         let hierarchical = report(&[("refine_seconds", 1.0), ("visibility_seconds", 2.0), ("gather_seconds", 3.0)]);
         let (phases, to_a, to_b) = time_split(Solver::Hierarchical, &[("cluster".into(), 0.5), ("hierarchical-solve".into(), 6.0), ("grid-gather".into(), 1.0)], &hierarchical);
         assert_eq!((to_a, to_b), (None, None));

@@ -367,7 +367,7 @@ impl Bench {
     /// each tau (image, then each surface), per surface samples, element
     /// vertices and secondary emitters (empty where the solver has none),
     /// the light-to-A, A-to-B and total times (empty where not split), and
-    /// every phase as `name=seconds` separated by spaces.
+    /// every phase as `name=seconds` separated by spaces (names have none).
     pub fn csv(&self) -> String {
         let surfaces = self.surface_names();
         let mut out = String::from("solver,setting,roles");
