@@ -155,7 +155,9 @@ pub fn bad_parameter(message: impl Into<String>) -> Error {
 }
 
 /// The error for `derived` if it records inputs made by the stage that
-/// made `source`, none of which is `source` itself (by SHA-256): the two
+/// made `source`, none of which is `source` itself (by SHA-256) nor a
+/// sibling output of the same run (same provenance: mesh-prep's surface
+/// file belongs with a clusters file made from that run's mesh): the two
 /// files come from different runs. `None` where they may belong together,
 /// or where either carries no provenance (a foreign file, a photometric
 /// file) and nothing can be told.
@@ -163,7 +165,7 @@ fn made_from_another(derived: &Input, source: &Input) -> Option<Error> {
     let (made, source_made) = (derived.made_by.as_deref()?, source.made_by.as_deref()?);
     let stage = &source_made.stage;
     let siblings: Vec<&Input> = made.inputs.iter().filter(|i| i.made_by.as_ref().is_some_and(|m| &m.stage == stage)).collect();
-    if siblings.is_empty() || siblings.iter().any(|i| i.sha256 == source.sha256) {
+    if siblings.is_empty() || siblings.iter().any(|i| i.sha256 == source.sha256 || i.made_by.as_deref() == Some(source_made)) {
         return None;
     }
     let recorded: Vec<String> = siblings.iter().map(|i| format!("{} (SHA-256 {:.12})", i.path, i.sha256)).collect();
@@ -291,7 +293,8 @@ mod tests {
 
     #[test]
     fn an_input_made_from_another_run_is_refused_naming_both_files() {
-        let mesh = |path: &str, sha: &str| input(path, sha, made_by("mesh-prep", vec![]));
+        // A mesh-prep run's provenance records its scene's hash.
+        let mesh = |path: &str, sha: &str| input(path, sha, made_by("mesh-prep", vec![input("scene.ron", sha, None)]));
         let clusters = |from: Input| input("out/clusters.exr", "c1", made_by("cluster", vec![from, input("scene.ron", "s", None)]));
         let mut run = Run::start("test", "0");
         run.input(mesh("out/mesh.exr", "aaaa")).unwrap();
@@ -309,6 +312,15 @@ mod tests {
         run.input(clusters(mesh("elsewhere/mesh.exr", "aaaa"))).unwrap();
         // Files without provenance (foreign, photometric) tell nothing.
         run.input(input("lamp.ldt", "dddd", None)).unwrap();
+        // Another output of the mesh's own run (surface.exr) belongs with
+        // clusters made from that mesh; one of another run does not.
+        let surface = |sha_of_run: &str| input("out/surface.exr", "eeee", made_by("mesh-prep", vec![input("scene.ron", sha_of_run, None)]));
+        let mut run = Run::start("test", "0");
+        run.input(clusters(mesh("out/mesh.exr", "aaaa"))).unwrap();
+        run.input(surface("aaaa")).unwrap();
+        let mut run = Run::start("test", "0");
+        run.input(clusters(mesh("out/mesh.exr", "aaaa"))).unwrap();
+        assert!(run.input(surface("bbbb")).unwrap_err().to_string().starts_with("out/clusters.exr: does not belong with out/surface.exr"));
     }
 
     fn scratch(name: &str) -> std::path::PathBuf {
