@@ -180,7 +180,12 @@ pub fn texel_point(region: Region, i: u32, j: u32) -> [f64; 2] {
 /// wide atlas), covered texels with positions and areas, and groups of
 /// `2^level` x `2^level` texels for substructured shooting.
 pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_size: u32, level: u32) -> Atlas {
-    let sizes = object_sizes(mesh, manifest.objects.len(), texels, min_size, max_size);
+    bake_sized(mesh, object_sizes(mesh, manifest.objects.len(), texels, min_size, max_size), level)
+}
+
+/// [`bake`] with given region sizes per object (the input mesh's, for the
+/// tiles of an adaptive subdivision, [`crate::tiling`]).
+pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, level: u32) -> Atlas {
     let size_of = |t: usize| sizes[mesh.triangles[t].object as usize];
     let footprint: u64 = (0..mesh.triangles.len()).map(|t| ((size_of(t) + 2) as u64).pow(2)).sum();
     let largest = (0..mesh.triangles.len()).map(|t| size_of(t) + 2).max().unwrap_or(1);

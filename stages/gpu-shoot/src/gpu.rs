@@ -221,6 +221,8 @@ pub struct Gpu {
     prepare: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
     receive: wgpu::ComputePipeline,
+    /// The adaptive subdivision's count pass and its per-triangle counters.
+    count: Option<(wgpu::ComputePipeline, wgpu::Buffer)>,
     render: wgpu::RenderPipeline,
     layer_views: Vec<wgpu::TextureView>,
     depth_view: wgpu::TextureView,
@@ -258,8 +260,11 @@ pub struct Setup<'a> {
     pub tris: &'a [GpuTri],
     /// The shooting samples (texel groups).
     pub groups: &'a [GpuGroup],
-    /// Initial radiosity = residual = emission, per texel (rgb, 0).
-    pub emission: &'a [[f32; 4]],
+    /// Initial radiosity per texel (rgb, 0): the emission, or what a
+    /// subdivided tile copied down.
+    pub radiosity: &'a [[f32; 4]],
+    /// Initial residual per texel (rgb, 0).
+    pub residual: &'a [[f32; 4]],
     /// Triangle corners, 3 per triangle (xyz, 1).
     pub vertices: &'a [[f32; 4]],
     /// Visibility map side, pixels.
@@ -273,6 +278,8 @@ pub struct Setup<'a> {
     /// The alpha masks for the visibility maps' test
     /// ([`crate::detail::Detail::mask_tables`]), where some triangle has one.
     pub masks: Option<(&'a [[f32; 4]], &'a [f32])>,
+    /// Build the visibility count of the adaptive subdivision.
+    pub adaptive: bool,
 }
 
 const SAMPLE_SIZE: u64 = std::mem::size_of::<GpuSample>() as u64;
@@ -294,8 +301,8 @@ impl Gpu {
             mapped_at_creation: false,
         });
         let texels = init("texels", bytemuck::cast_slice(setup.texels), rw);
-        let radiosity = init("radiosity", bytemuck::cast_slice(setup.emission), rw);
-        let residual = init("residual", bytemuck::cast_slice(setup.emission), rw);
+        let radiosity = init("radiosity", bytemuck::cast_slice(setup.radiosity), rw);
+        let residual = init("residual", bytemuck::cast_slice(setup.residual), rw);
         let tris = init("tris", bytemuck::cast_slice(setup.tris), rw);
         let groups = init("groups", bytemuck::cast_slice(setup.groups), rw);
         let tri_power = init("tri_power", &vec![0u8; setup.tris.len() * 32], rw);
@@ -366,12 +373,19 @@ impl Gpu {
             count: None,
         });
         entries.push(storage(11, c, true));
+        let counts = setup.adaptive.then(|| init("counts", &vec![0u8; setup.tris.len() * 8], rw));
+        if counts.is_some() {
+            entries.push(storage(12, c, false));
+        }
         let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("solver"), entries: &entries });
         let buffers = [&params, &texels, &radiosity, &residual, &tris, &groups, &tri_power, &selection, &samples, &ldt];
         let mut bind: Vec<wgpu::BindGroupEntry> =
             buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
         bind.push(wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&array_view) });
         bind.push(wgpu::BindGroupEntry { binding: 11, resource: vertices.as_entire_binding() });
+        if let Some(buffer) = &counts {
+            bind.push(wgpu::BindGroupEntry { binding: 12, resource: buffer.as_entire_binding() });
+        }
         let compute_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("solver"), layout: &compute_layout, entries: &bind });
         let compute_pipeline_layout =
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("solver"), bind_group_layouts: &[Some(&compute_layout)], immediate_size: 0 });
@@ -448,6 +462,7 @@ impl Gpu {
             prepare: pipeline("prepare_samples"),
             finish: pipeline("finish_shooter"),
             receive: pipeline("receive"),
+            count: counts.map(|buffer| (pipeline("count_visible"), buffer)),
             render,
             layer_views,
             depth_view,
@@ -496,6 +511,26 @@ impl Gpu {
     /// Renders the visibility maps of one batch of samples and runs the
     /// receiver pass over every texel.
     pub fn shoot_batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool) {
+        self.batch(device, queue, params, hemicube, &self.receive);
+    }
+
+    /// Renders the visibility maps of one batch of samples and adds every
+    /// triangle's visibility counts ([`Gpu::counts`]); the solver must
+    /// have been built with `adaptive`.
+    pub fn count_batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool) {
+        let (pipeline, _) = self.count.as_ref().expect("a solver built for adaptive subdivision");
+        self.batch(device, queue, params, hemicube, pipeline);
+    }
+
+    /// Per triangle `[n_r, n_v]` since the last call (which clears them).
+    pub fn counts(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Vec<[u32; 2]> {
+        let (_, buffer) = self.count.as_ref().expect("a solver built for adaptive subdivision");
+        let bytes = read_buffer(device, queue, buffer, self.tri_count as u64 * 8);
+        queue.write_buffer(buffer, 0, &vec![0u8; self.tri_count as usize * 8]);
+        bytemuck::pod_collect_to_vec(&bytes)
+    }
+
+    fn batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool, pass: &wgpu::ComputePipeline) {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let mut encoder = device.create_command_encoder(&Default::default());
         for sample in 0..params.sample_count {
@@ -533,7 +568,7 @@ impl Gpu {
         }
         let groups = self.texel_count.div_ceil(64);
         let (x, y) = if groups <= 65535 { (groups.max(1), 1) } else { (65535, groups.div_ceil(65535)) };
-        self.dispatch(&mut encoder, &self.receive, x, y);
+        self.dispatch(&mut encoder, pass, x, y);
         queue.submit([encoder.finish()]);
     }
 

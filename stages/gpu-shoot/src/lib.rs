@@ -32,6 +32,7 @@
 //! | `max_shots` | stop after this many shots | 100000 |
 //! | `ambient` | add `rho x ambient` (Eq. 2.4) to the solution's radiosity: a display aid for an unconverged solution, off by default because it adds light that an open scene does not have | false |
 //! | `texels_per_leaf` | solution leaves: about this many texels each | 4 |
+//! | `adaptive` | subdivision at shadow boundaries (004 Sec. 2.4): `lower`, `upper` (the bounds `b_l`, `b_u` of the visible fraction `n_v / n_r` that splits a receiver), `levels` (most splits of an input triangle) | off; on: 0.05, 0.95, 3 |
 
 pub mod atlas;
 pub mod detail;
@@ -39,6 +40,7 @@ pub mod gpu;
 pub mod output;
 pub mod reference;
 pub mod testing;
+pub mod tiling;
 
 use atlas::Atlas;
 use detail::{Detail, TexelDetail};
@@ -46,11 +48,13 @@ use glam::DVec3;
 use radiometry::geometry::frame_with_normal;
 pub use radiometry::photometry::Luminaire;
 use gpu::{Gpu, GpuGroup, GpuParams, GpuSample, GpuTexel, GpuTri, Setup};
-use schemas::lightmap::Shot;
+use schemas::header::{Provenance, Schema};
+use schemas::lightmap::{Lightmap, Shot};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::surface::Surface;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
+use tiling::Tile;
 
 /// How visibility from a shooting sample is found.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -100,6 +104,41 @@ pub struct Params {
     pub ambient: bool,
     /// Texels per solution leaf, about.
     pub texels_per_leaf: f64,
+    /// Adaptive subdivision at shadow boundaries (off: `None`, and then
+    /// not written, so the artifacts of a run without it keep their bits).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<Adaptive>,
+}
+
+/// Adaptive subdivision at shadow boundaries (004 Sec. 2.4): before a
+/// triangle first shoots, every receiving tile whose visible fraction
+/// `n_v / n_r` (texel-sample pairs the visibility maps see over those
+/// facing each other) lies in `[lower, upper]` is split 1:4, up to
+/// `levels` times per input triangle.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Adaptive {
+    /// `b_l`: a smaller visible fraction is a receiver in shadow but for
+    /// a short boundary, not split.
+    pub lower: f64,
+    /// `b_u`: a larger one is lit but for a short boundary, not split.
+    pub upper: f64,
+    /// Most 1:4 splits of an input triangle.
+    pub levels: u32,
+}
+
+impl Default for Adaptive {
+    fn default() -> Self {
+        Adaptive { lower: 0.05, upper: 0.95, levels: 3 }
+    }
+}
+
+impl Adaptive {
+    /// Whether a receiver with visible fraction `ratio` is crossed by a
+    /// shadow boundary worth a split: `b_l <= ratio <= b_u`.
+    pub fn crossed(&self, ratio: f64) -> bool {
+        (self.lower..=self.upper).contains(&ratio)
+    }
 }
 
 impl Default for Params {
@@ -117,6 +156,7 @@ impl Default for Params {
             max_shots: 100_000,
             ambient: false,
             texels_per_leaf: 4.0,
+            adaptive: None,
         }
     }
 }
@@ -144,6 +184,14 @@ impl Params {
         }
         if !(self.texels_per_leaf.is_finite() && self.texels_per_leaf >= 1.0) {
             return Some(format!("texels_per_leaf must be at least 1, got {}", self.texels_per_leaf));
+        }
+        if let Some(a) = &self.adaptive {
+            if !(0.0 <= a.lower && a.lower <= a.upper && a.upper <= 1.0) {
+                return Some(format!("adaptive bounds need 0 <= lower <= upper <= 1, got {} and {}", a.lower, a.upper));
+            }
+            if a.levels > 8 {
+                return Some(format!("adaptive levels must be at most 8, got {}", a.levels));
+            }
         }
         None
     }
@@ -182,13 +230,22 @@ pub struct Work {
     /// Texels of the texture atlas uploaded for the visibility maps'
     /// alpha test (0: no alpha mask, nothing allocated).
     pub mask_texels: u64,
+    /// Covered texels the adaptive subdivision added.
+    pub elements_added: u64,
+    /// Tiles it added (3 per split).
+    pub tiles_added: u64,
+    /// Seconds it took (counting, splitting, copying down, rebuilding).
+    pub subdivision_seconds: f64,
 }
 
 /// The result of a solve.
 #[derive(Clone, Debug)]
 pub struct Solved {
-    /// The atlas layout.
+    /// The atlas layout, one region per tile.
     pub atlas: Atlas,
+    /// The tiles ([`tiling`]): one per input triangle without adaptive
+    /// subdivision.
+    pub tiles: Vec<Tile>,
     /// Radiosity per covered texel (order of `atlas.texels`), W/m².
     pub radiosity: Vec<[f32; 3]>,
     /// Residual per covered texel, W/m².
@@ -208,6 +265,18 @@ pub struct Solved {
     pub triangle_power: Vec<[f32; 4]>,
 }
 
+impl Solved {
+    /// The mesh of its tiles: the input `mesh` itself without adaptive
+    /// subdivision.
+    pub fn tile_mesh<'a>(&self, mesh: &'a Mesh) -> std::borrow::Cow<'a, Mesh> {
+        if tiling::is_identity(&self.tiles) {
+            std::borrow::Cow::Borrowed(mesh)
+        } else {
+            std::borrow::Cow::Owned(tiling::mesh_of(mesh, &self.tiles))
+        }
+    }
+}
+
 /// The area-weighted mean reflectance of `texels` (0 where none is
 /// opaque): a textured triangle's for the ambient term and overshooting.
 fn mean_rho(texels: &[GpuTexel]) -> [f32; 4] {
@@ -216,31 +285,60 @@ fn mean_rho(texels: &[GpuTexel]) -> [f32; 4] {
     [mean(0) as f32, mean(1) as f32, mean(2) as f32, 0.0]
 }
 
-fn sum3(v: [f64; 3]) -> f64 {
-    v[0] + v[1] + v[2]
+fn f4(v: [f64; 3]) -> [f32; 4] {
+    [v[0] as f32, v[1] as f32, v[2] as f32, 0.0]
 }
 
-/// Runs the progressive solver on `device` / `queue`. `surface` (from
-/// `mesh-prep --surface`) gives textures, alpha masks and normal maps
-/// ([`detail`]); without it, or where no material has a texture, every
-/// texel takes its material's reflectance and its triangle's normal.
-/// `on_shot` sees every shot as it completes (for a progress bar).
-#[allow(clippy::too_many_arguments)]
-pub fn solve(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    mesh: &Mesh,
-    manifest: &Manifest,
-    surface: Option<&Surface>,
-    lights: &[Luminaire],
-    params: &Params,
-    on_shot: &mut dyn FnMut(&Shot),
-) -> Result<Solved, String> {
-    let started = Instant::now();
-    if mesh.triangles.is_empty() {
-        return Err("the mesh has no triangles".into());
-    }
-    let mut atlas = atlas::bake(mesh, manifest, params.texels, params.min_size, params.max_size, params.shoot_level);
+/// What every build of the solver's state shares.
+struct Context<'a> {
+    device: &'a wgpu::Device,
+    mesh: &'a Mesh,
+    manifest: &'a Manifest,
+    surface: Option<&'a Surface>,
+    params: &'a Params,
+    /// Region size per object, from the input mesh.
+    sizes: Vec<u32>,
+    /// Per input triangle: whether it has a twin.
+    twinned: Vec<bool>,
+    layers: u32,
+    ldt_capacity: usize,
+}
+
+/// The solver's state for one set of tiles.
+struct Built {
+    atlas: Atlas,
+    texels: Vec<GpuTexel>,
+    tris: Vec<GpuTri>,
+    gpu: Gpu,
+    /// Per tile: whether a normal map perturbs its texels' normals.
+    normal_mapped: Vec<bool>,
+    mask_texels: u64,
+}
+
+/// Initial radiosity and residual per covered texel of a new atlas.
+type Init<'a> = &'a dyn Fn(&Atlas) -> (Vec<[f32; 4]>, Vec<[f32; 4]>);
+
+/// Bakes the atlas of `tiles`, applies the surface detail, and uploads it
+/// all; radiosity and residual start as the emission, or as `init` says.
+fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
+    let identity = tiling::is_identity(tiles);
+    let tiled;
+    let mesh = if identity {
+        c.mesh
+    } else {
+        tiled = tiling::mesh_of(c.mesh, tiles);
+        &tiled
+    };
+    let tiled_surface;
+    let surface = match c.surface {
+        Some(s) if !identity => {
+            tiled_surface = tiling::surface_of(s, tiles);
+            Some(&tiled_surface)
+        }
+        s => s,
+    };
+    let manifest = c.manifest;
+    let mut atlas = atlas::bake_sized(mesh, c.sizes.clone(), c.params.shoot_level);
     let detail = surface.and_then(|s| Detail::new(mesh, s));
     // Per covered texel, what its textures make of it (None: its material has none).
     let details: Vec<Option<TexelDetail>> = match &detail {
@@ -261,7 +359,6 @@ pub fn solve(
         atlas.cover(&coverage, &|t| d.mask(mesh, t).is_some());
     }
     let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
-    let f4 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
     let texels: Vec<GpuTexel> = atlas
         .texels
         .iter()
@@ -309,16 +406,102 @@ pub fn solve(
     let groups: Vec<GpuGroup> = atlas.groups.iter().map(|g| GpuGroup { first: g.first, count: g.count, _pad: [0; 2] }).collect();
     // w: 2 for the corners of a triangle with a twin, whose back face the
     // visibility maps leave out (visibility.wgsl), else 1.
-    let twinned: Vec<bool> = mesh.twins().iter().map(Option::is_some).collect();
     let vertices: Vec<[f32; 4]> = mesh
         .triangles
         .iter()
-        .zip(&twinned)
-        .flat_map(|(t, &twin)| t.vertices.map(|v| {
+        .zip(tiles)
+        .flat_map(|(t, tile)| t.vertices.map(|v| {
             let p = mesh.positions[v as usize];
-            [p[0], p[1], p[2], if twin { 2.0 } else { 1.0 }]
+            [p[0], p[1], p[2], if c.twinned[tile.root as usize] { 2.0 } else { 1.0 }]
         }))
         .collect();
+    let max_groups = atlas.triangles.iter().map(|t| t.group_count).max().unwrap_or(1).max(1);
+    // The alpha masks for the visibility maps (004 Sec. 4.3.4), only where
+    // some triangle is masked.
+    let masks = detail.as_ref().filter(|d| d.masked(mesh)).map(|d| d.mask_tables(mesh));
+    let (radiosity, residual) = match init {
+        Some(init) => init(&atlas),
+        None => (emission.clone(), emission),
+    };
+    let gpu = Gpu::new(
+        c.device,
+        &Setup {
+            texels: &texels,
+            tris: &tris,
+            groups: &groups,
+            radiosity: &radiosity,
+            residual: &residual,
+            vertices: &vertices,
+            res: c.params.resolution,
+            layers: c.layers,
+            sample_capacity: max_groups.max(1),
+            ldt_capacity: c.ldt_capacity,
+            masks: masks.as_ref().map(|(t, m)| (t.as_slice(), m.as_slice())),
+            adaptive: c.params.adaptive.is_some(),
+        },
+    );
+    let normal_mapped = (0..tiles.len()).map(|t| detail.as_ref().is_some_and(|d| d.normal_mapped(mesh, t))).collect();
+    let mask_texels = masks.as_ref().map_or(0, |(_, m)| m.len() as u64);
+    Built { atlas, texels, tris, gpu, normal_mapped, mask_texels }
+}
+
+/// The samples of tile `shooter` (positions, frames, polygons; the GPU
+/// fills their powers): one per group, `offset` in front of it, its
+/// cosine's normal the group's mean perturbed normal under a normal map.
+fn samples_of(b: &Built, mesh: &Mesh, tiles: &[Tile], shooter: usize, offset: f64) -> Vec<GpuSample> {
+    let range = b.atlas.triangles[shooter];
+    let normal = DVec3::from(mesh.triangles[tiles[shooter].root as usize].normal.map(f64::from));
+    let [t, bt, n] = frame_with_normal(normal);
+    b.atlas.groups[range.group_first as usize..(range.group_first + range.group_count) as usize]
+        .iter()
+        .map(|g| {
+            let shading = if b.normal_mapped[shooter] {
+                let group = &b.texels[g.first as usize..(g.first + g.count) as usize];
+                let sum = group.iter().fold(DVec3::ZERO, |acc, x| acc + DVec3::from([0, 1, 2].map(|c| x.shading[c] as f64)) * x.position_area[3] as f64);
+                sum.try_normalize().unwrap_or(n)
+            } else {
+                n
+            };
+            let c = DVec3::from(g.centroid.map(f64::from)) + n * offset;
+            let mut polygon = g.polygon.map(|p| [p[0], p[1], p[2], 0.0]);
+            polygon[0][3] = g.corners as f32;
+            GpuSample {
+                position_area: [c.x as f32, c.y as f32, c.z as f32, g.area],
+                t: f4(t.to_array()),
+                b: f4(bt.to_array()),
+                n: f4(n.to_array()),
+                power: [0.0; 4],
+                shading: [shading.x as f32, shading.y as f32, shading.z as f32, g.opaque],
+                polygon,
+            }
+        })
+        .collect()
+}
+
+fn sum3(v: [f64; 3]) -> f64 {
+    v[0] + v[1] + v[2]
+}
+
+/// Runs the progressive solver on `device` / `queue`. `surface` (from
+/// `mesh-prep --surface`) gives textures, alpha masks and normal maps
+/// ([`detail`]); without it, or where no material has a texture, every
+/// texel takes its material's reflectance and its triangle's normal.
+/// `on_shot` sees every shot as it completes (for a progress bar).
+#[allow(clippy::too_many_arguments)]
+pub fn solve(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mesh: &Mesh,
+    manifest: &Manifest,
+    surface: Option<&Surface>,
+    lights: &[Luminaire],
+    params: &Params,
+    on_shot: &mut dyn FnMut(&Shot),
+) -> Result<Solved, String> {
+    let started = Instant::now();
+    if mesh.triangles.is_empty() {
+        return Err("the mesh has no triangles".into());
+    }
     // Scene size: near plane, far distance, and the sample offset.
     let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
     for p in &mesh.positions {
@@ -333,7 +516,6 @@ pub fn solve(
     let diagonal = (hi - lo).length().max(1e-6);
     let hemicube = params.visibility == Visibility::Hemicube;
     let layers_per_sample = if hemicube { 6 } else { 1 };
-    let max_groups = atlas.triangles.iter().map(|t| t.group_count).max().unwrap_or(1).max(1);
     // Visibility layers per batch: at most 256 (WebGPU's default array
     // limit) and 256 MiB of maps.
     let per_layer = 4 * (params.resolution as u64).pow(2);
@@ -341,25 +523,21 @@ pub fn solve(
     let batch = (layer_budget / 6).max(1);
     let layers = if hemicube { batch * 6 } else { (layer_budget / 6 * 6).max(6) };
     let batch_area = if hemicube { batch } else { layers };
-    let ldt_capacity = lights.iter().map(|l| light_table(l).len()).max().unwrap_or(4);
-    // The alpha masks for the visibility maps (004 Sec. 4.3.4), only where
-    // some triangle is masked.
-    let masks = detail.as_ref().filter(|d| d.masked(mesh)).map(|d| d.mask_tables(mesh));
-    let gpu = Gpu::new(
+    let context = Context {
         device,
-        &Setup {
-            texels: &texels,
-            tris: &tris,
-            groups: &groups,
-            emission: &emission,
-            vertices: &vertices,
-            res: params.resolution,
-            layers,
-            sample_capacity: max_groups.max(1),
-            ldt_capacity,
-            masks: masks.as_ref().map(|(t, m)| (t.as_slice(), m.as_slice())),
-        },
-    );
+        mesh,
+        manifest,
+        surface,
+        params,
+        sizes: atlas::object_sizes(mesh, manifest.objects.len(), params.texels, params.min_size, params.max_size),
+        twinned: mesh.twins().iter().map(Option::is_some).collect(),
+        layers,
+        ldt_capacity: lights.iter().map(|l| light_table(l).len()).max().unwrap_or(4),
+    };
+    let mut tiles = tiling::identity(mesh);
+    let mut built = build(&context, &tiles, None);
+    let tris = &built.tris;
+    let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
     let total_area: f64 = tris.iter().map(|t| t.area as f64).sum();
     let mut interreflection = [0.0f32; 4];
     for c in 0..3 {
@@ -379,8 +557,8 @@ pub fn solve(
         }
     }
     let emitted_total = sum3(emitted).max(f64::MIN_POSITIVE);
-    let base = GpuParams {
-        n_texels: texels.len() as u32,
+    let mut base = GpuParams {
+        n_texels: built.texels.len() as u32,
         n_tris: tris.len() as u32,
         shooter: u32::MAX,
         res: params.resolution,
@@ -393,8 +571,7 @@ pub fn solve(
         interreflection,
         ..Default::default()
     };
-    let mask_texels = masks.as_ref().map_or(0, |(_, m)| m.len() as u64);
-    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), mask_texels, ..Default::default() };
+    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), mask_texels: built.mask_texels, ..Default::default() };
     let shooting = Instant::now();
     let mut shots = Vec::new();
     let mut unshot_lights: f64 = light_flux.iter().map(|f| 3.0 * f).sum();
@@ -404,7 +581,7 @@ pub fn solve(
     let magnitude_of = |sel: &gpu::GpuSelection, lights: f64| {
         (sel.unshot_abs[0] as f64 + sel.unshot_abs[1] as f64 + sel.unshot_abs[2] as f64 + lights) / emitted_total
     };
-    let mut selection = gpu.select(device, queue, &base);
+    let mut selection = built.gpu.select(device, queue, &base);
     let initial_unshot = unshot_of(&selection, unshot_lights);
     let offset = 1e-6 * diagonal;
     // Lights first: all their power is unshot, and a point source shoots
@@ -426,67 +603,83 @@ pub fn solve(
             shading: [0.0; 4],
             polygon: [[0.0; 4]; 5],
         };
-        gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
+        built.gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
         let p = GpuParams { shooter: u32::MAX, sample_first: 0, sample_count: 1, layers_per_sample: 6, mode: 0, ..base };
-        gpu.shoot_batch(device, queue, &p, false);
+        built.gpu.shoot_batch(device, queue, &p, false);
         work.layers += 6;
         work.samples += 1;
-        work.receiver_evaluations += texels.len() as u64;
+        work.receiver_evaluations += built.texels.len() as u64;
         unshot_lights -= 3.0 * light_flux[k];
-        selection = gpu.select(device, queue, &base);
+        selection = built.gpu.select(device, queue, &base);
         let shot = Shot { shooter: format!("light {k}"), samples: 1, unshot_fraction: unshot_of(&selection, unshot_lights), unshot_magnitude_fraction: magnitude_of(&selection, unshot_lights), seconds: shooting.elapsed().as_secs_f64() };
         on_shot(&shot);
         shots.push(shot);
     }
+    // Tiles that have been tested for subdivision as shooters.
+    let mut tested = vec![false; tiles.len()];
     while shots.len() < params.max_shots && unshot_of(&selection, unshot_lights) > 1.0 - params.convergence_target {
         let shooter = selection.shooter[0];
-        if shooter as usize >= tris.len() || selection.score[0] <= 0.0 {
+        if shooter as usize >= built.tris.len() || selection.score[0] <= 0.0 {
             break;
         }
-        let range = atlas.triangles[shooter as usize];
-        let normal = DVec3::from(mesh.triangles[shooter as usize].normal.map(f64::from));
-        let [t, b, n] = frame_with_normal(normal);
-        let perturbed = detail.as_ref().is_some_and(|d| d.normal_mapped(mesh, shooter as usize));
-        let samples: Vec<GpuSample> = atlas.groups[range.group_first as usize..(range.group_first + range.group_count) as usize]
-            .iter()
-            .map(|g| {
-                // The group's cosine: its texels' area-weighted mean perturbed normal.
-                let shading = if perturbed {
-                    let group = &texels[g.first as usize..(g.first + g.count) as usize];
-                    let sum = group.iter().fold(DVec3::ZERO, |acc, x| acc + DVec3::from([0, 1, 2].map(|c| x.shading[c] as f64)) * x.position_area[3] as f64);
-                    sum.try_normalize().unwrap_or(n)
-                } else {
-                    n
-                };
-                let c = DVec3::from(g.centroid.map(f64::from)) + n * offset;
-                let mut polygon = g.polygon.map(|p| [p[0], p[1], p[2], 0.0]);
-                polygon[0][3] = g.corners as f32;
-                GpuSample {
-                    position_area: [c.x as f32, c.y as f32, c.z as f32, g.area],
-                    t: f4(t.to_array()),
-                    b: f4(b.to_array()),
-                    n: f4(n.to_array()),
-                    power: [0.0; 4],
-                    shading: [shading.x as f32, shading.y as f32, shading.z as f32, g.opaque],
-                    polygon,
-                }
-            })
-            .collect();
-        gpu.upload_samples(queue, &samples, None);
+        let range = built.atlas.triangles[shooter as usize];
+        // Batches of the shooter's samples: (first, count).
+        let batches: Vec<(u32, u32)> = (0..range.group_count).step_by(batch_area as usize).map(|first| (first, (range.group_count - first).min(batch_area))).collect();
         let shot_params = GpuParams { shooter, group_count: range.group_count, layers_per_sample, ..base };
-        gpu.prepare(device, queue, &shot_params);
-        let mut first = 0;
-        while first < range.group_count {
-            let count = (range.group_count - first).min(batch_area);
-            let p = GpuParams { sample_first: first, sample_count: count, ..shot_params };
-            gpu.shoot_batch(device, queue, &p, hemicube);
-            work.layers += count as u64 * if hemicube { 5 } else { 1 };
-            first += count;
+        if let Some(adaptive) = params.adaptive.as_ref().filter(|_| !tested[shooter as usize]) {
+            // 004 Sec. 2.4: before a triangle first shoots, split the
+            // receivers its shadow boundaries cross, again and again.
+            let splitting = Instant::now();
+            let shooter_tile = tiles[shooter as usize];
+            tested[shooter as usize] = true;
+            built.gpu.upload_samples(queue, &samples_of(&built, mesh, &tiles, shooter as usize, offset), None);
+            for &(first, count) in &batches {
+                built.gpu.count_batch(device, queue, &GpuParams { sample_first: first, sample_count: count, ..shot_params }, hemicube);
+                work.layers += count as u64 * if hemicube { 5 } else { 1 };
+            }
+            let counts = built.gpu.counts(device, queue);
+            let split: Vec<bool> = counts
+                .iter()
+                .enumerate()
+                .map(|(t, &[n_r, n_v])| t != shooter as usize && tiles[t].level < adaptive.levels && n_r > 0 && adaptive.crossed(n_v as f64 / n_r as f64))
+                .collect();
+            if split.contains(&true) {
+                let (next, origin) = tiling::split(mesh, &tiles, &split);
+                let radiosity = built.gpu.read_vec4(device, queue, &built.gpu.radiosity, built.texels.len());
+                let residual = built.gpu.read_vec4(device, queue, &built.gpu.residual, built.texels.len());
+                let rgb = |v: Vec<[f32; 4]>| v.into_iter().map(|x| [x[0], x[1], x[2]]).collect::<Vec<_>>();
+                let old = output::lightmap_of(&built.atlas, &rgb(radiosity), &rgb(residual), &tiling::mesh_of(mesh, &tiles), Lightmap::header(Provenance::in_memory("gpu-shoot")));
+                let copied = |atlas: &Atlas| output::copy_down(&old, &tiles, atlas, &next, &origin);
+                let texels_before = built.texels.len();
+                built = build(&context, &next, Some(&copied));
+                work.elements_added += built.texels.len().saturating_sub(texels_before) as u64;
+                work.tiles_added += (next.len() - tiles.len()) as u64;
+                // A split tile is new: its children have not shot.
+                tested = origin.iter().zip(&next).map(|(&o, tile)| tested[o] && tiles[o] == *tile).collect();
+                tiles = next;
+                // The shooter counts again: the new tiles its boundaries
+                // cross split further, up to the level limit.
+                if let Some(t) = tiles.iter().position(|x| *x == shooter_tile) {
+                    tested[t] = false;
+                }
+                base.n_texels = built.texels.len() as u32;
+                base.n_tris = built.tris.len() as u32;
+            }
+            work.subdivision_seconds += splitting.elapsed().as_secs_f64();
+            // Select again: the tiles (and the shooter's index) changed.
+            selection = built.gpu.select(device, queue, &base);
+            continue;
         }
-        gpu.finish(device, queue, &shot_params, range.count);
+        built.gpu.upload_samples(queue, &samples_of(&built, mesh, &tiles, shooter as usize, offset), None);
+        built.gpu.prepare(device, queue, &shot_params);
+        for &(first, count) in &batches {
+            built.gpu.shoot_batch(device, queue, &GpuParams { sample_first: first, sample_count: count, ..shot_params }, hemicube);
+            work.layers += count as u64 * if hemicube { 5 } else { 1 };
+        }
+        built.gpu.finish(device, queue, &shot_params, range.count);
         work.samples += range.group_count as u64;
-        work.receiver_evaluations += texels.len() as u64 * range.group_count as u64;
-        selection = gpu.select(device, queue, &base);
+        work.receiver_evaluations += built.texels.len() as u64 * range.group_count as u64;
+        selection = built.gpu.select(device, queue, &base);
         let shot = Shot {
             shooter: format!("triangle {shooter}"),
             samples: range.group_count,
@@ -499,10 +692,11 @@ pub fn solve(
     }
     work.shots = shots.len();
     work.shoot_seconds = shooting.elapsed().as_secs_f64();
-    let n = texels.len();
+    let n = built.texels.len();
+    let gpu = &built.gpu;
     let radiosity = gpu.read_vec4(device, queue, &gpu.radiosity, n).into_iter().map(|v| [v[0], v[1], v[2]]).collect();
     let residual = gpu.read_vec4(device, queue, &gpu.residual, n).into_iter().map(|v| [v[0], v[1], v[2]]).collect();
     let ambient = [0, 1, 2].map(|c| selection.ambient[c] as f64);
-    let triangle_power = gpu.read_vec4(device, queue, &gpu.tri_power, 2 * tris.len());
-    Ok(Solved { atlas, radiosity, residual, ambient, emitted_power: emitted, initial_unshot, shots, work, triangle_power })
+    let triangle_power = gpu.read_vec4(device, queue, &gpu.tri_power, 2 * built.tris.len());
+    Ok(Solved { atlas: built.atlas, tiles, radiosity, residual, ambient, emitted_power: emitted, initial_unshot, shots, work, triangle_power })
 }

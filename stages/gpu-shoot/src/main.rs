@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use schemas::cli::{check_outputs, main_of};
-use gpu_shoot::{gpu, output, solve, Luminaire, Params, Visibility};
+use gpu_shoot::{gpu, output, solve, Adaptive, Luminaire, Params, Visibility};
 use schemas::header::Schema;
 use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
@@ -90,6 +90,18 @@ struct Args {
     /// Texels per solution leaf, about.
     #[arg(long)]
     texels_per_leaf: Option<f64>,
+    /// Adaptive subdivision at shadow boundaries (004 Sec. 2.4); not with --lightmap.
+    #[arg(long)]
+    adaptive: bool,
+    /// Adaptive subdivision: split a receiver whose visible fraction is at least this (b_l) [default: 0.05].
+    #[arg(long)]
+    adaptive_lower: Option<f64>,
+    /// Adaptive subdivision: ... and at most this (b_u) [default: 0.95].
+    #[arg(long)]
+    adaptive_upper: Option<f64>,
+    /// Adaptive subdivision: most 1:4 splits of an input triangle [default: 3].
+    #[arg(long)]
+    adaptive_levels: Option<u32>,
 }
 
 fn params_of(args: &Args) -> schemas::Result<Params> {
@@ -116,6 +128,15 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
         p.ambient = false;
     }
     p.texels_per_leaf = args.texels_per_leaf.unwrap_or(p.texels_per_leaf);
+    if args.adaptive || args.adaptive_lower.is_some() || args.adaptive_upper.is_some() || args.adaptive_levels.is_some() {
+        let a = p.adaptive.get_or_insert_with(Adaptive::default);
+        a.lower = args.adaptive_lower.unwrap_or(a.lower);
+        a.upper = args.adaptive_upper.unwrap_or(a.upper);
+        a.levels = args.adaptive_levels.unwrap_or(a.levels);
+    }
+    if p.adaptive.is_some() && args.lightmap.is_some() {
+        return Err(bad_parameter("--lightmap is not written with adaptive subdivision: its regions would be the subdivided tiles', not the mesh's triangles"));
+    }
     match p.problem() {
         Some(problem) => Err(bad_parameter(problem)),
         None => Ok(p),
@@ -212,9 +233,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         solved.work.shoot_seconds
     );
     let provenance = run.provenance(&params);
-    let lightmap = output::lightmap(&solved, &mesh, Lightmap::header(provenance.clone()));
+    let lightmap = output::lightmap(&solved, &solved.tile_mesh(&mesh), Lightmap::header(provenance.clone()));
     let ambient = params.ambient.then_some(solved.ambient);
-    let solution = output::solution(&lightmap, &mesh, &manifest, ambient, params.texels_per_leaf, Solution::header(provenance.clone()));
+    let solution = output::solution(&lightmap, &mesh, &manifest, &solved.tiles, ambient, params.texels_per_leaf, Solution::header(provenance.clone()));
     let convergence = Convergence {
         header: Convergence::header(provenance),
         adapter: adapter.clone(),
@@ -243,6 +264,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("receiver_evaluations".to_string(), w.receiver_evaluations as f64),
             ("texels".to_string(), solved.atlas.texels.len() as f64),
             ("mask_texels".to_string(), w.mask_texels as f64),
+            ("subdivision_texels_added".to_string(), w.elements_added as f64),
+            ("subdivision_tiles_added".to_string(), w.tiles_added as f64),
+            ("subdivision_seconds".to_string(), w.subdivision_seconds),
             ("unshot_fraction".to_string(), final_unshot),
             ("setup_seconds".to_string(), w.setup_seconds),
             ("shoot_seconds".to_string(), w.shoot_seconds),

@@ -3,6 +3,8 @@
 //! leaves average the atlas, so the preview gather renders it like a
 //! hierarchical solution.
 
+use crate::atlas::{texel_point, Atlas};
+use crate::tiling::{from_root, to_root, Tile};
 use crate::Solved;
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
@@ -11,6 +13,7 @@ use schemas::header::Header;
 use schemas::lightmap::{Lightmap, COVERED, FILLED};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::{Element, Solution, NONE};
+use std::collections::HashMap;
 
 /// Fills the texels of every region that are not covered but that a
 /// bilinear lookup inside the triangle reads: two passes (004 Sec. 2.3.1
@@ -88,9 +91,15 @@ pub fn fill_seams(lightmap: &mut Lightmap) {
     }
 }
 
-/// The lightmap artifact of a solve, seams filled.
+/// The lightmap artifact of a solve, seams filled; `mesh` is the mesh of
+/// its tiles ([`Solved::tile_mesh`]).
 pub fn lightmap(solved: &Solved, mesh: &Mesh, header: Header) -> Lightmap {
-    let a = &solved.atlas;
+    lightmap_of(&solved.atlas, &solved.radiosity, &solved.residual, mesh, header)
+}
+
+/// The lightmap of `atlas` with these texel values (the atlas's order),
+/// seams filled.
+pub fn lightmap_of(a: &Atlas, radiosity: &[[f32; 3]], residual: &[[f32; 3]], mesh: &Mesh, header: Header) -> Lightmap {
     let (w, h) = (a.width as usize, a.height as usize);
     let mut lm = Lightmap {
         header,
@@ -106,8 +115,8 @@ pub fn lightmap(solved: &Solved, mesh: &Mesh, header: Header) -> Lightmap {
     };
     for (k, t) in a.texels.iter().enumerate() {
         let i = t.y as usize * w + t.x as usize;
-        lm.radiosity[i] = solved.radiosity[k];
-        lm.residual[i] = solved.residual[k];
+        lm.radiosity[i] = radiosity[k];
+        lm.residual[i] = residual[k];
         lm.coverage[i] = COVERED;
         lm.texel_area[i] = t.area;
     }
@@ -143,6 +152,11 @@ pub fn lightmap(solved: &Solved, mesh: &Mesh, header: Header) -> Lightmap {
 /// off Lambert's formula under a tilted emitter where the texels were
 /// within 1.2%; issue 10, item 7.)
 pub fn bilinear(lm: &Lightmap, t: usize, uv: [f64; 2]) -> [f64; 3] {
+    bilinear_of(lm, &lm.radiosity, t, uv)
+}
+
+/// [`bilinear`] of `values` (the lightmap's radiosity or residual).
+pub fn bilinear_of(lm: &Lightmap, values: &[[f32; 3]], t: usize, uv: [f64; 2]) -> [f64; 3] {
     let r = lm.regions[t];
     let n = r.size as f64;
     let fx = (uv[0] * n + 0.5).clamp(0.0, n + 1.0);
@@ -151,14 +165,43 @@ pub fn bilinear(lm: &Lightmap, t: usize, uv: [f64; 2]) -> [f64; 3] {
     let (tx, ty) = (fx - ix, fy - iy);
     let at = |dx: f64, dy: f64| {
         let k = (r.y as usize + (iy + dy) as usize) * lm.width + r.x as usize + (ix + dx) as usize;
-        lm.radiosity[k].map(f64::from)
+        values[k].map(f64::from)
     };
     let (a, b, c, d) = (at(0.0, 0.0), at(1.0, 0.0), at(0.0, 1.0), at(1.0, 1.0));
     [0, 1, 2].map(|k| (a[k] * (1.0 - tx) + b[k] * tx) * (1.0 - ty) + (c[k] * (1.0 - tx) + d[k] * tx) * ty)
 }
 
-/// The solution: each triangle subdivided uniformly (1:4, the order of
-/// `radiometry::subdivision`) to the level whose leaves hold about
+/// Radiosity and residual for every covered texel of `atlas` (tiles
+/// `tiles`, each inside the old tile `origin` of `old_tiles`, whose
+/// lightmap is `old`): a tile that did not change keeps its texels'
+/// values, a new one takes the bilinear reconstruction of its old tile at
+/// its texels' points (004 Sec. 2.4: "copied down ... using linear
+/// interpolation").
+pub fn copy_down(old: &Lightmap, old_tiles: &[Tile], atlas: &Atlas, tiles: &[Tile], origin: &[usize]) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let f4 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+    atlas
+        .texels
+        .iter()
+        .map(|x| {
+            let t = x.triangle as usize;
+            let o = origin[t];
+            let (i, j) = x.indices(atlas.regions[t]);
+            if old_tiles[o] == tiles[t] {
+                let r = old.regions[o];
+                let k = (r.y + 1 + j) as usize * old.width + (r.x + 1 + i) as usize;
+                let rgb = |v: [f32; 3]| [v[0], v[1], v[2], 0.0];
+                return (rgb(old.radiosity[k]), rgb(old.residual[k]));
+            }
+            let at = from_root(&old_tiles[o].corners, to_root(&tiles[t].corners, texel_point(atlas.regions[t], i, j)));
+            (f4(bilinear_of(old, &old.radiosity, o, at)), f4(bilinear_of(old, &old.residual, o, at)))
+        })
+        .unzip()
+}
+
+/// The solution: each input triangle refined (1:4, the order of
+/// `radiometry::subdivision`) down to its tiles ([`crate::tiling`]; one
+/// tile, the triangle, without adaptive subdivision), each tile uniformly
+/// to the level whose leaves hold about
 /// `texels_per_leaf` covered texels; a leaf's radiosity is the mean of the
 /// bilinear reconstruction over it: the leaf split 1:4 into pieces of
 /// about a texel, on each the mean of the lookups at its centroid and at
@@ -166,33 +209,65 @@ pub fn bilinear(lm: &Lightmap, t: usize, uv: [f64; 2]) -> [f64; 3] {
 /// rule plus the centroid), plus
 /// `rho x ambient` when asked (004 Eq. 2.4, for display). Inner elements
 /// hold the area-weighted mean of their children. No links, no clusters.
-pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, ambient: Option<[f64; 3]>, texels_per_leaf: f64, header: Header) -> Solution {
+pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile], ambient: Option<[f64; 3]>, texels_per_leaf: f64, header: Header) -> Solution {
     let mut elements: Vec<Element> = mesh.triangles.iter().enumerate().map(|(t, tri)| Element::root(t as u32, tri.area, [0.0; 3])).collect();
+    // Per element: its corners in its input triangle, and below the tiles
+    // its tile, its corners in the tile and its level under the tile.
     let mut corners_of: Vec<Corners> = vec![ROOT; elements.len()];
+    let mut place: Vec<Option<(usize, Corners, u32)>> = vec![None; elements.len()];
+    let key = |root: u32, c: &Corners| (root, c.map(|p| p.map(f64::to_bits)));
+    let tile_at: HashMap<_, usize> = tiles.iter().enumerate().map(|(k, t)| (key(t.root, &t.corners), k)).collect();
+    let push = |elements: &mut Vec<Element>, corners_of: &mut Vec<Corners>, place: &mut Vec<Option<(usize, Corners, u32)>>, parent: usize, corners: Corners, level: u32, at: Option<(usize, Corners, u32)>| {
+        let t = elements[parent].triangle;
+        elements.push(Element {
+            triangle: t,
+            parent: parent as u32,
+            first_child: NONE,
+            level,
+            corners: corners.map(|c| c.map(|x| x as f32)),
+            area: (mesh.triangles[t as usize].area as f64 / 4f64.powi(level as i32)) as f32,
+            radiosity: [0.0; 3],
+        });
+        corners_of.push(corners);
+        place.push(at);
+    };
     for t in 0..mesh.triangles.len() {
-        let covered = lm.regions[t].covered as f64;
-        let depth = ((covered / texels_per_leaf).max(1.0).ln() / 4f64.ln()).floor().clamp(0.0, 8.0) as u32;
-        let mut frontier = vec![t];
-        for level in 1..=depth {
-            let mut next = Vec::new();
-            for parent in frontier {
-                let first = elements.len() as u32;
-                elements[parent].first_child = first;
-                for child in children(&corners_of[parent]) {
-                    next.push(elements.len());
-                    elements.push(Element {
-                        triangle: t as u32,
-                        parent: parent as u32,
-                        first_child: NONE,
-                        level,
-                        corners: child.map(|c| c.map(|x| x as f32)),
-                        area: (mesh.triangles[t].area as f64 / 4f64.powi(level as i32)) as f32,
-                        radiosity: [0.0; 3],
-                    });
-                    corners_of.push(child);
-                }
+        // The input triangle's refinement down to its tiles.
+        let (mut queue, mut next) = (vec![t], 0);
+        let mut at_tiles = Vec::new();
+        while next < queue.len() {
+            let e = queue[next];
+            next += 1;
+            if let Some(&tile) = tile_at.get(&key(t as u32, &corners_of[e])) {
+                at_tiles.push((e, tile));
+                continue;
             }
-            frontier = next;
+            elements[e].first_child = elements.len() as u32;
+            for child in children(&corners_of[e]) {
+                queue.push(elements.len());
+                let level = elements[e].level + 1;
+                push(&mut elements, &mut corners_of, &mut place, e, child, level, None);
+            }
+        }
+        // Each tile uniformly down to about `texels_per_leaf` texels a leaf.
+        for (e, tile) in at_tiles {
+            place[e] = Some((tile, ROOT, 0));
+            let covered = lm.regions[tile].covered as f64;
+            let depth = ((covered / texels_per_leaf).max(1.0).ln() / 4f64.ln()).floor().clamp(0.0, 8.0) as u32;
+            let mut frontier = vec![e];
+            for local in 1..=depth {
+                let mut next = Vec::new();
+                for parent in frontier {
+                    elements[parent].first_child = elements.len() as u32;
+                    let (_, corners, _) = place[parent].expect("below a tile");
+                    for child in children(&corners) {
+                        next.push(elements.len());
+                        let level = tiles[tile].level + local;
+                        push(&mut elements, &mut corners_of, &mut place, parent, child.map(|c| to_root(&tiles[tile].corners, c)), level, Some((tile, child, local)));
+                    }
+                }
+                frontier = next;
+            }
         }
     }
     let rho_ambient = |t: usize| -> [f64; 3] {
@@ -204,13 +279,14 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, ambient: Option
             continue;
         }
         let t = elements[e].triangle as usize;
+        let (tile, local, local_level) = place[e].expect("every leaf lies in a tile");
         // Sub-triangles of about one texel each, so the rule integrates the
         // bilinear reconstruction, not a handful of its values (an element
         // of 14 texels next to a shared edge, where radiosity halves within
         // the element, was 1.7% low with the rule on the element itself).
-        let texels = lm.regions[t].covered as f64 / 4f64.powi(elements[e].level as i32);
+        let texels = lm.regions[tile].covered as f64 / 4f64.powi(local_level as i32);
         let levels = (texels.max(1.0).ln() / 4f64.ln()).ceil() as u32;
-        let mut pieces = vec![corners_of[e]];
+        let mut pieces = vec![local];
         for _ in 0..levels {
             pieces = pieces.iter().flat_map(children).collect();
         }
@@ -221,7 +297,7 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, ambient: Option
         for c in &pieces {
             let point = |l: [f64; 3]| [l[0] * c[0][0] + l[1] * c[1][0] + l[2] * c[2][0], l[0] * c[0][1] + l[1] * c[1][1] + l[2] * c[2][1]];
             for l in points {
-                for (s, v) in sum.iter_mut().zip(bilinear(lm, t, point(l))) {
+                for (s, v) in sum.iter_mut().zip(bilinear(lm, tile, point(l))) {
                     *s += v * weight;
                 }
             }

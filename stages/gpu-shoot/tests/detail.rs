@@ -134,7 +134,7 @@ fn checkerboard_floor_takes_each_texels_reflectance() {
 
     // Elements: the stage's own solution, against a midpoint rule of rho E F.
     let lightmap = output::lightmap(&solved, &mesh, Lightmap::header(Provenance::in_memory("test")));
-    let solution = output::solution(&lightmap, &mesh, &m, None, Params::default().texels_per_leaf, Solution::header(Provenance::in_memory("test")));
+    let solution = output::solution(&lightmap, &mesh, &m, &solved.tiles, None, Params::default().texels_per_leaf, Solution::header(Provenance::in_memory("test")));
     let (mut worst, mut count, mut power, mut reference_power) = (0.0f64, 0, 0.0, 0.0);
     for e in solution.elements.iter().filter(|e| e.is_leaf() && e.triangle < 2) {
         let corners = mesh.triangles[e.triangle as usize].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)));

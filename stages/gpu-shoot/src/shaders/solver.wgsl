@@ -453,6 +453,61 @@ fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, ns: vec3<f32>, s: Sample, 
     return h;
 }
 
+// Whether the receiver at p (triangle tri, plane normal nr, `local` in
+// the frame of sample s) is visible in the sample's maps, which start at
+// layer `base`.
+fn seen_in_maps(base: u32, tri: u32, p: vec3<f32>, nr: vec3<f32>, local: vec3<f32>, s: Sample, light: bool) -> bool {
+    if (params.mode == 1u && !light) { return visible_stereographic(base, tri, p, s); }
+    let face = face_of(local);
+    let normal = vec3<f32>(dot(nr, s.t.xyz), dot(nr, s.b.xyz), dot(nr, s.n.xyz));
+    return visible_face(base + face, face_coords(face, local), face_coords(face, normal));
+}
+
+// Adaptive subdivision (004 Sec. 2.4), before a triangle first shoots:
+// per receiving triangle, the point-sample pairs facing each other (n_r,
+// what a rasterization without depth test counts) in counts[2t], and
+// those the visibility maps see (n_v) in counts[2t + 1]. The paper counts
+// the receiver's fragments in the maps; here each texel tests COUNT_GRID
+// x COUNT_GRID points of its square (its own point on the hypotenuse), so
+// a boundary between two texel centres is found too. Bound only when the
+// subdivision is on.
+@group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
+
+const COUNT_GRID: u32 = 4u;
+
+@compute @workgroup_size(64)
+fn count_visible(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
+    let k = id.x + id.y * nw.x * 64u;
+    if (k >= params.n_texels) { return; }
+    let texel = texels[k];
+    let tri = bitcast<u32>(texel.normal.w);
+    if (tri == params.shooter || texel.position.w <= 0.0) { return; }
+    let nr = texel.normal.xyz;
+    var grid = COUNT_GRID;
+    if (texel.rho.w != 0.0) { grid = 1u; }
+    var n_r = 0u;
+    var n_v = 0u;
+    for (var g = 0u; g < grid * grid; g += 1u) {
+        var p = texel.position.xyz;
+        if (grid > 1u) {
+            let f = (vec2<f32>(f32(g % grid), f32(g / grid)) * 2.0 + 1.0) / f32(grid) - 1.0;
+            p += f.x * tris[tri].half_u.xyz + f.y * tris[tri].half_v.xyz;
+        }
+        for (var i = 0u; i < params.sample_count; i += 1u) {
+            let s = samples[params.sample_first + i];
+            let v = p - s.position.xyz;
+            if (dot(v, v) <= 0.0 || -dot(nr, v) <= 0.0 || dot(p - s.polygon[0].xyz, s.n.xyz) <= 0.0) { continue; }
+            n_r += 1u;
+            let local = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
+            if (seen_in_maps(i * params.layers_per_sample, tri, p, nr, local, s, false)) { n_v += 1u; }
+        }
+    }
+    if (n_r > 0u) {
+        atomicAdd(&counts[2u * tri], n_r);
+        atomicAdd(&counts[2u * tri + 1u], n_v);
+    }
+}
+
 // The receiver pass (004 Sec. 2.3, Eq. 2.2 / 4.1-4.3): every covered texel
 // tests its depth against each sample's visibility map and gathers
 //   area sample:  H += dB_s A_s cos_s cos_r / (pi d^2 + A_s)
@@ -509,16 +564,8 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
             if (any(s.shading.xyz != s.n.xyz)) { cos_s = dot(v, s.shading.xyz) / d; }
             cos_s = max(cos_s, 0.0);
         }
-        let base = i * params.layers_per_sample;
         var seen = straddles;
-        if (straddles) {
-        } else if (params.mode == 1u && !light) {
-            seen = visible_stereographic(base, tri, p, s);
-        } else {
-            let face = face_of(local);
-            let normal = vec3<f32>(dot(nr, s.t.xyz), dot(nr, s.b.xyz), dot(nr, s.n.xyz));
-            seen = visible_face(base + face, face_coords(face, local), face_coords(face, normal));
-        }
+        if (!straddles) { seen = seen_in_maps(i * params.layers_per_sample, tri, p, nr, local, s, light); }
         if (!seen) { continue; }
         if (light) {
             let gamma = degrees(acos(clamp(cos_s, -1.0, 1.0)));
