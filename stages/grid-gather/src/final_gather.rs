@@ -8,10 +8,12 @@ use crate::grid::Grid;
 use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
 use crate::render::pixel_offset;
 use crate::senders::{Aabb, Senders};
+use crate::specular::{Followed, Seen, Specular};
 use crate::{GridKind, Mode, Params};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
+use radiometry::rays::SceneRays;
 use radiometry::photometry::{DirectLight, Luminaire};
 use radiometry::sampling::Stream;
 use rayon::prelude::*;
@@ -102,6 +104,69 @@ pub struct FullScene<'a> {
     /// receiver is not in the links (a point light is no sender), so each
     /// camera sample adds it here, with a shadow ray per light.
     pub lights: &'a [Luminaire],
+    /// The mirrors and glass camera rays continue through, in a scene that
+    /// has some.
+    pub specular: Option<&'a Specular>,
+}
+
+/// What shades one surface point a camera ray reaches in the full or
+/// brute gather.
+struct Shading<'a> {
+    params: &'a Params,
+    scene: &'a FullScene<'a>,
+    senders: &'a Senders<'a>,
+    rays: &'a SceneRays,
+    gather: &'a FullGather<'a>,
+    grid: &'a Grid,
+    luminaires: &'a DirectLight<'a>,
+}
+
+impl Shading<'_> {
+    /// Irradiance at `p` on `triangle` (normal `normal`) from the links in
+    /// `links`: the brute gather in brute mode, and for a point seen
+    /// through mirrors or glass that lies outside the grid (the grid covers
+    /// the directly visible points); else the full gather.
+    #[allow(clippy::too_many_arguments)]
+    fn irradiance(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], seen: &Seen, pass: u32, stream: &mut Stream, work: &mut Work) -> [f64; 3] {
+        if self.params.mode == Mode::Brute || (seen.depth > 0 && !self.grid.contains(p)) {
+            brute_irradiance(self.senders, self.rays, p, normal, triangle, links, self.params.brute_samples, stream, work)
+        } else {
+            self.gather.irradiance(p, normal, triangle, leaf, links, pass, work)
+        }
+    }
+
+    /// Radiance `B / pi` leaving the point `seen` reached towards its ray,
+    /// for camera sample `pass`: `E + rho (H + H_lights) + tau H_back`
+    /// (004 Eq. 4.4 for the last term); black on a back face.
+    fn radiance(&self, seen: &Seen, pass: u32, (links, back_links): (&mut Vec<usize>, &mut Vec<usize>), stream: &mut Stream, work: &mut Work) -> [f64; 3] {
+        let (scene, triangle) = (self.scene, seen.hit.triangle);
+        let tri = &scene.triangles[triangle as usize];
+        if seen.direction.dot(tri.normal) > 0.0 {
+            return [0.0; 3];
+        }
+        let p = seen.origin + seen.direction * f64::from(seen.hit.t);
+        let uv = tri.uv_of(p);
+        let leaf = self.senders.chain(triangle, uv, links);
+        let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
+        let irradiance = self.irradiance(p, normal, triangle, leaf, links, seen, pass, stream, work);
+        let (direct, cast) = self.luminaires.at_point(p, normal, triangle);
+        work.visibility_rays += cast;
+        // 004 Eq. 4.4: a translucent surface also emits tau times the
+        // irradiance of its other face, gathered there (the twin's links and
+        // normal, the same point).
+        let transmitted = scene.transmission.get(triangle as usize).copied().flatten().map(|(tau, twin)| {
+            let back = &scene.triangles[twin as usize];
+            let back_leaf = self.senders.chain(twin, back.uv_of(p), back_links);
+            let h = self.irradiance(p, back.normal, twin, back_leaf, back_links, seen, pass, stream, work);
+            let (direct, cast) = self.luminaires.at_point(p, back.normal, twin);
+            work.visibility_rays += cast;
+            std::array::from_fn::<f64, 3, _>(|c| tau[c] * (h[c] + direct))
+        });
+        let s = scene.surfaces[triangle as usize];
+        let rho = scene.detail.and_then(|detail| detail.reflectance(triangle, uv)).unwrap_or(s.reflectance);
+        let t = transmitted.unwrap_or([0.0; 3]);
+        std::array::from_fn(|c| (s.emission[c] + rho[c] * (irradiance[c] + direct) + t[c]) / PI)
+    }
 }
 
 /// The full (or brute-force) image.
@@ -155,11 +220,12 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let gather = FullGather::new(&senders, &grid, &rays, scene.surfaces, params, vertex_contrast, width);
     let spp = params.spp;
     let luminaires = DirectLight { lights: scene.lights, rays: &rays };
-    let rows: Vec<(Vec<([f32; 3], f32, Work, [u32; 3])>, u64)> = (0..height)
+    let shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires };
+    let rows: Vec<(Vec<([f32; 3], f32, Work, [u32; 3])>, u64, Followed)> = (0..height)
         .into_par_iter()
         .map(|y| {
             let (mut links, mut back_links) = (Vec::new(), Vec::new());
-            let mut hits = 0u64;
+            let (mut hits, mut followed) = (0u64, Followed::default());
             let row = (0..width)
                 .map(|x| {
                     let pixel = u64::from(y) * u64::from(width) + u64::from(x);
@@ -178,51 +244,31 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
                         covered += 1;
                         hits += 1;
                         let tri = &scene.triangles[hit.triangle as usize];
-                        if d.dot(tri.normal) > 0.0 {
+                        let front = d.dot(tri.normal) <= 0.0;
+                        let specular = scene.specular.filter(|s| s.is_specular(hit.triangle));
+                        if front {
+                            tally.front(scene.ids[hit.triangle as usize], tri.normal);
+                        } else {
                             tally.other();
-                            continue;
                         }
-                        tally.front(scene.ids[hit.triangle as usize], tri.normal);
-                        let p = camera.eye + d * f64::from(hit.t);
-                        let uv = tri.uv_of(p);
-                        let leaf = senders.chain(hit.triangle, uv, &mut links);
-                        let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(hit.triangle, uv, tri.normal));
                         let mut sample = Work::default();
-                        let irradiance = match params.mode {
-                            Mode::Brute => {
-                                brute_irradiance(&senders, &rays, p, normal, hit.triangle, &links, params.brute_samples, &mut gather_stream, &mut sample)
-                            }
-                            _ => gather.irradiance(p, normal, hit.triangle, leaf, &links, k, &mut sample),
+                        let mut shade = |seen: &Seen| {
+                            let radiance = shading.radiance(seen, k, (&mut links, &mut back_links), &mut gather_stream, &mut sample);
+                            (0..3).for_each(|c| sum[c] += seen.weight[c] * radiance[c]);
                         };
-                        let (direct, cast) = luminaires.at_point(p, normal, hit.triangle);
-                        sample.visibility_rays += cast;
-                        // 004 Eq. 4.4: a translucent surface also emits
-                        // tau times the irradiance of its other face, gathered
-                        // there (the twin's links and normal, the same point).
-                        let transmitted = scene.transmission.get(hit.triangle as usize).copied().flatten().map(|(tau, twin)| {
-                            let back = &scene.triangles[twin as usize];
-                            let back_uv = back.uv_of(p);
-                            let back_leaf = senders.chain(twin, back_uv, &mut back_links);
-                            let h = match params.mode {
-                                Mode::Brute => brute_irradiance(&senders, &rays, p, back.normal, twin, &back_links, params.brute_samples, &mut gather_stream, &mut sample),
-                                _ => gather.irradiance(p, back.normal, twin, back_leaf, &back_links, k, &mut sample),
-                            };
-                            let (direct, cast) = luminaires.at_point(p, back.normal, twin);
-                            sample.visibility_rays += cast;
-                            std::array::from_fn::<f64, 3, _>(|c| tau[c] * (h[c] + direct))
-                        });
+                        match specular {
+                            Some(specular) => followed.add(specular.follow(&rays, scene.triangles, camera.eye, d, hit, &mut shade)),
+                            None if front => shade(&Seen { hit, origin: camera.eye, direction: d, weight: [1.0; 3], depth: 0 }),
+                            None => {}
+                        }
                         work.add(&sample);
-                        let s = scene.surfaces[hit.triangle as usize];
-                        let rho = scene.detail.and_then(|detail| detail.reflectance(hit.triangle, uv)).unwrap_or(s.reflectance);
-                        let t = transmitted.unwrap_or([0.0; 3]);
-                        (0..3).for_each(|c| sum[c] += (s.emission[c] + rho[c] * (irradiance[c] + direct) + t[c]) / PI);
                     }
                     let n = f64::from(spp);
                     (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, work, tally.finish())
                 })
                 .collect();
             rows_done(1);
-            (row, hits)
+            (row, hits, followed)
         })
         .collect();
 
@@ -233,11 +279,12 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
         diagnostics: Diagnostics { width: w, height: h, ..Diagnostics::default() },
         counters: BTreeMap::new(),
     };
-    let (mut total, mut hits) = (Work::default(), 0u64);
+    let (mut total, mut hits, mut specular) = (Work::default(), 0u64, Followed::default());
     let per = 1.0 / f64::from(spp);
     let mut seen = Vec::with_capacity(w * h);
-    for (row, row_hits) in rows {
+    for (row, row_hits, followed) in rows {
         hits += row_hits;
+        specular.add(followed);
         for (rgb, coverage, work, surface) in row {
             image.rgb.push(rgb);
             image.coverage.push(coverage);
@@ -291,6 +338,9 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     c.insert("grid_vertices".into(), grid.vertex_count() as f64);
     c.insert("grid_vertices_built".into(), image.diagnostics.vertices.len() as f64);
     c.insert("senders_skipped_occluded".into(), skipped as f64);
+    if scene.specular.is_some() {
+        crate::specular::count(c, specular);
+    }
     for k in 0..4 {
         c.insert(format!("vertex_senders_{}", CLASS_NAMES[k]), vertex_classes[k] as f64);
         c.insert(format!("pixel_senders_{}", CLASS_NAMES[k]), total.classes[k] as f64);

@@ -156,6 +156,12 @@ impl Grid {
         }
     }
 
+    /// Whether `p` lies in the grid's domain (between its first and last
+    /// vertices on every axis).
+    pub fn contains(&self, p: DVec3) -> bool {
+        self.coordinates(p).is_some_and(|g| (0..3).all(|a| (0.0..=self.n[a] as f64).contains(&g[a])))
+    }
+
     /// The cell holding `p` (clamped into the grid) and `p`'s tetrahedron
     /// and weights in it: of the five, the one whose smallest barycentric
     /// weight is largest, so a point inside the cell gets the tetrahedron

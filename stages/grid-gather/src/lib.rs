@@ -24,6 +24,13 @@
 //! surface's transmitted light, `tau H_back` gathered on its other face
 //! (paper 004 Eq. 4.4; [`final_gather::FullScene::transmission`]).
 //!
+//! In every mode, a camera ray that meets an ideal mirror (`rho_s`) or thin
+//! glass (`tau_s`) is continued, reflected or straight on, to the depth and
+//! weight bounds below, and the diffuse surfaces it reaches are shaded as
+//! if seen directly ([`specular`]); the full gather classifies senders at
+//! the surface finally reached (by the grid where that point lies in it,
+//! else by the brute gather).
+//!
 //! ## Parameters
 //!
 //! | name | type | meaning | default |
@@ -48,6 +55,8 @@
 //! | `leaf_check_rays` | count | full: rays a leaf of the surface-based gather casts to check each link the solver called fully visible or occluded whose error would not fit the threshold; 0 trusts the solver | 8 |
 //! | `view_dependent` | bool | full: shadow samples bounded by penumbra size and contrast (Sec. 5.3) | true |
 //! | `brute_samples` | count | brute: visibility rays per link per camera sample | 64 |
+//! | `specular_depth` | count | most mirror reflections and glass passages along a camera ray ([`specular`]) | 8 |
+//! | `specular_min_weight` | fraction | a ray through mirrors and glass stops when its largest channel weight (product of `rho_s`, `tau_s`) falls under this | 1e-3 |
 //!
 //! Same inputs and parameters give bit-identical images, whatever the
 //! number of threads.
@@ -60,6 +69,7 @@ pub mod grid;
 pub mod pixel_surfaces;
 pub mod render;
 pub mod senders;
+pub mod specular;
 
 use gouraud::{Gouraud, Smoothing};
 use radiometry::camera::Pinhole;
@@ -199,6 +209,12 @@ pub struct Params {
     pub view_dependent: bool,
     /// Brute: visibility rays per link per camera sample, at least 1.
     pub brute_samples: u32,
+    /// Most specular events (mirror reflections, glass passages) along a
+    /// camera ray.
+    pub specular_depth: u32,
+    /// A branch through mirrors and glass stops when its largest channel
+    /// weight falls under this, in [0, 1].
+    pub specular_min_weight: f64,
 }
 
 impl Default for Params {
@@ -225,6 +241,8 @@ impl Default for Params {
             leaf_check_rays: 8,
             view_dependent: true,
             brute_samples: 64,
+            specular_depth: 8,
+            specular_min_weight: 1e-3,
         }
     }
 }
@@ -256,6 +274,12 @@ impl Params {
         }
         if !(self.contrast > 0.0 && self.contrast <= 1.0) {
             return Err(bad_parameter(format!("contrast must be in (0, 1], got {}", self.contrast)));
+        }
+        if !(0.0..=1.0).contains(&self.specular_min_weight) {
+            return Err(bad_parameter(format!("specular_min_weight must be in [0, 1], got {}", self.specular_min_weight)));
+        }
+        if self.specular_depth > 64 {
+            return Err(bad_parameter(format!("specular_depth must be at most 64, got {}", self.specular_depth)));
         }
         if !(1..=2).contains(&self.allowed_hits) {
             return Err(bad_parameter(format!("allowed_hits must be 1 or 2, got {}", self.allowed_hits)));
@@ -389,11 +413,21 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     };
     let textured = textures.zip(irradiance.as_ref()).map(|(detail, irradiance)| render::Textured { detail, irradiance, emission: &emission });
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
-    let view = View { camera: &camera, triangles: &triangles, rays: rays.as_ref(), shading: &shading, textured, surfaces: &ids, crease_angle_deg: params.crease_angle_deg };
+    let specular = specular::Specular::new(scene.mesh, scene.manifest, &triangles, params.specular_depth, params.specular_min_weight);
+    let view = View {
+        camera: &camera,
+        triangles: &triangles,
+        rays: rays.as_ref(),
+        shading: &shading,
+        textured,
+        surfaces: &ids,
+        crease_angle_deg: params.crease_angle_deg,
+        specular: specular.as_ref(),
+    };
     let film = render::render(&view, Sampling { width, height, spp: params.spp, seed: params.seed }, rows_done);
 
     let pixels = f64::from(width) * f64::from(height);
-    let counters = BTreeMap::from([
+    let mut counters = BTreeMap::from([
         ("pixels".to_string(), pixels),
         ("samples_per_pixel".to_string(), f64::from(params.spp)),
         ("rays_cast".to_string(), pixels * f64::from(params.spp)),
@@ -404,6 +438,9 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
         ("leaf_elements".to_string(), shading.leaves() as f64),
         ("vertices".to_string(), shading.vertices() as f64),
     ]);
+    if specular.is_some() {
+        specular::count(&mut counters, film.specular);
+    }
     Ok((
         Rendered {
             width: width as usize,
@@ -483,6 +520,7 @@ fn full_gather(
         Vec::new()
     };
     let transmission = transmission(scene);
+    let specular = specular::Specular::new(scene.mesh, scene.manifest, triangles, params.specular_depth, params.specular_min_weight);
     let full_scene = final_gather::FullScene {
         triangles,
         surfaces: &surfaces,
@@ -494,6 +532,7 @@ fn full_gather(
         detail: extras.detail,
         transmission: &transmission,
         lights: &lights,
+        specular: specular.as_ref(),
     };
     let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
     let mut counters = image.counters;
@@ -528,8 +567,8 @@ pub fn skipped(manifest: &Manifest, mode: Mode, detail: bool) -> Vec<String> {
         (e.normal_maps && !detail, format!("normal maps: {no_surface}; cosines use the triangle normals")),
         (e.normal_maps && detail && mode == Mode::Preview, "normal maps: the preview shows the solver's element radiosity; the full gather applies them".to_string()),
         (e.alpha_masks && !detail, format!("alpha masks: {no_surface}; rays hit the whole triangles")),
-        (e.specular_reflection, "specular reflection: present but not traced; mirrors show their diffuse radiosity".to_string()),
-        (e.specular_transmission, "specular transmission: present but not traced; glass shows its diffuse radiosity".to_string()),
+        (e.specular_reflection, "specular reflection: traced as ideal and planar per triangle (no glossy reflection; a curved mirror is its facets)".to_string()),
+        (e.specular_transmission, "specular transmission: traced as thin glass (rays go straight on; no refraction bending by thick glass)".to_string()),
         (e.diffuse_transmission && mode == Mode::Preview, "diffuse transmission: the preview shows the radiosity the solver transmitted; a translucent material that is not two-sided has no back face and shows black from behind".to_string()),
         (e.diffuse_transmission && mode != Mode::Preview && one_sided_translucent(manifest), "diffuse transmission: a translucent material that is not two-sided has no back face, transmits nothing and shows black from behind".to_string()),
     ];

@@ -155,6 +155,12 @@ struct Args {
     /// Brute: visibility rays per link per camera sample [default: 64].
     #[arg(long, value_name = "N")]
     brute_samples: Option<u32>,
+    /// Most mirror reflections and glass passages along a camera ray [default: 8].
+    #[arg(long, value_name = "N")]
+    specular_depth: Option<u32>,
+    /// A ray through mirrors and glass stops when its weight (product of rho_s, tau_s) falls under this [default: 1e-3].
+    #[arg(long, value_name = "FRACTION")]
+    specular_min_weight: Option<f64>,
     /// Image width in pixels [default: the manifest camera's].
     #[arg(long, value_name = "W")]
     width: Option<u32>,
@@ -227,7 +233,7 @@ impl Args {
         macro_rules! set {
             ($($f:ident),*) => { $(if let Some(v) = self.$f { p.$f = v; })* };
         }
-        set!(grid_pixels, grid_depth, samples, min_samples, max_shadow_samples, contrast, allowed_hits, leaf_check_rays, interior_rays, brute_samples);
+        set!(grid_pixels, grid_depth, samples, min_samples, max_shadow_samples, contrast, allowed_hits, leaf_check_rays, interior_rays, brute_samples, specular_depth, specular_min_weight);
         if self.surface_gather {
             p.surface_gather = true;
         }

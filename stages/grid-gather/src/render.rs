@@ -3,10 +3,12 @@
 use crate::detail::Detail;
 use crate::gouraud::Gouraud;
 use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
+use crate::specular::{Followed, Seen, Specular};
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
-use radiometry::rays::SceneRays;
+use radiometry::rays::{Hit, SceneRays};
 use radiometry::sampling::Stream;
+use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -27,6 +29,9 @@ pub struct View<'a> {
     pub surfaces: &'a [SurfaceId],
     /// Hit normals further apart than this make a pixel an edge, degrees.
     pub crease_angle_deg: f64,
+    /// The mirrors and glass camera rays continue through, in a scene
+    /// that has some.
+    pub specular: Option<&'a Specular>,
 }
 
 /// What the display of a textured scene adds ([`crate::detail`]): at a
@@ -68,6 +73,8 @@ pub struct Film {
     pub back_face_hits: u64,
     /// What each pixel saw.
     pub surfaces: schemas::image::PixelSurfaces,
+    /// Rays continued through mirrors and glass.
+    pub specular: Followed,
 }
 
 /// The `k`-th of `n` sample positions in the unit pixel: the first `m²`
@@ -93,10 +100,10 @@ pub fn pixel_offset(k: u32, n: u32, stream: &mut Stream) -> (f64, f64) {
 /// is black with no coverage. `rows_done` is called with 1 after each row.
 pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync)) -> Film {
     let Sampling { width, height, spp, seed } = sampling;
-    let rows: Vec<(Vec<([f32; 3], f32, [u32; 3])>, u64, u64)> = (0..height)
+    let rows: Vec<(Vec<([f32; 3], f32, [u32; 3])>, u64, u64, Followed)> = (0..height)
         .into_par_iter()
         .map(|y| {
-            let (mut hits, mut back) = (0, 0);
+            let (mut hits, mut back, mut followed) = (0, 0, Followed::default());
             let row = (0..width)
                 .map(|x| {
                     let pixel = u64::from(y) * u64::from(width) + u64::from(x);
@@ -104,7 +111,7 @@ pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync))
                     let (mut sum, mut covered, mut tally) = ([0.0f64; 3], 0u32, PixelTally::new(view.crease_angle_deg));
                     for k in 0..spp {
                         let (jx, jy) = pixel_offset(k, spp, &mut stream);
-                        let Some((triangle, sample)) = trace(view, f64::from(x) + jx, f64::from(y) + jy) else {
+                        let Some((triangle, sample)) = trace(view, f64::from(x) + jx, f64::from(y) + jy, &mut followed) else {
                             tally.other();
                             continue;
                         };
@@ -126,12 +133,13 @@ pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync))
                 })
                 .collect();
             rows_done(1);
-            (row, hits, back)
+            (row, hits, back, followed)
         })
         .collect();
-    let mut film = Film { rgb: Vec::new(), coverage: Vec::new(), hits: 0, back_face_hits: 0, surfaces: Default::default() };
+    let mut film = Film { rgb: Vec::new(), coverage: Vec::new(), hits: 0, back_face_hits: 0, surfaces: Default::default(), specular: Followed::default() };
     let mut seen = Vec::with_capacity(width as usize * height as usize);
-    for (row, hits, back) in rows {
+    for (row, hits, back, followed) in rows {
+        film.specular.add(followed);
         film.rgb.extend(row.iter().map(|p| p.0));
         film.coverage.extend(row.iter().map(|p| p.1));
         seen.extend(row.iter().map(|p| p.2));
@@ -144,15 +152,33 @@ pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync))
 
 /// One camera ray through image point `(x, y)`: `None` for a miss, else
 /// the triangle hit with `None` for a back-face hit or `Some(L)`, the
-/// radiance of a front-face hit.
-fn trace(view: &View, x: f64, y: f64) -> Option<(u32, Option<[f64; 3]>)> {
+/// radiance of a front-face hit, plus what the ray sees through mirrors and
+/// glass ([`Specular::follow`]; a specular surface seen from behind is not
+/// black when it transmits).
+fn trace(view: &View, x: f64, y: f64, followed: &mut Followed) -> Option<(u32, Option<[f64; 3]>)> {
     let direction = view.camera.direction(x, y);
     let hit = view.rays?.closest_hit(view.camera.eye, direction, 0.0, f32::INFINITY, [u32::MAX; 2])?;
+    let Some(specular) = view.specular.filter(|s| s.is_specular(hit.triangle)) else {
+        return Some((hit.triangle, shade(view, view.camera.eye, direction, hit)));
+    };
+    let mut sum = [0.0; 3];
+    let visit = &mut |s: &Seen| {
+        if let Some(radiance) = shade(view, s.origin, s.direction, s.hit) {
+            (0..3).for_each(|c| sum[c] += s.weight[c] * radiance[c]);
+        }
+    };
+    followed.add(specular.follow(view.rays?, view.triangles, view.camera.eye, direction, hit, visit));
+    Some((hit.triangle, Some(sum)))
+}
+
+/// The diffuse radiance `B / pi` the ray `origin + t direction` sees at
+/// `hit`: `None` on a back face (radiosity is one-sided).
+fn shade(view: &View, origin: DVec3, direction: DVec3, hit: Hit) -> Option<[f64; 3]> {
     let triangle = &view.triangles[hit.triangle as usize];
     if direction.dot(triangle.normal) > 0.0 {
-        return Some((hit.triangle, None));
+        return None;
     }
-    let point = view.camera.eye + direction * f64::from(hit.t);
+    let point = origin + direction * f64::from(hit.t);
     let uv = triangle.uv_of(point);
     let textured = view.textured.and_then(|t| Some((t, t.detail.reflectance(hit.triangle, uv)?)));
     let radiosity = match textured {
@@ -162,5 +188,5 @@ fn trace(view: &View, x: f64, y: f64) -> Option<(u32, Option<[f64; 3]>)> {
         }
         None => view.shading.radiosity(hit.triangle, uv),
     };
-    Some((hit.triangle, Some(radiosity.map(|b| b / PI))))
+    Some(radiosity.map(|b| b / PI))
 }
