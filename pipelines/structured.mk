@@ -58,9 +58,9 @@ $(STRUCTURED_OUT)/compare.ron: $(BIN)/compare $(STRUCTURED_OUT)/image.exr $(OUT)
 # converged hierarchical-solve full gather (EPS a quarter of the smallest
 # swept, SPP 16), which the table says is not an independent truth.
 # Writes bench.ron, bench.csv and bench.txt (printed too) under
-# $(BENCH_STRUCTURED_OUT)/<scene>/. About 8 minutes on 2 cores, most of
-# it the Cornell box's converged reference. A benchmark only: never in
-# `make test`.
+# $(BENCH_STRUCTURED_OUT)/<scene>/. About 2 minutes on 2 cores with the
+# Mitsuba reference, 8 without (the converged reference). A benchmark
+# only: never in `make test`.
 BENCH_STRUCTURED_OUT ?= out/bench-structured
 BENCH_STRUCTURED_EPS ?= 0.3,0.1,0.07,0.05,0.03,0.02,0.01,0.003,0.001
 BENCH_STRUCTURED_CORNELL_EPS ?= 0.01,0.003,0.001,0.0003
