@@ -10,22 +10,14 @@
 use bench::structured::table::{Bench, Role};
 use bench::sweep::knobs::Solver;
 use schemas::ron_io::read_ron;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
+
+mod common;
+use common::scratch;
 
 fn bench_structured(args: &[&str]) -> Output {
-    let exe = Path::new(env!("CARGO_BIN_EXE_bench-structured"));
-    let dir = exe.parent().expect("target directory");
-    for stage in ["mesh-prep", "cluster", "hierarchical-solve", "grid-gather", "compare", "exact", "structured-sample"] {
-        assert!(dir.join(stage).exists(), "{} is missing: run `make test` (it builds the stages first)", dir.join(stage).display());
-    }
-    Command::new(exe).args(args).output().expect("bench-structured runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    let stages = ["mesh-prep", "cluster", "hierarchical-solve", "grid-gather", "compare", "exact", "structured-sample"];
+    common::run_driver(env!("CARGO_BIN_EXE_bench-structured"), &stages, args)
 }
 
 /// At 100 x 100 pixels (the exact image takes about 5 s), EPS 0.1 to

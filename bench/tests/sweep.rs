@@ -8,22 +8,13 @@
 use bench::sweep::knobs::Solver;
 use bench::sweep::table::{ReferenceKind, Sweep};
 use schemas::ron_io::read_ron;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
+
+mod common;
+use common::scratch;
 
 fn sweep(args: &[&str]) -> Output {
-    let exe = Path::new(env!("CARGO_BIN_EXE_sweep"));
-    let dir = exe.parent().expect("target directory");
-    for stage in ["mesh-prep", "cluster", "hierarchical-solve", "grid-gather", "compare"] {
-        assert!(dir.join(stage).exists(), "{} is missing: run `make test` (it builds the stages first)", dir.join(stage).display());
-    }
-    Command::new(exe).args(args).output().expect("sweep runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::run_driver(env!("CARGO_BIN_EXE_sweep"), &["mesh-prep", "cluster", "hierarchical-solve", "grid-gather", "compare"], args)
 }
 
 /// The 1280-triangle geodesic sphere: at 320 triangles the faceting alone
