@@ -23,6 +23,7 @@
 
 use crate::elements::Hierarchy;
 use crate::links::Link;
+use crate::mirrors::Couplings;
 use rayon::prelude::*;
 use schemas::solution::Node;
 
@@ -216,13 +217,23 @@ pub const STEADY_RATIO: f64 = 1e-2;
 ///
 /// Stopping at `max_iterations` is reported ([`Convergence::converged`]
 /// `false`, with the bound reached); the caller says so.
-pub fn solve(h: &Hierarchy, links: &[Link], offsets: &[usize], b: &mut [[f64; 3]], tolerance: f64, max_iterations: usize, prior_rate: [f64; 3]) -> Convergence {
+#[allow(clippy::too_many_arguments)]
+pub fn solve(
+    h: &Hierarchy,
+    links: &[Link],
+    offsets: &[usize],
+    specular: Option<&Couplings>,
+    b: &mut [[f64; 3]],
+    tolerance: f64,
+    max_iterations: usize,
+    prior_rate: [f64; 3],
+) -> Convergence {
     let n = b.len();
     let topology = Topology::new(h, n);
     let senders: Vec<usize> = links.iter().map(|l| h.flat(l.sender)).collect();
     // Each link's visibility-weighted form factor, once per solve.
     let coupling: Vec<f64> = links.iter().map(|l| l.form_factor * f64::from(l.visibility.unwrap_or(1.0))).collect();
-    let norm = max_norm(&topology, &coupling, offsets);
+    let norm = max_norm(&topology, &coupling, offsets, specular);
     let mut h_down = vec![[0.0f64; 3]; n];
     let mut delta = vec![[0.0f64; 3]; n];
     let mut convergence =
@@ -232,7 +243,8 @@ pub fn solve(h: &Hierarchy, links: &[Link], offsets: &[usize], b: &mut [[f64; 3]
         let gathered: Vec<[f64; 3]> = (0..n)
             .into_par_iter()
             .map(|i| {
-                let mut g = [0.0; 3];
+                // Light through mirrors and glass (crate::mirrors).
+                let mut g = specular.map_or([0.0; 3], |s| s.gather(i, b));
                 for (&weight, &s) in coupling[offsets[i]..offsets[i + 1]].iter().zip(&senders[offsets[i]..offsets[i + 1]]) {
                     for c in 0..3 {
                         g[c] += weight * b[s][c];
@@ -400,14 +412,14 @@ impl Rate {
 
 /// The max-norm of the iteration matrix per channel (see [`solve`]): the
 /// largest `rho_leaf sum V F` over the links into a leaf and its ancestors.
-fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize]) -> [f64; 3] {
+fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: Option<&Couplings>) -> [f64; 3] {
     let n = topology.parent.len();
     // Visibility-weighted factor sum into each node and its ancestors
     // (parents come first, one forward sweep).
     let mut chain = vec![0.0f64; n];
     let mut norm = [0.0f64; 3];
     for i in 0..n {
-        let own: f64 = coupling[offsets[i]..offsets[i + 1]].iter().sum();
+        let own: f64 = coupling[offsets[i]..offsets[i + 1]].iter().sum::<f64>() + specular.map_or(0.0, |s| s.row_sum(i));
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
             for c in 0..3 {

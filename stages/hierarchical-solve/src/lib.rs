@@ -29,6 +29,8 @@
 //! | `max_iterations` | Jacobi iterations per solve, at most | 2000 |
 //! | `max_passes` | refine-and-solve passes, at most | 8 |
 //! | `seed` | seed of the visibility rays | 1 |
+//! | `specular_rays` | rays per coupling through a mirror or pane ([`mirrors`]) | 16 |
+//! | `specular_min_factor` | couplings through a mirror or pane whose `rho_s F` or `tau_s F` is under this are dropped | 1e-6 |
 //!
 //! **Why `relative` is the default.** The absolute criterion bounds each
 //! link's error in units of the brightest emitter, so on a surface lit only
@@ -67,6 +69,7 @@ pub mod elements;
 pub mod gather;
 pub mod links;
 pub mod luminaires;
+pub mod mirrors;
 pub mod nodes;
 pub mod transfer;
 pub mod transmission;
@@ -123,6 +126,10 @@ pub struct Params {
     pub max_passes: usize,
     /// Seed of the visibility rays.
     pub seed: u64,
+    /// Rays per coupling through a mirror or pane ([`mirrors`]).
+    pub specular_rays: usize,
+    /// Couplings through a mirror or pane under this factor are dropped.
+    pub specular_min_factor: f64,
 }
 
 impl Default for Params {
@@ -142,6 +149,8 @@ impl Default for Params {
             max_iterations: 2000,
             max_passes: 8,
             seed: 1,
+            specular_rays: 16,
+            specular_min_factor: 1e-6,
         }
     }
 }
@@ -185,6 +194,12 @@ impl Params {
         }
         if self.quadrature_depth > 8 {
             return Some(format!("quadrature_depth must be at most 8, not {}", self.quadrature_depth));
+        }
+        if self.specular_rays == 0 || self.specular_rays > 4096 {
+            return Some(format!("specular_rays must be in 1..=4096, not {}", self.specular_rays));
+        }
+        if !(self.specular_min_factor.is_finite() && self.specular_min_factor >= 0.0) {
+            return Some(format!("specular_min_factor must be a non-negative number, not {}", self.specular_min_factor));
         }
         if !positive(self.tolerance) || self.max_iterations == 0 || self.max_passes == 0 {
             return Some("tolerance must be positive, max_iterations and max_passes at least 1".into());
@@ -242,6 +257,10 @@ pub struct Work {
     pub luminaire_rays: u64,
     /// Seconds lighting elements from luminaires.
     pub luminaire_seconds: f64,
+    /// Couplings through mirrors and panes in the last pass ([`mirrors`]).
+    pub specular_couplings: usize,
+    /// Rays cast to build them, all passes.
+    pub specular_rays: u64,
 }
 
 /// Progress of a solve, reported as each phase of a pass begins and when
@@ -324,6 +343,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         scene = scene.with_alpha_masks(masks);
     }
     let mut work = Work::default();
+    let windows = mirrors::Windows::new(mesh, manifest, &h, (params.specular_rays, params.specular_min_factor, params.quadrature_depth, params.seed));
     // Luminaires first (crate::luminaires): their direct light on the input
     // triangles, which joins the emission in the scale of the threshold,
     // then the elements refined for it.
@@ -434,12 +454,17 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
             .sum();
         work.rays += rays as u64;
         work.visibility_seconds += started.elapsed().as_secs_f64();
+        let specular = windows.as_ref().map(|w| w.couplings(&h, &scene, b.len()));
+        if let Some(s) = &specular {
+            work.specular_couplings = s.len();
+            work.specular_rays += s.rays;
+        }
 
         progress(&Progress { pass, phase: Phase::Gathering, links: all_links.len(), elements: h.elements.len() });
         let started = Instant::now();
         all_links.par_sort_unstable_by_key(|l| (h.flat(l.receiver), h.flat(l.sender)));
         let offsets = csr_offsets(&h, &all_links, b.len());
-        let convergence = gather::solve(&h, &all_links, &offsets, &mut b, params.tolerance, params.max_iterations, rates);
+        let convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates);
         rates = convergence.rates;
         work.iterations += convergence.iterations;
         work.relative_change = convergence.relative_change;

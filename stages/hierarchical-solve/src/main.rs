@@ -89,6 +89,12 @@ struct Args {
     /// Seed of the visibility rays.
     #[arg(long)]
     seed: Option<u64>,
+    /// Rays per coupling through a mirror or pane [default: 16].
+    #[arg(long)]
+    specular_rays: Option<usize>,
+    /// Couplings through a mirror or pane whose rho_s F or tau_s F is under this are dropped [default: 1e-6].
+    #[arg(long)]
+    specular_min_factor: Option<f64>,
 }
 
 fn params_of(args: &Args) -> schemas::Result<Params> {
@@ -107,6 +113,8 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.max_iterations = args.max_iterations.unwrap_or(p.max_iterations);
     p.max_passes = args.max_passes.unwrap_or(p.max_passes);
     p.seed = args.seed.unwrap_or(p.seed);
+    p.specular_rays = args.specular_rays.unwrap_or(p.specular_rays);
+    p.specular_min_factor = args.specular_min_factor.unwrap_or(p.specular_min_factor);
     match p.problem() {
         Some(problem) => Err(bad_parameter(problem)),
         None => Ok(p),
@@ -121,8 +129,8 @@ fn skipped(effects: &Effects, surface: bool, one_sided: usize) -> Vec<String> {
     let transmits = format!("diffuse transmission: {one_sided} triangles of translucent materials that are not two-sided transmit nothing (their back face has no elements; make the material two_sided)");
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
-        (effects.specular_reflection, "specular reflection: not simulated by hierarchical-solve; mirrors keep their diffuse part only"),
-        (effects.specular_transmission, "specular transmission: not simulated by hierarchical-solve"),
+        (effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, one reflection per path, each sender at its triangle's mean radiosity; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
+        (effects.specular_transmission, "specular transmission: thin panes by transmitted senders, one pane per path; no refraction bending by thick glass"),
         (effects.diffuse_transmission && one_sided > 0, &transmits),
         (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),
         (effects.alpha_masks && !surface, "alpha masks: no --surface given; surfaces are treated as opaque"),
@@ -212,6 +220,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("luminaires".to_string(), manifest.goniometric_lights.len() as f64),
             ("luminaire_rays".to_string(), w.luminaire_rays as f64),
             ("luminaire_seconds".to_string(), w.luminaire_seconds),
+            ("specular_couplings".to_string(), w.specular_couplings as f64),
+            ("specular_rays".to_string(), w.specular_rays as f64),
             ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
         ]);
         // Left out where unknown (no contraction below 1 was known).

@@ -1,0 +1,292 @@
+//! Planar mirrors and thin glass by virtual senders (issue 14 item 3;
+//! Sillion's mirrored shooter, paper 004 Sec. 4.3.2).
+//!
+//! The specular triangles are grouped into *windows*: those of one material
+//! in one oriented plane. A window `P` (unit normal `n`, reflectance
+//! `rho_s`, transmittance `tau_s`) gives each leaf receiver `r` light from
+//! every input triangle `s`:
+//!
+//! - by reflection, when `r` and `s` lie in front of `P`: from the virtual
+//!   sender `s'`, `s` mirrored in `P` (`y' = y - 2 ((y - p0) . n) n`),
+//!
+//!   ```text
+//!   H_r += rho_s F(r <- s') V'(r, s') B_s
+//!   ```
+//!
+//!   with `F` Lambert's closed form averaged over `r`
+//!   ([`radiometry::form_factor::triangle_to_polygon`]) and `V'` the
+//!   fraction of stratified point pairs `(x, y)` whose ray `x -> y'` meets
+//!   `P` first, inside the window, on its front, and whose reflected leg
+//!   from there to `y` is clear: the form factor clipped to the window as
+//!   seen from `r`, and the occlusion before and after the mirror, with the
+//!   same ray caster as every link;
+//! - by transmission, when `r` and `s` lie on opposite sides of `P`: from
+//!   `s` itself (a transmissive node keeps the shooter), `tau_s F(r <- s)
+//!   V'`, `V'` the fraction of pairs whose segment meets `P` first and is
+//!   clear behind it. The ordinary link `r <- s` counts the pane as an
+//!   occluder, so nothing is counted twice. Refraction is neglected (a thin
+//!   plate), as paper 004 does.
+//!
+//! Both `r` and `s` must face the window (the point kernel is positive for
+//! some pair). `B_s` is the input triangle's area-mean radiosity (its root
+//! element): exact for a uniform emitter, an approximation for a sender
+//! whose radiosity varies across it. One specular event per path (depth
+//! 1): light that meets a second mirror or pane on its way is stopped
+//! there. Couplings whose `coefficient x F` (largest channel) falls under
+//! `specular_min_factor` are dropped (the energy bound). Goniometric point
+//! lights are not mirrored. The couplings are rebuilt on the leaves of
+//! every pass and join the gather ([`crate::gather::solve`]) as extra terms
+//! of the receiving leaves' irradiance.
+
+use crate::elements::Hierarchy;
+use glam::DVec3;
+use radiometry::form_factor::{point_kernel, triangle_to_polygon};
+use radiometry::rays::SceneRays;
+use radiometry::sampling::{stratified_point, Stream};
+use rayon::prelude::*;
+use schemas::mesh::{Manifest, Mesh};
+use schemas::solution::Node;
+
+/// One window: the specular triangles of one material in one plane.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Window {
+    /// A point of the plane.
+    pub origin: DVec3,
+    /// Unit front normal.
+    pub normal: DVec3,
+    /// `rho_s`, RGB.
+    pub reflectance: [f64; 3],
+    /// `tau_s`, RGB.
+    pub transmittance: [f64; 3],
+    /// Whether its material is two-sided (each face a window of its own,
+    /// which transmits only from its front, so the pane counts once).
+    pub two_sided: bool,
+}
+
+/// The scene's windows and which triangle belongs to which.
+pub struct Windows {
+    /// The windows.
+    pub windows: Vec<Window>,
+    /// Per input triangle, its window, if it is specular.
+    pub of_triangle: Vec<Option<u32>>,
+    /// Rays per coupling.
+    rays: usize,
+    /// Smallest `coefficient x F` kept.
+    min_factor: f64,
+    /// Quadrature depth of the form factors.
+    depth: u32,
+    /// Seed of the rays.
+    seed: u64,
+}
+
+/// The virtual senders' couplings into the leaves, by receiver (dense node
+/// index, as the gather's links).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Couplings {
+    /// `offsets[i]..offsets[i + 1]` are node `i`'s couplings.
+    offsets: Vec<usize>,
+    /// Dense index of each coupling's sender (an input triangle's root).
+    senders: Vec<usize>,
+    /// `coefficient x F x V'`, RGB.
+    weights: Vec<[f64; 3]>,
+    /// Rays cast to build them.
+    pub rays: u64,
+}
+
+impl Couplings {
+    /// Irradiance node `i` receives through the windows from radiosity `b`.
+    pub fn gather(&self, i: usize, b: &[[f64; 3]]) -> [f64; 3] {
+        let mut g = [0.0; 3];
+        if let Some(range) = self.offsets.get(i..=i + 1) {
+            for (w, &s) in self.weights[range[0]..range[1]].iter().zip(&self.senders[range[0]..range[1]]) {
+                (0..3).for_each(|c| g[c] += w[c] * b[s][c]);
+            }
+        }
+        g
+    }
+
+    /// Sum of node `i`'s weights, largest channel (its share of the
+    /// gather's contraction bound).
+    pub fn row_sum(&self, i: usize) -> f64 {
+        let Some(range) = self.offsets.get(i..=i + 1) else { return 0.0 };
+        (0..3).map(|c| self.weights[range[0]..range[1]].iter().map(|w| w[c]).sum::<f64>()).fold(0.0, f64::max)
+    }
+
+    /// Number of couplings.
+    pub fn len(&self) -> usize {
+        self.senders.len()
+    }
+
+    /// Whether there is none.
+    pub fn is_empty(&self) -> bool {
+        self.senders.is_empty()
+    }
+}
+
+/// `p` mirrored in the plane through `origin` with unit normal `n`.
+pub fn mirror_point(p: DVec3, origin: DVec3, n: DVec3) -> DVec3 {
+    p - 2.0 * (p - origin).dot(n) * n
+}
+
+/// Direction `d` mirrored in a plane of unit normal `n`.
+pub fn mirror_direction(d: DVec3, n: DVec3) -> DVec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
+impl Windows {
+    /// The windows of `mesh`, or `None` when the scene has no specular
+    /// reflection or transmission. `rays` per coupling, couplings under
+    /// `min_factor` dropped, form factors to quadrature depth `depth`.
+    pub fn new(mesh: &Mesh, manifest: &Manifest, h: &Hierarchy, (rays, min_factor, depth, seed): (usize, f64, u32, u64)) -> Option<Windows> {
+        let e = &manifest.effects;
+        if !(e.specular_reflection || e.specular_transmission) {
+            return None;
+        }
+        let scale = h.triangles.iter().flat_map(|t| t.corners).map(|p| p.abs().max_element()).fold(1e-12, f64::max);
+        let mut windows: Vec<(u32, Window)> = Vec::new();
+        let mut of_triangle = vec![None; mesh.triangles.len()];
+        for (t, triangle) in mesh.triangles.iter().enumerate() {
+            let m = &manifest.materials[triangle.material as usize];
+            if !m.specular_reflectance.iter().chain(&m.specular_transmittance).any(|&x| x > 0.0) {
+                continue;
+            }
+            let g = &h.triangles[t];
+            let same = |(material, w): &(u32, Window)| {
+                *material == triangle.material && w.normal.dot(g.normal) > 1.0 - 1e-9 && (g.corners[0] - w.origin).dot(w.normal).abs() <= 1e-7 * scale
+            };
+            let index = match windows.iter().position(same) {
+                Some(i) => i,
+                None => {
+                    let window = Window {
+                        origin: g.corners[0],
+                        normal: g.normal,
+                        reflectance: m.specular_reflectance,
+                        transmittance: m.specular_transmittance,
+                        two_sided: m.two_sided,
+                    };
+                    windows.push((triangle.material, window));
+                    windows.len() - 1
+                }
+            };
+            of_triangle[t] = Some(index as u32);
+        }
+        Some(Windows { windows: windows.into_iter().map(|(_, w)| w).collect(), of_triangle, rays, min_factor, depth, seed })
+    }
+
+    /// The couplings into the current leaves of `h` (module docs), over
+    /// `nodes` dense indices.
+    pub fn couplings(&self, h: &Hierarchy, scene: &SceneRays, nodes: usize) -> Couplings {
+        let n = h.triangles.len();
+        let leaves: Vec<u32> = (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf()).collect();
+        let per_leaf: Vec<(u32, Vec<(usize, [f64; 3])>, u64)> = leaves
+            .par_iter()
+            .map(|&r| {
+                let mut found = Vec::new();
+                let mut rays = 0;
+                for (w, window) in self.windows.iter().enumerate() {
+                    for s in 0..n as u32 {
+                        if let Some((weight, cast)) = self.coupling(h, scene, w as u32, window, r, s) {
+                            rays += cast;
+                            found.push((h.flat(Node::Element(s)), weight));
+                        }
+                    }
+                }
+                (r, found, rays)
+            })
+            .collect();
+        let mut rows: Vec<Vec<(usize, [f64; 3])>> = vec![Vec::new(); nodes];
+        let mut couplings = Couplings::default();
+        for (r, found, rays) in per_leaf {
+            rows[h.flat(Node::Element(r))] = found;
+            couplings.rays += rays;
+        }
+        couplings.offsets.push(0);
+        for row in rows {
+            for (s, w) in row {
+                couplings.senders.push(s);
+                couplings.weights.push(w);
+            }
+            couplings.offsets.push(couplings.senders.len());
+        }
+        couplings
+    }
+
+    /// The coupling of leaf `r` with input triangle `s` through window
+    /// `w`, and the rays it cost; `None` where none.
+    fn coupling(&self, h: &Hierarchy, scene: &SceneRays, w: u32, window: &Window, r: u32, s: u32) -> Option<([f64; 3], u64)> {
+        let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
+        if self.of_triangle[re.triangle as usize].is_some() || self.of_triangle[s as usize].is_some() {
+            return None;
+        }
+        let side = |p: &[DVec3; 3]| {
+            let d: Vec<f64> = p.iter().map(|&q| (q - window.origin).dot(window.normal)).collect();
+            if d.iter().all(|&x| x >= 0.0) {
+                1
+            } else if d.iter().all(|&x| x <= 0.0) {
+                -1
+            } else {
+                0
+            }
+        };
+        let (r_side, s_side) = (side(&re.points), side(&se.points));
+        let (nr, ns) = (h.normal(r), h.normal(s));
+        let reflect = r_side > 0 && s_side > 0 && window.reflectance.iter().any(|&x| x > 0.0);
+        let transmit = r_side * s_side < 0 && (r_side > 0 || !window.two_sided) && window.transmittance.iter().any(|&x| x > 0.0);
+        let (coefficient, sender, sender_normal) = if reflect {
+            let m = se.points.map(|p| mirror_point(p, window.origin, window.normal));
+            (window.reflectance, [m[0], m[2], m[1]], mirror_direction(ns, window.normal))
+        } else if transmit {
+            (window.transmittance, se.points, ns)
+        } else {
+            return None;
+        };
+        let f = triangle_to_polygon(&re.points, nr, &sender, sender_normal, self.depth).mean;
+        if f <= 0.0 || coefficient.iter().fold(0.0f64, |a, &c| a.max(c)) * f < self.min_factor {
+            return None;
+        }
+        let (v, cast) = self.through(h, scene, w, r, s, &sender, sender_normal, reflect);
+        (v > 0.0).then(|| (coefficient.map(|c| c * f * v), cast))
+    }
+
+    /// Kernel-weighted fraction of stratified pairs `(x on r, y on s)`
+    /// whose light passes through window `w` unoccluded (module docs);
+    /// `image` is `s` as seen through the window (mirrored where
+    /// `reflect`). Returns the fraction and the rays cast.
+    #[allow(clippy::too_many_arguments)]
+    fn through(&self, h: &Hierarchy, scene: &SceneRays, w: u32, r: u32, s: u32, image: &[DVec3; 3], image_normal: DVec3, reflect: bool) -> (f64, u64) {
+        let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
+        let nr = h.normal(r);
+        let mut stream = Stream::new(self.seed ^ 0x4d49_5252_4f52, r.into(), (u64::from(s) << 20) | u64::from(w));
+        // Receiver stratum k with a shuffled sender stratum, as the links' rays.
+        let mut order: Vec<usize> = (0..self.rays).collect();
+        for i in (1..self.rays).rev() {
+            let j = (stream.next_f64() * (i + 1) as f64) as usize;
+            order.swap(i, j.min(i));
+        }
+        let (mut clear, mut total, mut cast) = (0.0, 0.0, 0u64);
+        for (k, &k_sender) in order.iter().enumerate() {
+            let x = stratified_point(&re.points, k, self.rays, &mut stream);
+            let seen = stratified_point(image, k_sender, self.rays, &mut stream);
+            let g = point_kernel(x, nr, seen, image_normal);
+            if g <= 0.0 {
+                continue;
+            }
+            total += g;
+            cast += 1;
+            let d = seen - x;
+            let length = d.length();
+            let Some(hit) = scene.closest_hit(x, d / length, (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32, [re.triangle, u32::MAX]) else { continue };
+            if self.of_triangle[hit.triangle as usize] != Some(w) {
+                continue;
+            }
+            let at = x + d / length * f64::from(hit.t);
+            // The real sender point: the image point mirrored back, or itself.
+            let y = if reflect { mirror_point(seen, self.windows[w as usize].origin, self.windows[w as usize].normal) } else { seen };
+            cast += 1;
+            if scene.segment_clear(at, y, [hit.triangle, se.triangle]) {
+                clear += g;
+            }
+        }
+        (if total > 0.0 { clear / total } else { 0.0 }, cast)
+    }
+}
