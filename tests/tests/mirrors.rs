@@ -17,10 +17,13 @@
 //! ([`SOLVER_MIRRORS`]); the floor sees its own mirror image edge-on (the
 //! same plane), so no light goes floor-mirror-floor.
 
-use end_to_end::closed_form::lambert_polygon;
+use end_to_end::artifacts::leaf_world_corners;
+use end_to_end::closed_form::{clip_to_front, lambert_polygon, mean_over_triangle};
+use end_to_end::scenes::closed_box;
 use end_to_end::{assert_refused, run_ok, s, scratch, solve_prepared};
 use schemas::image::HdrImage;
-use schemas::mesh::Manifest;
+use schemas::mesh::{Manifest, Mesh};
+use schemas::solution::{Element, Solution, NONE};
 use schemas::ron_io::read_ron;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -48,7 +51,7 @@ const MIRROR_Y: f64 = 1.0;
 const MIRROR: ([f64; 2], [f64; 2]) = ([-0.5, 1.5], [0.0, 1.5]);
 /// Whether hierarchical-solve lights the floor through the mirror (the
 /// floor's irradiance then includes `rho_s` times the mirrored emitter's).
-const SOLVER_MIRRORS: bool = false;
+const SOLVER_MIRRORS: bool = true;
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -73,11 +76,12 @@ fn emitter() -> [[f64; 3]; 4] {
     [c, add(c, u, 1.0), add(add(c, u, 1.0), v, 1.0), add(c, v, 1.0)]
 }
 
-/// Writes the scene into a fresh directory; returns it and the scene path.
-fn mirror_scene(test: &str, mirror_mtl: &str) -> (PathBuf, PathBuf) {
+/// Writes the scene, with the mirror wall spanning `mirror` (x and z), into
+/// a fresh directory; returns it and the scene path.
+fn mirror_scene(test: &str, mirror_mtl: &str, mirror: ([f64; 2], [f64; 2])) -> (PathBuf, PathBuf) {
     let dir = scratch(test);
     let ([x0, x1], [y0, y1]) = FLOOR;
-    let ([m0, m1], [z0, z1]) = MIRROR;
+    let ([m0, m1], [z0, z1]) = mirror;
     let y = MIRROR_Y;
     let obj = format!(
         "mtllib scene.mtl\no floor\nusemtl floor\nv {x0} {y0} 0\nv {x1} {y0} 0\nv {x1} {y1} 0\nv {x0} {y1} 0\nf 1 2 3 4\n\
@@ -173,7 +177,7 @@ fn gather(dir: &Path, mode: &str) -> (HdrImage, String) {
 
 #[test]
 fn a_camera_looking_into_a_mirror_sees_rho_s_times_the_reflected_floor_per_pixel() {
-    let (dir, scene) = mirror_scene("mirror_display", "Kd 0\nKs 0.8\nillum 3\n");
+    let (dir, scene) = mirror_scene("mirror_display", "Kd 0\nKs 0.8\nillum 3\n", MIRROR);
     let manifest = prepare_and_solve(&dir, &scene);
     let mirror = manifest.materials.iter().find(|m| m.name == "mirror").unwrap();
     assert_eq!((mirror.diffuse, mirror.specular_reflectance, mirror.specular_transmittance), ([0.0; 3], [RHO_S; 3], [0.0; 3]));
@@ -215,7 +219,7 @@ fn a_camera_looking_into_a_mirror_sees_rho_s_times_the_reflected_floor_per_pixel
 
 #[test]
 fn a_mirror_that_would_reflect_more_than_it_receives_is_refused() {
-    let (dir, scene) = mirror_scene("mirror_refused", "Kd 0.3\nKs 0.8\nillum 3\n");
+    let (dir, scene) = mirror_scene("mirror_refused", "Kd 0.3\nKs 0.8\nillum 3\n", MIRROR);
     let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
     assert_refused(
         "mesh-prep",
@@ -223,4 +227,152 @@ fn a_mirror_that_would_reflect_more_than_it_receives_is_refused() {
         &["material 'mirror'", "diffuse + specular_reflectance", "more than 1"],
         &[&mesh, &manifest],
     );
+}
+
+/// The leaves of a solution, with their triangle's material.
+struct Solved {
+    mesh: Mesh,
+    manifest: Manifest,
+    solution: Solution,
+    report: String,
+}
+
+impl Solved {
+    /// mesh-prep and hierarchical-solve with `solve_args` in `dir`.
+    fn new(dir: &Path, scene: &Path, solve_args: &[&str]) -> Solved {
+        let p = |f: &str| dir.join(f);
+        let (mesh, manifest, solution, report) = (p("mesh.exr"), p("manifest.ron"), p("solution.exr"), p("solve.report.ron"));
+        run_ok("mesh-prep", &[s(scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+        let mut args = vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--report", s(&report)];
+        args.extend_from_slice(solve_args);
+        run_ok("hierarchical-solve", &args);
+        Solved {
+            mesh: Mesh::read(&mesh).unwrap().0,
+            manifest: read_ron::<Manifest>(&manifest).unwrap().value,
+            solution: Solution::read(&solution).unwrap().0,
+            report: std::fs::read_to_string(report).unwrap(),
+        }
+    }
+
+    /// The leaves whose material is `name`.
+    fn leaves_of(&self, name: &str) -> Vec<&Element> {
+        let m = self.manifest.materials.iter().position(|m| m.name == name).unwrap() as u32;
+        self.solution.elements.iter().filter(|e| e.first_child == NONE && self.mesh.triangles[e.triangle as usize].material == m).collect()
+    }
+
+    /// Mean of `f` over leaf `e` (world frame), on the centroids of
+    /// `4^levels` sub-triangles.
+    fn mean(&self, e: &Element, levels: u32, f: &dyn Fn([f64; 3]) -> f64) -> f64 {
+        mean_over_triangle(&leaf_world_corners(&self.mesh, self.manifest.world_from_mesh_translation, e), levels, f)
+    }
+
+    /// Checks every leaf of material `name`: its irradiance `B / rho`
+    /// against the area-mean of `expected` within `tolerance`; returns the
+    /// leaves checked and the largest error.
+    fn check(&self, name: &str, rho: f64, tolerance: f64, expected: &dyn Fn([f64; 3]) -> f64) -> (usize, f64) {
+        let leaves = self.leaves_of(name);
+        let mut worst = 0.0f64;
+        for e in &leaves {
+            let want = self.mean(e, 4, expected);
+            let got = f64::from(e.radiosity[0]) / rho;
+            let error = (got - want).abs() / want.max(1e-12);
+            let at = leaf_world_corners(&self.mesh, self.manifest.world_from_mesh_translation, e);
+            assert!(error < tolerance, "{name} leaf at {at:?}: irradiance {got}, expected {want} (error {error})");
+            worst = worst.max(error);
+        }
+        (leaves.len(), worst)
+    }
+}
+
+/// The part of `polygon` seen from `p` through the convex window `window`
+/// (corners in order): clipped by the planes through `p` and each edge.
+fn through_window(polygon: &[[f64; 3]], p: [f64; 3], window: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let centre = window.iter().fold([0.0; 3], |c, w| add(c, *w, 1.0 / window.len() as f64));
+    let mut clipped = polygon.to_vec();
+    for i in 0..window.len() {
+        let (a, b) = (window[i], window[(i + 1) % window.len()]);
+        let mut n = cross(sub(a, p), sub(b, p));
+        if (0..3).map(|k| (centre[k] - p[k]) * n[k]).sum::<f64>() < 0.0 {
+            n = n.map(|x| -x);
+        }
+        clipped = clip_to_front(&clipped, p, n);
+    }
+    clipped
+}
+
+#[test]
+fn a_floor_beside_a_mirror_wall_gets_lambert_plus_rho_s_times_the_mirrored_emitter_through_the_window() {
+    // A mirror too small to show the whole image of the emitter from the
+    // far part of the floor: the image is clipped to the window.
+    let mirror = ([0.0, 1.0], [0.0, 0.8]);
+    let (dir, scene) = mirror_scene("mirror_solver", "Kd 0\nKs 0.8\nillum 3\n", mirror);
+    let solved = Solved::new(&dir, &scene, &["--eps", "1e-4", "--specular-rays", "1024"]);
+    assert!(solved.report.contains("planar mirrors by virtual senders"), "{}", solved.report);
+    let ([m0, m1], [z0, z1]) = mirror;
+    let window = [[m0, MIRROR_Y, z0], [m1, MIRROR_Y, z0], [m1, MIRROR_Y, z1], [m0, MIRROR_Y, z1]];
+    let image = emitter().map(|c| [c[0], 2.0 * MIRROR_Y - c[1], c[2]]);
+    let up = [0.0, 0.0, 1.0];
+    let expected = |p: [f64; 3]| EXITANCE * (lambert_polygon(p, up, &emitter()) + RHO_S * lambert_polygon(p, up, &through_window(&image, p, &window)));
+    let (leaves, worst) = solved.check("floor", RHO, 0.01, &expected);
+    // The image is clipped somewhere, and seen somewhere.
+    let clipped = |p: [f64; 3]| lambert_polygon(p, up, &through_window(&image, p, &window)) / lambert_polygon(p, up, &image);
+    let fractions: Vec<f64> = solved.leaves_of("floor").iter().map(|e| solved.mean(e, 0, &clipped)).collect();
+    assert!(fractions.iter().any(|&f| f < 0.5) && fractions.iter().any(|&f| f > 0.99), "{fractions:?}");
+    eprintln!("floor beside a mirror: {leaves} leaves, largest irradiance error {worst:.4}");
+}
+
+#[test]
+fn a_glass_pane_passes_tau_s_of_the_light_and_an_opaque_pane_none() {
+    // Floor [0, 1]^2 at z = 0, the emitter [0.25, 0.75]^2 at z = 1, a pane
+    // larger than both at z = 0.5 between them.
+    let quads = |dir: &Path, pane: &str| {
+        let obj = "mtllib scene.mtl\no floor\nusemtl floor\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n\
+                   o pane\nusemtl pane\nv -1 -1 0.5\nv -1 2 0.5\nv 2 2 0.5\nv 2 -1 0.5\nf 5 6 7 8\n";
+        std::fs::write(dir.join("scene.obj"), obj).unwrap();
+        std::fs::write(dir.join("scene.mtl"), format!("newmtl floor\nKd {RHO}\nnewmtl pane\n{pane}")).unwrap();
+        let scene = format!(
+            "Scene(meshes: [Obj(file: \"scene.obj\")], camera: Camera(eye: (0.5, -2.0, 0.3), target: (0.5, 0.5, 0.2), up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 8, height: 8), lights: [Area(corner: (0.25, 0.25, 1.0), edge_u: (0.0, 0.5, 0.0), edge_v: (0.5, 0.0, 0.0), emission: ({EXITANCE:?}, {EXITANCE:?}, {EXITANCE:?}))])"
+        );
+        std::fs::write(dir.join("scene.ron"), scene).unwrap();
+        dir.join("scene.ron")
+    };
+    let lamp = [[0.25, 0.25, 1.0], [0.25, 0.75, 1.0], [0.75, 0.75, 1.0], [0.75, 0.25, 1.0]];
+    let lambert = |p: [f64; 3]| EXITANCE * lambert_polygon(p, [0.0, 0.0, 1.0], &lamp);
+    let tau = 0.6;
+    let dir = scratch("mirror_glass");
+    let glass = Solved::new(&dir, &quads(&dir, "Kd 0\nTf 0.6\nillum 4\n"), &["--eps", "1e-4"]);
+    let pane = &glass.manifest.materials[1];
+    assert_eq!((pane.specular_transmittance, pane.specular_reflectance, pane.diffuse_transmittance), ([tau; 3], [0.0; 3], [0.0; 3]));
+    let (leaves, worst) = glass.check("floor", RHO, 0.01, &|p| tau * lambert(p));
+    eprintln!("floor under a glass pane: {leaves} leaves, largest error {worst:.4} against tau_s x Lambert");
+    let dir = scratch("mirror_opaque_pane");
+    let opaque = Solved::new(&dir, &quads(&dir, "Kd 0\n"), &["--eps", "1e-4"]);
+    for e in opaque.leaves_of("floor") {
+        assert_eq!(e.radiosity, [0.0; 3], "an opaque pane lets light through");
+    }
+}
+
+#[test]
+fn a_closed_box_with_a_mirror_wall_conserves_energy() {
+    let dir = scratch("mirror_box");
+    let mut scene = closed_box(1.0, 0.5, 10.0);
+    for quad in scene.quads.iter_mut().filter(|q| q.0 == "wall0true") {
+        quad.1 = "mirror".into();
+    }
+    scene.material("mirror", 0.05, 0.0);
+    let path = scene.write(&dir);
+    // The mirror is the last material of the library: it reflects 0.9 specularly.
+    let mtl = std::fs::read_to_string(dir.join("scene.mtl")).unwrap();
+    std::fs::write(dir.join("scene.mtl"), format!("{mtl}Ks 0.9\nillum 3\n")).unwrap();
+    let solved = Solved::new(&dir, &path, &["--eps", "1e-3", "--min-area", "1e-3", "--tolerance", "1e-7"]);
+    // Absorbed: sum A (1 - rho_d - rho_s) H over the leaves, H = (B - E) / rho_d.
+    let (mut emitted, mut absorbed) = (0.0, 0.0);
+    for e in solved.solution.elements.iter().filter(|e| e.first_child == NONE) {
+        let m = &solved.manifest.materials[solved.mesh.triangles[e.triangle as usize].material as usize];
+        let area = f64::from(e.area);
+        emitted += area * m.emission[0];
+        absorbed += area * (1.0 - m.diffuse[0] - m.specular_reflectance[0]) * (f64::from(e.radiosity[0]) - m.emission[0]) / m.diffuse[0];
+    }
+    eprintln!("closed box with a mirror wall: absorbed / emitted = {:.5}", absorbed / emitted);
+    assert!((absorbed / emitted - 1.0).abs() < 1e-2, "absorbed {absorbed} of {emitted} emitted");
 }

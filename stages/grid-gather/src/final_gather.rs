@@ -148,7 +148,11 @@ impl Shading<'_> {
         let uv = tri.uv_of(p);
         let leaf = self.senders.chain(triangle, uv, links);
         let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
-        let irradiance = self.irradiance(p, normal, triangle, leaf, links, seen, pass, stream, work);
+        let mut irradiance = self.irradiance(p, normal, triangle, leaf, links, seen, pass, stream, work);
+        if scene.specular.is_some() {
+            let windows = crate::specular::through_windows(scene.solution, leaf, links, scene.surfaces[triangle as usize]);
+            (0..3).for_each(|c| irradiance[c] += windows[c]);
+        }
         let (direct, cast) = self.luminaires.at_point(p, normal, triangle);
         work.visibility_rays += cast;
         // 004 Eq. 4.4: a translucent surface also emits tau times the

@@ -21,7 +21,9 @@
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::{Hit, SceneRays};
+use crate::full::Surface;
 use schemas::mesh::{Manifest, Mesh};
+use schemas::solution::Solution;
 
 /// Ideal specular reflectance and transmittance of one triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -147,6 +149,27 @@ impl Specular {
         }
         work
     }
+}
+
+/// The irradiance the solver's radiosity of `leaf` holds beyond what the
+/// links in `links` (those into the leaf, its ancestors and clusters,
+/// [`crate::senders::Senders::chain`]) bring: the light hierarchical-solve
+/// gathered through mirrors and glass by virtual senders, which the
+/// solution's links do not carry. Per channel `max(0, (B - E) / rho - sum
+/// V E_unoccluded)`, 0 where `rho` is 0 (such a leaf reflects none of it).
+/// The full gather adds it, constant over the leaf, to what it gathers from
+/// the links.
+pub fn through_windows(solution: &Solution, leaf: u32, links: &[usize], surface: Surface) -> [f64; 3] {
+    let b = solution.elements[leaf as usize].radiosity;
+    let from_links = |c: usize| links.iter().map(|&l| f64::from(solution.links[l].visibility) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
+    std::array::from_fn(|c| {
+        let rho = surface.reflectance[c];
+        if rho > 0.0 {
+            ((f64::from(b[c]) - surface.emission[c]) / rho - from_links(c)).max(0.0)
+        } else {
+            0.0
+        }
+    })
 }
 
 #[cfg(test)]
