@@ -30,6 +30,7 @@
 //! | `max_passes` | refine-and-solve passes, at most | 8 |
 //! | `seed` | seed of the visibility rays | 1 |
 //! | `specular_rays` | rays per coupling through a mirror or pane ([`mirrors`]) | 16 |
+//! | `specular_sender_level` | levels below each input triangle the senders through mirrors and panes are taken at (their leaves where coarser) | 2 |
 //! | `specular_min_factor` | couplings through a mirror or pane whose `rho_s F` or `tau_s F` is under this are dropped | 1e-6 |
 //!
 //! **Why `relative` is the default.** The absolute criterion bounds each
@@ -130,6 +131,9 @@ pub struct Params {
     pub specular_rays: usize,
     /// Couplings through a mirror or pane under this factor are dropped.
     pub specular_min_factor: f64,
+    /// Levels below each input triangle the senders through mirrors and
+    /// panes are taken at ([`mirrors`]).
+    pub specular_sender_level: u32,
 }
 
 impl Default for Params {
@@ -151,6 +155,7 @@ impl Default for Params {
             seed: 1,
             specular_rays: 16,
             specular_min_factor: 1e-6,
+            specular_sender_level: 2,
         }
     }
 }
@@ -197,6 +202,9 @@ impl Params {
         }
         if self.specular_rays == 0 || self.specular_rays > 4096 {
             return Some(format!("specular_rays must be in 1..=4096, not {}", self.specular_rays));
+        }
+        if self.specular_sender_level > 8 {
+            return Some(format!("specular_sender_level must be at most 8, not {}", self.specular_sender_level));
         }
         if !(self.specular_min_factor.is_finite() && self.specular_min_factor >= 0.0) {
             return Some(format!("specular_min_factor must be a non-negative number, not {}", self.specular_min_factor));
@@ -343,7 +351,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         scene = scene.with_alpha_masks(masks);
     }
     let mut work = Work::default();
-    let windows = mirrors::Windows::new(mesh, manifest, &h, (params.specular_rays, params.specular_min_factor, params.quadrature_depth, params.seed));
+    let windows = mirrors::Windows::new(mesh, manifest, &h, (params.specular_rays, params.specular_min_factor, params.quadrature_depth, params.seed, params.specular_sender_level));
     // Luminaires first (crate::luminaires): their direct light on the input
     // triangles, which joins the emission in the scale of the threshold,
     // then the elements refined for it.
@@ -464,7 +472,10 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let started = Instant::now();
         all_links.par_sort_unstable_by_key(|l| (h.flat(l.receiver), h.flat(l.sender)));
         let offsets = csr_offsets(&h, &all_links, b.len());
-        let convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates);
+        // The passes refine with senders' area means; the last one solves
+        // with senders resolved by the kernel (gather::SenderTerms).
+        let senders = if pass == passes || (!refined_any && pass > 1) { gather::Senders::Resolved } else { gather::Senders::Means };
+        let convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, senders);
         rates = convergence.rates;
         work.iterations += convergence.iterations;
         work.relative_change = convergence.relative_change;

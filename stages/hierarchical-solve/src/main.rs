@@ -95,6 +95,9 @@ struct Args {
     /// Couplings through a mirror or pane whose rho_s F or tau_s F is under this are dropped [default: 1e-6].
     #[arg(long)]
     specular_min_factor: Option<f64>,
+    /// Levels below each input triangle the senders through mirrors and panes are taken at [default: 2].
+    #[arg(long)]
+    specular_sender_level: Option<u32>,
 }
 
 fn params_of(args: &Args) -> schemas::Result<Params> {
@@ -115,6 +118,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.seed = args.seed.unwrap_or(p.seed);
     p.specular_rays = args.specular_rays.unwrap_or(p.specular_rays);
     p.specular_min_factor = args.specular_min_factor.unwrap_or(p.specular_min_factor);
+    p.specular_sender_level = args.specular_sender_level.unwrap_or(p.specular_sender_level);
     match p.problem() {
         Some(problem) => Err(bad_parameter(problem)),
         None => Ok(p),

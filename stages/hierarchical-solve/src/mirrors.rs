@@ -28,9 +28,11 @@
 //!   plate), as paper 004 does.
 //!
 //! Both `r` and `s` must face the window (the point kernel is positive for
-//! some pair). `B_s` is the input triangle's area-mean radiosity (its root
-//! element): exact for a uniform emitter, an approximation for a sender
-//! whose radiosity varies across it. One specular event per path (depth
+//! some pair). The senders are the elements `specular_sender_level` levels
+//! below each input triangle (its leaves where it is coarser), each at its
+//! area-mean radiosity: exact for a uniform emitter, an approximation for
+//! a sender whose radiosity varies across it (in a closed box with a mirror
+//! wall, level 0 loses 0.96% of the energy, level 2 0.07%). One specular event per path (depth
 //! 1): light that meets a second mirror or pane on its way is stopped
 //! there. Couplings whose `coefficient x F` (largest channel) falls under
 //! `specular_min_factor` are dropped (the energy bound). Goniometric point
@@ -77,6 +79,8 @@ pub struct Windows {
     depth: u32,
     /// Seed of the rays.
     seed: u64,
+    /// Levels below each input triangle its senders are taken at.
+    sender_level: u32,
 }
 
 /// The virtual senders' couplings into the leaves, by receiver (dense node
@@ -137,7 +141,7 @@ impl Windows {
     /// The windows of `mesh`, or `None` when the scene has no specular
     /// reflection or transmission. `rays` per coupling, couplings under
     /// `min_factor` dropped, form factors to quadrature depth `depth`.
-    pub fn new(mesh: &Mesh, manifest: &Manifest, h: &Hierarchy, (rays, min_factor, depth, seed): (usize, f64, u32, u64)) -> Option<Windows> {
+    pub fn new(mesh: &Mesh, manifest: &Manifest, h: &Hierarchy, (rays, min_factor, depth, seed, sender_level): (usize, f64, u32, u64, u32)) -> Option<Windows> {
         let e = &manifest.effects;
         if !(e.specular_reflection || e.specular_transmission) {
             return None;
@@ -170,13 +174,13 @@ impl Windows {
             };
             of_triangle[t] = Some(index as u32);
         }
-        Some(Windows { windows: windows.into_iter().map(|(_, w)| w).collect(), of_triangle, rays, min_factor, depth, seed })
+        Some(Windows { windows: windows.into_iter().map(|(_, w)| w).collect(), of_triangle, rays, min_factor, depth, seed, sender_level })
     }
 
     /// The couplings into the current leaves of `h` (module docs), over
     /// `nodes` dense indices.
     pub fn couplings(&self, h: &Hierarchy, scene: &SceneRays, nodes: usize) -> Couplings {
-        let n = h.triangles.len();
+        let senders: Vec<u32> = (0..h.triangles.len() as u32).filter(|&t| self.of_triangle[t as usize].is_none()).flat_map(|t| self.senders_below(h, t)).collect();
         let leaves: Vec<u32> = (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf()).collect();
         let per_leaf: Vec<(u32, Vec<(usize, [f64; 3])>, u64)> = leaves
             .par_iter()
@@ -184,7 +188,7 @@ impl Windows {
                 let mut found = Vec::new();
                 let mut rays = 0;
                 for (w, window) in self.windows.iter().enumerate() {
-                    for s in 0..n as u32 {
+                    for &s in &senders {
                         if let Some((weight, cast)) = self.coupling(h, scene, w as u32, window, r, s) {
                             rays += cast;
                             found.push((h.flat(Node::Element(s)), weight));
@@ -211,11 +215,27 @@ impl Windows {
         couplings
     }
 
-    /// The coupling of leaf `r` with input triangle `s` through window
+    /// The senders of input triangle `t`: its elements `sender_level`
+    /// levels down, or its leaves where it is coarser.
+    fn senders_below(&self, h: &Hierarchy, t: u32) -> Vec<u32> {
+        let mut found = Vec::new();
+        let mut stack = vec![(t, 0)];
+        while let Some((e, level)) = stack.pop() {
+            let element = &h.elements[e as usize];
+            if element.is_leaf() || level == self.sender_level {
+                found.push(e);
+            } else {
+                stack.extend((0..4).map(|k| (element.first_child + k, level + 1)));
+            }
+        }
+        found
+    }
+
+    /// The coupling of leaf `r` with sender element `s` through window
     /// `w`, and the rays it cost; `None` where none.
     fn coupling(&self, h: &Hierarchy, scene: &SceneRays, w: u32, window: &Window, r: u32, s: u32) -> Option<([f64; 3], u64)> {
         let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
-        if self.of_triangle[re.triangle as usize].is_some() || self.of_triangle[s as usize].is_some() {
+        if self.of_triangle[re.triangle as usize].is_some() {
             return None;
         }
         let side = |p: &[DVec3; 3]| {
