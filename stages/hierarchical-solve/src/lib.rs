@@ -269,6 +269,8 @@ pub struct Work {
     pub specular_couplings: usize,
     /// Rays cast to build them, all passes.
     pub specular_rays: u64,
+    /// Seconds building them, all passes.
+    pub specular_seconds: f64,
 }
 
 /// Progress of a solve, reported as each phase of a pass begins and when
@@ -462,10 +464,12 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
             .sum();
         work.rays += rays as u64;
         work.visibility_seconds += started.elapsed().as_secs_f64();
+        let started = Instant::now();
         let specular = windows.as_ref().map(|w| w.couplings(&h, &scene, b.len()));
         if let Some(s) = &specular {
             work.specular_couplings = s.len();
             work.specular_rays += s.rays;
+            work.specular_seconds += started.elapsed().as_secs_f64();
         }
 
         progress(&Progress { pass, phase: Phase::Gathering, links: all_links.len(), elements: h.elements.len() });

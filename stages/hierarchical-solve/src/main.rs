@@ -133,7 +133,7 @@ fn skipped(effects: &Effects, surface: bool, one_sided: usize) -> Vec<String> {
     let transmits = format!("diffuse transmission: {one_sided} triangles of translucent materials that are not two-sided transmit nothing (their back face has no elements; make the material two_sided)");
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
-        (effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, one reflection per path, each sender at its triangle's mean radiosity; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
+        (effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, one reflection per path (light meeting a second mirror or pane stops there), senders at their elements' mean radiosity --specular-sender-level levels down; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
         (effects.specular_transmission, "specular transmission: thin panes by transmitted senders, one pane per path; no refraction bending by thick glass"),
         (effects.diffuse_transmission && one_sided > 0, &transmits),
         (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),
@@ -226,6 +226,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("luminaire_seconds".to_string(), w.luminaire_seconds),
             ("specular_couplings".to_string(), w.specular_couplings as f64),
             ("specular_rays".to_string(), w.specular_rays as f64),
+            ("specular_seconds".to_string(), w.specular_seconds),
             ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
         ]);
         // Left out where unknown (no contraction below 1 was known).
