@@ -31,6 +31,12 @@ pub fn default_material() -> Material {
 ///   exporters write beside `Tf 1 1 1`) transmits nothing.
 /// - `map_Kd`, `map_d` and `norm`/`bump` name the diffuse texture, alpha mask
 ///   and normal map.
+/// - Ignored: `Ni` (index of refraction: glass is a thin plate whose
+///   refraction bending is neglected, as paper 004 Sec. 4.3.2 does, and
+///   `Ks`, `Tf` are taken as the plate's reflectance and transmittance,
+///   without a Fresnel split), `Ns` (the specular part is ideal, never
+///   glossy), `Ka`, `Tr` and the Fresnel variants of `illum` 5 and 7 (read
+///   as 3 and 6).
 pub fn from_mtl(m: &MtlMaterial) -> Material {
     let illum = m.illumination_model.unwrap_or(2);
     let rgb = |v: Option<[f64; 3]>| v.unwrap_or([0.0; 3]);
@@ -144,6 +150,26 @@ mod tests {
         let glass = sheet(Some(4), Some([0.5; 3]), Some(0.4));
         assert_eq!((glass.diffuse_transmittance, glass.specular_transmittance), ([0.0; 3], [0.5; 3]));
         assert_eq!(sheet(Some(3), Some([0.5; 3]), Some(0.4)).diffuse_transmittance, [0.0; 3], "a mirror model does not transmit");
+    }
+
+    #[test]
+    fn mcguires_mirror_and_glass_map_to_ideal_specular_coefficients() {
+        let mirror = from_mtl(&MtlMaterial { name: "tallBox".into(), diffuse: Some([0.01; 3]), specular: Some([0.95; 3]), illumination_model: Some(5), ..Default::default() });
+        assert_eq!((mirror.diffuse, mirror.specular_reflectance, mirror.specular_transmittance), ([0.01; 3], [0.95; 3], [0.0; 3]));
+        let glass = MtlMaterial {
+            name: "water".into(),
+            diffuse: Some([0.01; 3]),
+            specular: Some([0.3; 3]),
+            transmission_filter: Some([0.1; 3]),
+            illumination_model: Some(7),
+            ..Default::default()
+        };
+        let water = from_mtl(&glass);
+        assert_eq!((water.specular_reflectance, water.specular_transmittance, water.diffuse_transmittance), ([0.3; 3], [0.1; 3], [0.0; 3]));
+        assert_eq!(check(&water), None);
+        // illum 9: glass without reflection; Tf absent, 1 - d passes.
+        let pane = from_mtl(&MtlMaterial { illumination_model: Some(9), transmission_filter: None, dissolve: Some(0.25), ..glass });
+        assert_eq!((pane.specular_reflectance, pane.specular_transmittance), ([0.0; 3], [0.75; 3]));
     }
 
     #[test]
