@@ -1,0 +1,167 @@
+//! hierarchical-solve's leaves against the radiosity equation over the same
+//! leaves with a kernel written here (issue 10: the Cornell box's dark
+//! offset).
+//!
+//! In a convex room nothing occludes, so the piecewise-constant radiosity
+//! equation over the solver's own leaves,
+//!
+//! ```text
+//! B_i = E_i + rho_i sum_j F_ij B_j,   F_ij = mean over leaf i of Lambert's point-to-polygon factor of leaf j
+//! ```
+//!
+//! has a solution computed here by Jacobi iteration with
+//! [`lambert_polygon`] (paper 002 Eq. 3), written apart from the stages'
+//! kernel. It differs from the solver's only by what the hierarchy
+//! approximates (links between inner elements); refining every link to
+//! the leaves would give it. A sender's area mean is such an
+//! approximation with one sign wherever the part of the sender nearer the
+//! receiver is brighter than its mean: it made every wall of the Cornell
+//! box without blocks 0.24% to 0.66% darker than this equation, half of
+//! that scene's offset against Mitsuba (the rest: the leaves' constant
+//! radiosity, and the preview's interpolation). The solver now resolves
+//! senders by the kernel in its last pass (`gather::SenderTerms`).
+
+use end_to_end::artifacts::leaf_world_corners;
+use end_to_end::closed_form::{lambert_polygon, mean_over_triangle};
+use end_to_end::scenes::closed_box;
+use end_to_end::{run_ok, s, scratch, solve_prepared};
+use schemas::mesh::{Manifest, Mesh};
+use schemas::ron_io::read_ron;
+use schemas::solution::Solution;
+use std::collections::BTreeMap;
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit_normal(c: &[[f64; 3]; 3]) -> [f64; 3] {
+    let (u, v) = (sub(c[1], c[0]), sub(c[2], c[0]));
+    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    let l = dot(n, n).sqrt();
+    n.map(|x| x / l)
+}
+
+/// One leaf: its object, corners (world), unit normal, area, reflectance,
+/// emission and the solver's radiosity (grey scenes: one channel).
+struct Leaf {
+    object: String,
+    corners: [[f64; 3]; 3],
+    normal: [f64; 3],
+    area: f64,
+    rho: f64,
+    emission: f64,
+    solved: f64,
+}
+
+/// The closed box of the closed-form tests (1 m, the ceiling's middle
+/// ninth a lamp) without its wall `y = 0`: an open, convex room, lit
+/// unevenly, as the Cornell box without its blocks.
+fn open_box(test: &str, args: &[&str], clustered: bool) -> Vec<Leaf> {
+    let mut scene = closed_box(1.0, 0.7, 10.0);
+    scene.quads.retain(|(object, _, _)| object != "wall1false");
+    scene.camera = ([0.5, -1.0, 0.5], [0.5, 0.0, 0.5]);
+    let dir = scratch(test);
+    let scene_path = scene.write(&dir);
+    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
+    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let solution = solve_prepared(&dir, args, clustered.then_some(1));
+    let (mesh, _) = Mesh::read(&mesh).unwrap();
+    let manifest = read_ron::<Manifest>(&manifest).unwrap().value;
+    let (solution, _) = Solution::read(&solution).unwrap();
+    let origin = manifest.world_from_mesh_translation;
+    solution
+        .elements
+        .iter()
+        .filter(|e| e.is_leaf())
+        .map(|e| {
+            let t = &mesh.triangles[e.triangle as usize];
+            let material = &manifest.materials[t.material as usize];
+            let corners = leaf_world_corners(&mesh, origin, e);
+            Leaf {
+                object: manifest.objects[t.object as usize].clone(),
+                corners,
+                normal: unit_normal(&corners),
+                area: f64::from(e.area),
+                rho: material.diffuse[0],
+                emission: material.emission[0],
+                solved: f64::from(e.radiosity[0]),
+            }
+        })
+        .collect()
+}
+
+/// The radiosity equation over `leaves` solved with the kernel written
+/// here: `F_ij` the mean over 4 points of leaf i of Lambert's factor of
+/// leaf j where j faces those points (one-sided), Jacobi to 1e-9.
+fn reference(leaves: &[Leaf]) -> Vec<f64> {
+    let n = leaves.len();
+    let mut f = vec![0.0f64; n * n];
+    for (i, r) in leaves.iter().enumerate() {
+        for (j, sdr) in leaves.iter().enumerate() {
+            if i == j {
+                continue;
+            }
+            f[i * n + j] = mean_over_triangle(&r.corners, 1, &|x| if dot(sub(x, sdr.corners[0]), sdr.normal) > 1e-12 { lambert_polygon(x, r.normal, &sdr.corners) } else { 0.0 });
+        }
+    }
+    let mut b: Vec<f64> = leaves.iter().map(|l| l.solved).collect();
+    for _ in 0..500 {
+        let next: Vec<f64> = (0..n).map(|i| leaves[i].emission + leaves[i].rho * (0..n).map(|j| f[i * n + j] * b[j]).sum::<f64>()).collect();
+        let change = next.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        b = next;
+        if change < 1e-9 * b.iter().cloned().fold(0.0, f64::max) {
+            break;
+        }
+    }
+    b
+}
+
+/// Per object, the area-weighted mean of the solver's leaves against the
+/// reference's, within `mean_tolerance`; and every leaf within
+/// `leaf_tolerance` of its reference.
+fn check(test: &str, clustered: bool, mean_tolerance: f64, leaf_tolerance: f64) {
+    let leaves = open_box(test, &[], clustered);
+    let want = reference(&leaves);
+    let mut means: BTreeMap<&str, (f64, f64)> = BTreeMap::new();
+    let mut worst = (0.0f64, 0usize);
+    for (i, (leaf, w)) in leaves.iter().zip(&want).enumerate() {
+        if leaf.emission > 0.0 {
+            continue;
+        }
+        let m = means.entry(&leaf.object).or_default();
+        m.0 += leaf.area * leaf.solved;
+        m.1 += leaf.area * w;
+        let e = (leaf.solved / w - 1.0).abs();
+        if e > worst.0 {
+            worst = (e, i);
+        }
+    }
+    let report: Vec<String> = means.iter().map(|(o, (got, want))| format!("{o} {:+.3}%", 100.0 * (got / want - 1.0))).collect();
+    eprintln!("{test}: {} leaves; per object, solver vs the equation: {}; worst leaf {:.3}%", leaves.len(), report.join(", "), 100.0 * worst.0);
+    for (object, (got, want)) in &means {
+        assert!((got / want - 1.0).abs() <= mean_tolerance, "{test}: {object}: area mean {got} vs the equation's {want} ({:+.3}%; allowed {:.2}%)", 100.0 * (got / want - 1.0), 100.0 * mean_tolerance);
+    }
+    let (e, i) = worst;
+    assert!(e <= leaf_tolerance, "{test}: leaf {i} of {} is {:.3}% off the equation (allowed {:.1}%)", leaves[i].object, 100.0 * e, 100.0 * leaf_tolerance);
+}
+
+/// Measured (defaults, 3164 leaves): objects -0.05% to -0.11%, worst leaf
+/// 0.74%; with senders' area means, -0.21% to -0.40% and 0.96%.
+#[test]
+fn open_box_leaves_satisfy_the_radiosity_equation() {
+    check("radiosity_equation", false, 1.5e-3, 8.5e-3);
+}
+
+/// Measured (defaults, 3149 leaves): objects +0.02% to -0.13%; with
+/// senders' area means, -0.21% to -0.29%. The worst leaf, 8.2% (7.9%
+/// before), is one lit through a cluster link, whose factor is a 16-sample
+/// estimate (hierarchical-solve's `transfer`): a spread of single leaves,
+/// not a bias of surfaces.
+#[test]
+fn open_box_leaves_satisfy_the_radiosity_equation_with_clusters() {
+    check("radiosity_equation_clustered", true, 1.5e-3, 0.1);
+}
