@@ -174,26 +174,65 @@ pub fn bilinear_of(lm: &Lightmap, values: &[[f32; 3]], t: usize, uv: [f64; 2]) -
 /// Radiosity and residual for every covered texel of `atlas` (tiles
 /// `tiles`, each inside the old tile `origin` of `old_tiles`, whose
 /// lightmap is `old`): a tile that did not change keeps its texels'
-/// values, a new one takes the bilinear reconstruction of its old tile at
-/// its texels' points (004 Sec. 2.4: "copied down ... using linear
-/// interpolation").
+/// values; the children of a split tile take the bilinear reconstruction
+/// of their old tile at their texels' points (004 Sec. 2.4: "copied down
+/// ... using linear interpolation"), scaled per channel so that together
+/// they hold the old tile's power (the reconstruction's extrapolated
+/// seams would otherwise add or lose some).
 pub fn copy_down(old: &Lightmap, old_tiles: &[Tile], atlas: &Atlas, tiles: &[Tile], origin: &[usize]) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
-    let f4 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
-    atlas
+    let split = |t: usize| old_tiles[origin[t]] != tiles[t];
+    let values: Vec<([f64; 3], [f64; 3])> = atlas
         .texels
         .iter()
         .map(|x| {
             let t = x.triangle as usize;
             let o = origin[t];
             let (i, j) = x.indices(atlas.regions[t]);
-            if old_tiles[o] == tiles[t] {
+            if !split(t) {
                 let r = old.regions[o];
                 let k = (r.y + 1 + j) as usize * old.width + (r.x + 1 + i) as usize;
-                let rgb = |v: [f32; 3]| [v[0], v[1], v[2], 0.0];
-                return (rgb(old.radiosity[k]), rgb(old.residual[k]));
+                return (old.radiosity[k].map(f64::from), old.residual[k].map(f64::from));
             }
             let at = from_root(&old_tiles[o].corners, to_root(&tiles[t].corners, texel_point(atlas.regions[t], i, j)));
-            (f4(bilinear_of(old, &old.radiosity, o, at)), f4(bilinear_of(old, &old.residual, o, at)))
+            (bilinear_of(old, &old.radiosity, o, at), bilinear_of(old, &old.residual, o, at))
+        })
+        .collect();
+    // Power per old tile that was split: in the old lightmap, and copied.
+    let mut before = vec![[0.0f64; 6]; old_tiles.len()];
+    let mut after = vec![[0.0f64; 6]; old_tiles.len()];
+    for (o, r) in old.regions.iter().enumerate() {
+        for j in 0..r.size {
+            for i in 0..r.size - j {
+                let k = (r.y + 1 + j) as usize * old.width + (r.x + 1 + i) as usize;
+                let a = old.texel_area[k] as f64;
+                for c in 0..3 {
+                    before[o][c] += old.radiosity[k][c] as f64 * a;
+                    before[o][c + 3] += old.residual[k][c] as f64 * a;
+                }
+            }
+        }
+    }
+    for (x, (b, r)) in atlas.texels.iter().zip(&values) {
+        let a = x.area as f64;
+        for c in 0..3 {
+            after[origin[x.triangle as usize]][c] += b[c] * a;
+            after[origin[x.triangle as usize]][c + 3] += r[c] * a;
+        }
+    }
+    let scale = |o: usize, c: usize| if after[o][c] != 0.0 { before[o][c] / after[o][c] } else { 1.0 };
+    atlas
+        .texels
+        .iter()
+        .zip(values)
+        .map(|(x, (b, r))| {
+            let t = x.triangle as usize;
+            if !split(t) {
+                return ([b[0] as f32, b[1] as f32, b[2] as f32, 0.0], [r[0] as f32, r[1] as f32, r[2] as f32, 0.0]);
+            }
+            let o = origin[t];
+            let f = |v: [f64; 3], at: usize| [0, 1, 2].map(|c| (v[c] * scale(o, c + at)) as f32);
+            let (b, r) = (f(b, 0), f(r, 3));
+            ([b[0], b[1], b[2], 0.0], [r[0], r[1], r[2], 0.0])
         })
         .unzip()
 }

@@ -169,3 +169,34 @@ fn a_sharp_shadow_on_a_coarse_floor_is_refined_along_its_edge() {
     assert!(refined_texels < 2 * plain_texels, "{refined_texels} texels vs {plain_texels}");
     assert!(refined_error * 4.0 <= plain_error, "error {refined_error} vs {plain_error}");
 }
+
+/// On the Cornell box (shadows of its blocks on the floor and walls, the
+/// light and then the surfaces shooting, each split copying its radiosity
+/// and residual down), every surface's reflected power (radiosity times
+/// area over its texels) with the subdivision (one level, 2000 texels) is
+/// within 3% of a solve at 32000 texels without it (measured 2.6%), no
+/// farther than the 2000-texel solve without it (measured 6.2%), and the
+/// shots converge as far.
+#[test]
+fn the_cornell_box_keeps_its_surfaces_power_under_subdivision() {
+    let (mesh, m) = mesh_prep::prepare_builtin("cornell-box", "test").unwrap();
+    let Some((device, queue)) = device() else { return };
+    let power = |texels: f64, adaptive: Option<Adaptive>| {
+        let params = Params { texels, convergence_target: 0.995, adaptive, ..Params::default() };
+        let solved = solve(&device, &queue, &mesh, &m, None, &[], &params, &mut |_| {}).unwrap();
+        let mut per_object = vec![0.0f64; m.objects.len()];
+        for (k, x) in solved.atlas.texels.iter().enumerate() {
+            let object = mesh.triangles[solved.tiles[x.triangle as usize].root as usize].object as usize;
+            per_object[object] += solved.radiosity[k].iter().map(|&v| v as f64).sum::<f64>() * x.area as f64;
+        }
+        assert!(solved.shots.last().unwrap().unshot_fraction <= 0.005);
+        (per_object, solved.work.tiles_added)
+    };
+    let (fine, _) = power(32000.0, None);
+    let (plain, _) = power(2000.0, None);
+    let (refined, added) = power(2000.0, Some(Adaptive { levels: 1, ..Adaptive::default() }));
+    let worst = |p: &[f64]| p.iter().zip(&fine).map(|(a, b)| (a / b - 1.0).abs()).fold(0.0, f64::max);
+    eprintln!("Cornell box: {added} tiles added; worst object power against 32000 texels: {:.4} subdivided, {:.4} not", worst(&refined), worst(&plain));
+    assert!(added > 0);
+    assert!(worst(&refined) < 0.03 && worst(&refined) <= worst(&plain), "{refined:?} and {plain:?} vs {fine:?}");
+}
