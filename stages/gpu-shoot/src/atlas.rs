@@ -279,10 +279,10 @@ impl Atlas {
             }
             for g in &mut self.groups[range.group_first as usize..(range.group_first + range.group_count) as usize] {
                 let (mut sum, mut area, mut nominal) = (DVec3::ZERO, 0.0f64, 0.0f64);
-                for k in g.first as usize..(g.first + g.count) as usize {
-                    let texel = &mut self.texels[k];
+                let range = g.first as usize..(g.first + g.count) as usize;
+                for (texel, &fraction) in self.texels[range.clone()].iter_mut().zip(&coverage[range]) {
                     nominal += texel.area as f64;
-                    texel.area = (texel.area as f64 * coverage[k]) as f32;
+                    texel.area = (texel.area as f64 * fraction) as f32;
                     sum += DVec3::from(texel.position.map(f64::from)) * texel.area as f64;
                     area += texel.area as f64;
                 }

@@ -14,6 +14,13 @@
 //! by mesh-prep) shoot first, as point sources with
 //! intensity `I_max LDT(C, gamma)` (Eq. 3.4) over a full cube of faces.
 //!
+//! Surface detail from `mesh-prep --surface` ([`detail`]): per-texel
+//! reflectance from diffuse textures (004 Sec. 4.2), alpha masks that
+//! remove texels and discard their fragments in the visibility maps (Sec.
+//! 4.3.4), normal maps for the cosines (Sec. 2.3.3). Adaptive subdivision
+//! at shadow boundaries ([`tiling`], Sec. 2.4) splits receivers into tiles
+//! before a triangle first shoots.
+//!
 //! The result is written as the lightmap atlas with its region table
 //! (`schemas::lightmap`), and as a `solution.exr` whose leaves average the
 //! atlas ([`output`]), so `grid-gather --mode preview`, `tonemap` and

@@ -8,8 +8,8 @@
 //! Without an adapter the test skips loudly, but fails under CI.
 
 use glam::DVec3;
-use gpu_shoot::testing::{manifest, material, triangles};
-use gpu_shoot::{gpu, solve, Adaptive, Params, Solved};
+use gpu_shoot::testing::{device, manifest, material, triangles};
+use gpu_shoot::{solve, Adaptive, Params, Solved};
 use radiometry::form_factor::point_to_polygon;
 use schemas::mesh::{Manifest, Mesh};
 
@@ -26,17 +26,6 @@ const SIZE: f64 = 0.001;
 const CELLS: usize = 32;
 
 
-fn device() -> Option<(wgpu::Device, wgpu::Queue)> {
-    gpu::quiet_device_select_layer();
-    match gpu::acquire() {
-        Ok((d, q, _)) => Some((d, q)),
-        Err(e) if std::env::var_os("CI").is_some() => panic!("CI has no GPU adapter: {e}"),
-        Err(e) => {
-            eprintln!("\n*** SKIPPED: gpu-shoot adaptive subdivision test: {e} ***\n");
-            None
-        }
-    }
-}
 
 /// The floor `[0, 1]^2` (y = 0, up) as `CELLS^2` cells of two right
 /// triangles, the plate `[-0.5, 0.5] x [-0.5, 1.5]` at height `H / 2` (black,

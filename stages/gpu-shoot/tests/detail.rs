@@ -8,8 +8,8 @@
 //! skip loudly, but fail under CI.
 
 use glam::DVec3;
-use gpu_shoot::testing::{manifest, material, triangles};
-use gpu_shoot::{gpu, output, solve, Params, Solved};
+use gpu_shoot::testing::{device, manifest, material, triangles};
+use gpu_shoot::{output, solve, Params, Solved};
 use radiometry::form_factor::point_to_polygon;
 use schemas::header::{Provenance, Schema};
 use schemas::lightmap::Lightmap;
@@ -20,21 +20,11 @@ use schemas::surface::{Surface, Texture, TextureKind, NONE};
 /// Emitted radiosity of the emitter, W/m².
 const E: f64 = 10.0;
 
-fn device() -> Option<(wgpu::Device, wgpu::Queue)> {
-    gpu::quiet_device_select_layer();
-    match gpu::acquire() {
-        Ok((d, q, _)) => Some((d, q)),
-        Err(e) if std::env::var_os("CI").is_some() => panic!("CI has no GPU adapter: {e}"),
-        Err(e) => {
-            eprintln!("\n*** SKIPPED: gpu-shoot surface detail test: {e} ***\n");
-            None
-        }
-    }
-}
 
 /// The horizontal square `[x0, x1] x [z0, z1]` at height `y` as two right
 /// triangles whose legs run along x and z (so a region's texel grid lines
 /// are lines of constant x and z), facing up or down.
+#[allow(clippy::too_many_arguments)]
 fn square(x0: f64, x1: f64, z0: f64, z1: f64, y: f64, up: bool, material: u32, object: u32) -> Vec<([DVec3; 3], u32, u32)> {
     let p = |x: f64, z: f64| DVec3::new(x, y, z);
     let (a, b) = ([p(x0, z0), p(x0, z1), p(x1, z0)], [p(x1, z1), p(x1, z0), p(x0, z1)]);
@@ -125,8 +115,8 @@ fn checkerboard_floor_takes_each_texels_reflectance() {
     let mut worst = 0.0f64;
     for (k, p) in floor_texels(&solved).filter(|(_, p)| (p.x - 0.5).abs() > 1.0 / 32.0 && (p.z - 0.5).abs() > 1.0 / 32.0) {
         let reference = exact(p);
-        for ch in 0..3 {
-            worst = worst.max((solved.radiosity[k][ch] as f64 - reference[ch]).abs() / reference[ch]);
+        for (b, r) in solved.radiosity[k].iter().zip(reference) {
+            worst = worst.max((*b as f64 - r).abs() / r);
         }
     }
     eprintln!("checkerboard floor: worst texel {worst:.4}");
@@ -166,8 +156,8 @@ fn checkerboard_floor_takes_each_texels_reflectance() {
         if touches {
             continue;
         }
-        for ch in 0..3 {
-            worst = worst.max((e.radiosity[ch] as f64 - mean[ch]).abs() / mean[ch]);
+        for (b, r) in e.radiosity.iter().zip(mean) {
+            worst = worst.max((*b as f64 - r).abs() / r);
         }
         count += 1;
     }

@@ -4,21 +4,11 @@
 
 use glam::DVec3;
 use radiometry::photometry::{Distribution, Luminaire, K_M};
-use gpu_shoot::testing::{closed_box, manifest, material, quads};
-use gpu_shoot::{gpu, reference, solve, Params, Solved, Visibility};
+use gpu_shoot::testing::{closed_box, device, manifest, material, quads};
+use gpu_shoot::{reference, solve, Params, Solved, Visibility};
 use schemas::mesh::{Manifest, Mesh};
 use std::f64::consts::PI;
 
-fn device() -> Option<(wgpu::Device, wgpu::Queue)> {
-    match gpu::acquire() {
-        Ok((d, q, _)) => Some((d, q)),
-        Err(e) if std::env::var_os("CI").is_some() => panic!("CI has no GPU adapter: {e}"),
-        Err(e) => {
-            eprintln!("\n*** SKIPPED: gpu-shoot GPU test: {e} ***\n");
-            None
-        }
-    }
-}
 
 fn run(mesh: &Mesh, manifest: &Manifest, lights: &[Luminaire], params: &Params) -> Option<Solved> {
     let (device, queue) = device()?;
