@@ -395,6 +395,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let passes = if manifest.effects.diffuse_interreflection { params.max_passes } else { 1 };
     // The rate of convergence of the previous pass's solve (gather::solve).
     let mut rates = [0.0; 3];
+    // The couplings through mirrors and panes, rebuilt each pass (mirrors).
+    let mut specular: Option<mirrors::Couplings> = None;
     for pass in 1..=passes {
         let started = Instant::now();
         let mut refined_any = false;
@@ -437,6 +439,13 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
                 break;
             }
         }
+        // Leaves the light through mirrors and panes varies over (mirrors).
+        for e in specular.as_ref().map_or(Vec::new(), |s| s.to_split(&h, &b, &allowance, min_area)) {
+            h.ensure_children(Node::Element(e));
+            let parent_b = b[h.flat(Node::Element(e))];
+            b.resize(b.len() + 4, parent_b);
+            refined_any = true;
+        }
         // The faces of translucent surfaces refine alike (crate::transmission).
         if h.pair_faces() {
             while b.len() < h.cluster_count() + h.elements.len() {
@@ -465,7 +474,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         work.rays += rays as u64;
         work.visibility_seconds += started.elapsed().as_secs_f64();
         let started = Instant::now();
-        let specular = windows.as_ref().map(|w| w.couplings(&h, &scene, b.len()));
+        specular = windows.as_ref().map(|w| w.couplings(&h, &scene, &b));
         if let Some(s) = &specular {
             work.specular_couplings = s.len();
             work.specular_rays += s.rays;

@@ -38,11 +38,15 @@
 //! `specular_min_factor` are dropped (the energy bound). Goniometric point
 //! lights are not mirrored. The couplings are rebuilt on the leaves of
 //! every pass and join the gather ([`crate::gather::solve`]) as extra terms
-//! of the receiving leaves' irradiance.
+//! of the receiving leaves' irradiance. The links' refinement oracle does
+//! not see this light, so a leaf whose couplings' light varies over it
+//! (the spread of `F` at its quadrature points) by more than the allowance
+//! is split before the next pass ([`Couplings::to_split`]).
 
 use crate::elements::Hierarchy;
 use glam::DVec3;
-use radiometry::form_factor::{point_kernel, triangle_to_polygon};
+use crate::links::Allowance;
+use radiometry::form_factor::{point_kernel, triangle_to_polygon, AreaFactor};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
 use rayon::prelude::*;
@@ -93,6 +97,10 @@ pub struct Couplings {
     senders: Vec<usize>,
     /// `coefficient x F x V'`, RGB.
     weights: Vec<[f64; 3]>,
+    /// Per node, what its couplings' light varies by over it: the sum of
+    /// `coefficient (F_max - F_min) V' B_s` over them (largest channel,
+    /// `F` at the receiver quadrature's points, `B` when they were built).
+    spread: Vec<f64>,
     /// Rays cast to build them.
     pub rays: u64,
 }
@@ -114,6 +122,22 @@ impl Couplings {
     pub fn row_sum(&self, i: usize) -> f64 {
         let Some(range) = self.offsets.get(i..=i + 1) else { return 0.0 };
         (0..3).map(|c| self.weights[range[0]..range[1]].iter().map(|w| w[c]).sum::<f64>()).fold(0.0, f64::max)
+    }
+
+    /// The leaves to split so that the light through windows is resolved
+    /// as the links' is: those whose reflected spread `rho_r x spread`
+    /// exceeds what the refinement allows on them, and that the area floor
+    /// lets split. (The links' oracle does not see this light: under a
+    /// pane, the links from the emitter are occluded.)
+    pub fn to_split(&self, h: &Hierarchy, b: &[[f64; 3]], allowance: &Allowance, min_area: f64) -> Vec<u32> {
+        (0..h.elements.len() as u32)
+            .filter(|&e| {
+                let node = Node::Element(e);
+                let i = h.flat(node);
+                let rho = h.node_reflectance(node).into_iter().fold(0.0, f64::max);
+                h.elements[e as usize].is_leaf() && rho * self.spread.get(i).copied().unwrap_or(0.0) > allowance.at(b[i]) && h.can_split(node, min_area)
+            })
+            .collect()
     }
 
     /// Number of couplings.
@@ -179,29 +203,34 @@ impl Windows {
 
     /// The couplings into the current leaves of `h` (module docs), over
     /// `nodes` dense indices.
-    pub fn couplings(&self, h: &Hierarchy, scene: &SceneRays, nodes: usize) -> Couplings {
+    pub fn couplings(&self, h: &Hierarchy, scene: &SceneRays, b: &[[f64; 3]]) -> Couplings {
+        let nodes = b.len();
         let senders: Vec<u32> = (0..h.triangles.len() as u32).filter(|&t| self.of_triangle[t as usize].is_none()).flat_map(|t| self.senders_below(h, t)).collect();
         let leaves: Vec<u32> = (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf()).collect();
-        let per_leaf: Vec<(u32, Vec<(usize, [f64; 3])>, u64)> = leaves
+        let per_leaf: Vec<(u32, Vec<(usize, [f64; 3])>, f64, u64)> = leaves
             .par_iter()
             .map(|&r| {
-                let mut found = Vec::new();
-                let mut rays = 0;
+                let (mut found, mut spread, mut rays) = (Vec::new(), 0.0, 0);
                 for (w, window) in self.windows.iter().enumerate() {
                     for &s in &senders {
-                        if let Some((weight, cast)) = self.coupling(h, scene, w as u32, window, r, s) {
+                        if let Some((weight, f, cast)) = self.coupling(h, scene, w as u32, window, r, s) {
+                            let sender = h.flat(Node::Element(s));
                             rays += cast;
-                            found.push((h.flat(Node::Element(s)), weight));
+                            // weight / F_mean x (F_max - F_min), per channel.
+                            spread += (0..3).map(|c| weight[c] * b[sender][c] * (f.max - f.min) / f.mean).fold(0.0, f64::max);
+                            found.push((sender, weight));
                         }
                     }
                 }
-                (r, found, rays)
+                (r, found, spread, rays)
             })
             .collect();
         let mut rows: Vec<Vec<(usize, [f64; 3])>> = vec![Vec::new(); nodes];
-        let mut couplings = Couplings::default();
-        for (r, found, rays) in per_leaf {
-            rows[h.flat(Node::Element(r))] = found;
+        let mut couplings = Couplings { spread: vec![0.0; nodes], ..Couplings::default() };
+        for (r, found, spread, rays) in per_leaf {
+            let i = h.flat(Node::Element(r));
+            rows[i] = found;
+            couplings.spread[i] = spread;
             couplings.rays += rays;
         }
         couplings.offsets.push(0);
@@ -232,8 +261,9 @@ impl Windows {
     }
 
     /// The coupling of leaf `r` with sender element `s` through window
-    /// `w`, and the rays it cost; `None` where none.
-    fn coupling(&self, h: &Hierarchy, scene: &SceneRays, w: u32, window: &Window, r: u32, s: u32) -> Option<([f64; 3], u64)> {
+    /// `w`, the unclipped factor it comes from, and the rays it cost;
+    /// `None` where none.
+    fn coupling(&self, h: &Hierarchy, scene: &SceneRays, w: u32, window: &Window, r: u32, s: u32) -> Option<([f64; 3], AreaFactor, u64)> {
         let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
         if self.of_triangle[re.triangle as usize].is_some() {
             return None;
@@ -260,12 +290,12 @@ impl Windows {
         } else {
             return None;
         };
-        let f = triangle_to_polygon(&re.points, nr, &sender, sender_normal, self.depth).mean;
-        if f <= 0.0 || coefficient.iter().fold(0.0f64, |a, &c| a.max(c)) * f < self.min_factor {
+        let f = triangle_to_polygon(&re.points, nr, &sender, sender_normal, self.depth);
+        if f.mean <= 0.0 || coefficient.iter().fold(0.0f64, |a, &c| a.max(c)) * f.mean < self.min_factor {
             return None;
         }
         let (v, cast) = self.through(h, scene, w, r, s, &sender, sender_normal, reflect);
-        (v > 0.0).then(|| (coefficient.map(|c| c * f * v), cast))
+        (v > 0.0).then(|| (coefficient.map(|c| c * f.mean * v), f, cast))
     }
 
     /// Kernel-weighted fraction of stratified pairs `(x on r, y on s)`
