@@ -156,11 +156,11 @@ fn irradiance(p: [f64; 3]) -> f64 {
     EXITANCE * (direct + mirrored)
 }
 
-/// mesh-prep and hierarchical-solve in `dir`.
-fn prepare_and_solve(dir: &Path, scene: &Path) -> Manifest {
+/// mesh-prep and hierarchical-solve with `solve_args` in `dir`.
+fn prepare_and_solve(dir: &Path, scene: &Path, solve_args: &[&str]) -> Manifest {
     let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
     run_ok("mesh-prep", &[s(scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
-    solve_prepared(dir, &["--eps", "1e-4"], None);
+    solve_prepared(dir, solve_args, None);
     read_ron::<Manifest>(&manifest).unwrap().value
 }
 
@@ -178,7 +178,7 @@ fn gather(dir: &Path, mode: &str) -> (HdrImage, String) {
 #[test]
 fn a_camera_looking_into_a_mirror_sees_rho_s_times_the_reflected_floor_per_pixel() {
     let (dir, scene) = mirror_scene("mirror_display", "Kd 0\nKs 0.8\nillum 3\n", MIRROR);
-    let manifest = prepare_and_solve(&dir, &scene);
+    let manifest = prepare_and_solve(&dir, &scene, &["--eps", "1e-4"]);
     let mirror = manifest.materials.iter().find(|m| m.name == "mirror").unwrap();
     assert_eq!((mirror.diffuse, mirror.specular_reflectance, mirror.specular_transmittance), ([0.0; 3], [RHO_S; 3], [0.0; 3]));
     assert!(manifest.effects.specular_reflection && !manifest.effects.specular_transmission);
@@ -321,32 +321,93 @@ fn a_floor_beside_a_mirror_wall_gets_lambert_plus_rho_s_times_the_mirrored_emitt
     eprintln!("floor beside a mirror: {leaves} leaves, largest irradiance error {worst:.4}");
 }
 
+/// The pane scene in `dir`: the floor `[0, 1]^2` at z = 0 (`Kd` RHO), the
+/// emitter `[0.25, 0.75]^2` at z = 1 emitting down, a pane (MTL lines
+/// `pane`) at z = 0.5 between them, facing down, one triangle larger than
+/// both (a quad's diagonal lets one camera sample in 16 through the crack
+/// between its triangles, a ray caster matter outside this test), and a
+/// camera at [`PANE_EYE`] looking straight down through it. Returns the
+/// scene path.
+fn pane_scene(dir: &Path, pane: &str) -> PathBuf {
+    let obj = "mtllib scene.mtl\no floor\nusemtl floor\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n\
+               o pane\nusemtl pane\nv -2 -1 0.5\nv 0.5 4 0.5\nv 3 -1 0.5\nf 5 6 7\n";
+    std::fs::write(dir.join("scene.obj"), obj).unwrap();
+    std::fs::write(dir.join("scene.mtl"), format!("newmtl floor\nKd {RHO}\nnewmtl pane\n{pane}")).unwrap();
+    let [x, y, z] = PANE_EYE;
+    let scene = format!(
+        "Scene(meshes: [Obj(file: \"scene.obj\")], camera: Camera(eye: ({x:?}, {y:?}, {z:?}), target: (0.5, 0.5, 0.0), up: (0.0, 1.0, 0.0), vertical_fov_deg: {PANE_FOV_DEG:?}, width: {SIZE}, height: {SIZE}), lights: [Area(corner: (0.25, 0.25, 1.0), edge_u: (0.0, 0.5, 0.0), edge_v: (0.5, 0.0, 0.0), emission: ({EXITANCE:?}, {EXITANCE:?}, {EXITANCE:?}))])"
+    );
+    std::fs::write(dir.join("scene.ron"), scene).unwrap();
+    dir.join("scene.ron")
+}
+
+/// The pane scene's camera: above the floor's centre, under the emitter,
+/// looking down.
+const PANE_EYE: [f64; 3] = [0.5, 0.5, 0.9];
+/// Its vertical field of view: the floor [0, 1]^2 just fills the image.
+const PANE_FOV_DEG: f64 = 58.0;
+/// The pane scene's emitter, corners in order.
+const LAMP: [[f64; 3]; 4] = [[0.25, 0.25, 1.0], [0.25, 0.75, 1.0], [0.75, 0.75, 1.0], [0.75, 0.25, 1.0]];
+
+/// Irradiance of floor point `p` from the pane scene's emitter, unoccluded.
+fn lambert(p: [f64; 3]) -> f64 {
+    EXITANCE * lambert_polygon(p, [0.0, 0.0, 1.0], &LAMP)
+}
+
+#[test]
+fn a_camera_looking_through_a_pane_sees_tau_s_times_the_floor_behind_it() {
+    let dir = scratch("mirror_pane_display");
+    let tau = 0.6;
+    let scene = pane_scene(&dir, "Kd 0\nTf 0.6\nillum 4\n");
+    // The pane is 9 m², the floor 1 m²: a finer area floor than the
+    // default lets the floor's elements resolve the light through the pane.
+    prepare_and_solve(&dir, &scene, &["--eps", "1e-4", "--min-area", "1e-5"]);
+    // Where the ray through image point (x, y) meets the plane z = at.
+    let half = (0.5 * PANE_FOV_DEG.to_radians()).tan();
+    let at = |x: f64, y: f64, z: f64| {
+        let (sx, sy) = ((2.0 * x / f64::from(SIZE) - 1.0) * half, (1.0 - 2.0 * y / f64::from(SIZE)) * half);
+        let t = PANE_EYE[2] - z;
+        [PANE_EYE[0] + sx * t, PANE_EYE[1] + sy * t, z]
+    };
+    for (mode, tolerance) in [("preview", 0.05), ("full", 0.01)] {
+        let (image, report) = gather(&dir, mode);
+        assert!(report.contains("specular transmission: traced"), "{mode}: {report}");
+        let (mut checked, mut worst) = (0, 0.0f64);
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                // Pixels whose rays reach the floor 0.02 inside its edges.
+                let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(cx, cy)| (f64::from(x) + cx, f64::from(y) + cy));
+                let on_floor = corners.iter().all(|&(cx, cy)| at(cx, cy, 0.0).iter().take(2).all(|&v| (0.02..=0.98).contains(&v)));
+                if !on_floor {
+                    continue;
+                }
+                let expected: f64 = (0..64)
+                    .map(|k| at(f64::from(x) + (f64::from(k % 8) + 0.5) / 8.0, f64::from(y) + (f64::from(k / 8) + 0.5) / 8.0, 0.0))
+                    .map(|p| tau * RHO * tau * lambert(p) / PI / 64.0)
+                    .sum();
+                let got = f64::from(image.rgb[(y * SIZE + x) as usize][0]);
+                let error = (got - expected).abs() / expected;
+                assert!(error < tolerance, "{mode}: pixel ({x}, {y}): radiance {got}, expected {expected} (error {error})");
+                checked += 1;
+                worst = worst.max(error);
+            }
+        }
+        eprintln!("{mode}: {checked} floor pixels through the pane, largest error {worst:.4}");
+        assert!(checked > 500, "{mode}: only {checked} pixels checked");
+    }
+}
+
 #[test]
 fn a_glass_pane_passes_tau_s_of_the_light_and_an_opaque_pane_none() {
-    // Floor [0, 1]^2 at z = 0, the emitter [0.25, 0.75]^2 at z = 1, a pane
-    // larger than both at z = 0.5 between them.
-    let quads = |dir: &Path, pane: &str| {
-        let obj = "mtllib scene.mtl\no floor\nusemtl floor\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n\
-                   o pane\nusemtl pane\nv -1 -1 0.5\nv -1 2 0.5\nv 2 2 0.5\nv 2 -1 0.5\nf 5 6 7 8\n";
-        std::fs::write(dir.join("scene.obj"), obj).unwrap();
-        std::fs::write(dir.join("scene.mtl"), format!("newmtl floor\nKd {RHO}\nnewmtl pane\n{pane}")).unwrap();
-        let scene = format!(
-            "Scene(meshes: [Obj(file: \"scene.obj\")], camera: Camera(eye: (0.5, -2.0, 0.3), target: (0.5, 0.5, 0.2), up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 8, height: 8), lights: [Area(corner: (0.25, 0.25, 1.0), edge_u: (0.0, 0.5, 0.0), edge_v: (0.5, 0.0, 0.0), emission: ({EXITANCE:?}, {EXITANCE:?}, {EXITANCE:?}))])"
-        );
-        std::fs::write(dir.join("scene.ron"), scene).unwrap();
-        dir.join("scene.ron")
-    };
-    let lamp = [[0.25, 0.25, 1.0], [0.25, 0.75, 1.0], [0.75, 0.75, 1.0], [0.75, 0.25, 1.0]];
-    let lambert = |p: [f64; 3]| EXITANCE * lambert_polygon(p, [0.0, 0.0, 1.0], &lamp);
     let tau = 0.6;
     let dir = scratch("mirror_glass");
-    let glass = Solved::new(&dir, &quads(&dir, "Kd 0\nTf 0.6\nillum 4\n"), &["--eps", "1e-4"]);
+    let glass = Solved::new(&dir, &pane_scene(&dir, "Kd 0\nTf 0.6\nillum 4\n"), &["--eps", "1e-4"]);
     let pane = &glass.manifest.materials[1];
     assert_eq!((pane.specular_transmittance, pane.specular_reflectance, pane.diffuse_transmittance), ([tau; 3], [0.0; 3], [0.0; 3]));
     let (leaves, worst) = glass.check("floor", RHO, 0.01, &|p| tau * lambert(p));
     eprintln!("floor under a glass pane: {leaves} leaves, largest error {worst:.4} against tau_s x Lambert");
     let dir = scratch("mirror_opaque_pane");
-    let opaque = Solved::new(&dir, &quads(&dir, "Kd 0\n"), &["--eps", "1e-4"]);
+    let opaque = Solved::new(&dir, &pane_scene(&dir, "Kd 0\n"), &["--eps", "1e-4"]);
     for e in opaque.leaves_of("floor") {
         assert_eq!(e.radiosity, [0.0; 3], "an opaque pane lets light through");
     }

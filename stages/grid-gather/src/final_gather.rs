@@ -107,6 +107,9 @@ pub struct FullScene<'a> {
     /// The mirrors and glass camera rays continue through, in a scene that
     /// has some.
     pub specular: Option<&'a Specular>,
+    /// The light the solver gathered through mirrors and glass, beyond its
+    /// links ([`crate::specular::window_light`]), in a scene that has them.
+    pub window_light: Option<&'a crate::gouraud::Gouraud>,
 }
 
 /// What shades one surface point a camera ray reaches in the full or
@@ -149,9 +152,9 @@ impl Shading<'_> {
         let leaf = self.senders.chain(triangle, uv, links);
         let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
         let mut irradiance = self.irradiance(p, normal, triangle, leaf, links, seen, pass, stream, work);
-        if scene.specular.is_some() {
-            let windows = crate::specular::through_windows(scene.solution, leaf, links, scene.surfaces[triangle as usize]);
-            (0..3).for_each(|c| irradiance[c] += windows[c]);
+        if let Some(windows) = scene.window_light {
+            let light = windows.radiosity(triangle, uv);
+            (0..3).for_each(|c| irradiance[c] += light[c]);
         }
         let (direct, cast) = self.luminaires.at_point(p, normal, triangle);
         work.visibility_rays += cast;

@@ -521,6 +521,10 @@ fn full_gather(
     };
     let transmission = transmission(scene);
     let specular = specular::Specular::new(scene.mesh, scene.manifest, triangles, params.specular_depth, params.specular_min_weight);
+    let window_light = match specular {
+        Some(_) => Some(specular::window_light(scene, triangles, &senders::Senders::new(triangles, scene.solution, extras.clusters, params.seed), &surfaces, smoothing)?),
+        None => None,
+    };
     let full_scene = final_gather::FullScene {
         triangles,
         surfaces: &surfaces,
@@ -533,6 +537,7 @@ fn full_gather(
         transmission: &transmission,
         lights: &lights,
         specular: specular.as_ref(),
+        window_light: window_light.as_ref(),
     };
     let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
     let mut counters = image.counters;

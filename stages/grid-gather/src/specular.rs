@@ -22,8 +22,10 @@ use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::{Hit, SceneRays};
 use crate::full::Surface;
+use crate::gouraud::{Gouraud, Smoothing};
+use crate::senders::Senders;
 use schemas::mesh::{Manifest, Mesh};
-use schemas::solution::Solution;
+use schemas::solution::{Element, Solution};
 
 /// Ideal specular reflectance and transmittance of one triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -151,15 +153,30 @@ impl Specular {
     }
 }
 
-/// The irradiance the solver's radiosity of `leaf` holds beyond what the
-/// links in `links` (those into the leaf, its ancestors and clusters,
-/// [`crate::senders::Senders::chain`]) bring: the light hierarchical-solve
-/// gathered through mirrors and glass by virtual senders, which the
-/// solution's links do not carry. Per channel `max(0, (B - E) / rho - sum
-/// V E_unoccluded)`, 0 where `rho` is 0 (such a leaf reflects none of it).
-/// The full gather adds it, constant over the leaf, to what it gathers from
-/// the links.
-pub fn through_windows(solution: &Solution, leaf: u32, links: &[usize], surface: Surface) -> [f64; 3] {
+/// The irradiance the solver's radiosity of each leaf holds beyond what
+/// the links into it, its ancestors and clusters bring (the light
+/// hierarchical-solve gathered through mirrors and glass by virtual
+/// senders, which the solution's links do not carry), interpolated over
+/// the surfaces like the preview's radiosity ([`Gouraud::of`]). The full
+/// gather adds it to what it gathers from the links.
+pub fn window_light(scene: &crate::Scene, triangles: &[TriangleGeometry], senders: &Senders, surfaces: &[Surface], smoothing: Smoothing) -> schemas::Result<Gouraud> {
+    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
+    let index = |e: &Element| {
+        let mut links = Vec::new();
+        let centroid = [0, 1].map(|k| (0..3).map(|c| e.corners[c][k]).sum::<f32>() as f64 / 3.0);
+        let leaf = senders.chain(e.triangle, centroid, &mut links);
+        (leaf, links)
+    };
+    Gouraud::of(triangles, &materials, scene.solution, scene.solution_path, smoothing, &|_, e| {
+        let (leaf, links) = index(e);
+        through_windows(scene.solution, leaf, &links, surfaces[e.triangle as usize])
+    })
+}
+
+/// What [`window_light`] holds for `leaf`: per channel `max(0, (B - E) /
+/// rho - sum V E_unoccluded)` over `links` (its chain's), 0 where `rho` is
+/// 0 (such a leaf reflects none of it).
+fn through_windows(solution: &Solution, leaf: u32, links: &[usize], surface: Surface) -> [f64; 3] {
     let b = solution.elements[leaf as usize].radiosity;
     let from_links = |c: usize| links.iter().map(|&l| f64::from(solution.links[l].visibility) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
     std::array::from_fn(|c| {
