@@ -400,8 +400,10 @@ impl Gpu {
             })
         };
 
+        // The masked fragment stage reads the samples and the corners too.
         let v = wgpu::ShaderStages::VERTEX;
-        let mut render_entries = vec![uniform(0, v), storage(1, v, true), storage(2, v, true)];
+        let vf = if setup.masks.is_some() { v | wgpu::ShaderStages::FRAGMENT } else { v };
+        let mut render_entries = vec![uniform(0, vf), storage(1, vf, true), storage(2, vf, true)];
         let mut render_bind = vec![
             wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: samples.as_entire_binding() },

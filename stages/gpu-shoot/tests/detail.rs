@@ -9,7 +9,7 @@
 
 use glam::DVec3;
 use gpu_shoot::testing::{device, manifest, material, triangles};
-use gpu_shoot::{output, solve, Params, Solved};
+use gpu_shoot::{output, solve, Params, Solved, Visibility};
 use radiometry::form_factor::point_to_polygon;
 use schemas::header::{Provenance, Schema};
 use schemas::lightmap::Lightmap;
@@ -221,7 +221,7 @@ fn an_emitter_masked_in_stripes_shoots_from_its_opaque_half() {
 /// with a black occluder at height 1/2 that leaves the hole `[0.375,
 /// 0.625]^2` open: the square `[0, 1]^2` with an alpha mask (`masked`), or
 /// the four rectangles around the hole.
-fn occluder_with_a_hole(masked: bool) -> Option<Solved> {
+fn occluder_with_a_hole(masked: bool, visibility: Visibility) -> Option<Solved> {
     let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
     let (a, b) = (0.375, 0.625);
     if masked {
@@ -237,7 +237,7 @@ fn occluder_with_a_hole(masked: bool) -> Option<Solved> {
     let m = manifest(3, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [E; 3]), material([0.0; 3], [0.0; 3])]);
     let hole = |c: usize| (3..5).contains(&c);
     let s = surface(uvs(&mesh, 2..4, 0.0, 1.0, 0.0, 1.0), Vec::new(), vec![[NONE; 3], [NONE; 3], [NONE, 0, NONE]], vec![mask(8, 8, |x, y| !(hole(x) && hole(y)))]);
-    let solved = run(&mesh, &m, masked.then_some(&s), &params(32))?;
+    let solved = run(&mesh, &m, masked.then_some(&s), &Params { visibility, ..params(32) })?;
     let shooters = [format!("triangle {emitter}"), format!("triangle {}", emitter + 1)];
     assert!(solved.shots.iter().all(|s| shooters.contains(&s.shooter)), "{:?}", solved.shots);
     Some(solved)
@@ -251,10 +251,14 @@ fn occluder_with_a_hole(masked: bool) -> Option<Solved> {
 /// the emitter) within 8% of the brightest texel's, the floor's power
 /// within 5% (the visibility test's neighbour pixels widen the lit patch
 /// by about a pixel at the shadow's edges, with geometry as with the mask;
-/// measured 6.1% and 3.6%).
+/// measured 6.1% and 3.6%). With the stereographic map, whose affine
+/// placement of these large triangles misplaces the shadow (004 Fig. 4.4),
+/// the masked occluder is no farther from Lambert than the geometry
+/// (measured 13.9% and 20.6% of the peak).
 #[test]
 fn an_occluder_masked_with_a_hole_casts_the_shadow_of_its_geometry() {
-    let (Some(masked), Some(geometry)) = (occluder_with_a_hole(true), occluder_with_a_hole(false)) else { return };
+    for visibility in [Visibility::Hemicube, Visibility::Stereographic] {
+    let (Some(masked), Some(geometry)) = (occluder_with_a_hole(true, visibility), occluder_with_a_hole(false, visibility)) else { return };
     let exact = |p: DVec3| {
         let cut = |c: f64| ((0.75 - c).max(0.25), (1.25 - c).min(0.75));
         let ((x0, x1), (z0, z1)) = (cut(p.x), cut(p.z));
@@ -265,20 +269,28 @@ fn an_occluder_masked_with_a_hole_casts_the_shadow_of_its_geometry() {
     };
     let texels: Vec<(usize, DVec3)> = floor_texels(&masked).collect();
     let peak = texels.iter().map(|&(_, p)| exact(p)).fold(0.0, f64::max);
-    let (mut worst, mut same, mut power, mut reference) = (0.0f64, 0.0f64, 0.0, 0.0);
+    let (mut worst, mut same, mut power, mut reference, mut geometric) = (0.0f64, 0.0f64, 0.0, 0.0, 0.0f64);
     for &(k, p) in &texels {
         let (b, x) = (masked.radiosity[k][0] as f64, exact(p));
         worst = worst.max((b - x).abs() / peak);
+        geometric = geometric.max((geometry.radiosity[k][0] as f64 - x).abs() / peak);
         same = same.max((b - geometry.radiosity[k][0] as f64).abs() / peak);
         let area = masked.atlas.texels[k].area as f64;
         power += b * area;
         reference += x * area;
     }
     let power_error = (power / reference - 1.0).abs();
-    eprintln!("occluder with a hole: masked vs geometry {same:.4} of the peak; vs Lambert worst texel {worst:.4} of the peak, floor power {power_error:.4}");
+    eprintln!("occluder with a hole ({visibility:?}): masked vs geometry {same:.4} of the peak; vs Lambert worst texel {worst:.4} of the peak (geometry {geometric:.4}), floor power {power_error:.4}");
+    if visibility == Visibility::Stereographic {
+        // Large triangles: the map's affine placement misplaces geometry
+        // and receivers alike; the mask is no worse than the geometry.
+        assert!(worst <= geometric, "stereographic: masked {worst} vs geometry {geometric} of the peak");
+        continue;
+    }
     assert!(same < 5e-3, "masked occluder vs its geometry: {same} of the peak");
     assert!(peak > 0.0 && worst < 0.08, "floor through the hole vs Lambert: {worst} of the peak");
     assert!(power_error < 0.05, "floor power through the hole: {power_error}");
+    }
 }
 
 /// A flat floor whose normal map tilts every normal by 30 degrees towards

@@ -19,6 +19,7 @@ struct VertexOut {
     @location(0) local: vec3<f32>,
     @location(1) bary: vec2<f32>,
     @location(2) @interpolate(flat) triangle: u32,
+    @location(3) @interpolate(flat) sample: u32,
 };
 
 @vertex
@@ -32,6 +33,7 @@ fn vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) layer: u32) -> Ve
     let corner = vi % 3u;
     out.bary = vec2<f32>(f32(corner == 1u), f32(corner == 2u));
     out.triangle = vi / 3u;
+    out.sample = params.sample_first + layer / params.layers_per_sample;
     if (params.mode == 1u && s.power.w == 0.0) {
         let d = length(local);
         out.clip = vec4<f32>(stereographic(local / max(d, 1e-20)), d / params.far, 1.0);
@@ -87,11 +89,39 @@ fn opaque(t: u32, bary: vec2<f32>) -> bool {
     return masks[at + 7u + y * u32(size.x) + x] > 0.0;
 }
 
+// The barycentrics of the point a fragment shows. Cube faces interpolate
+// them perspective-correctly; the stereographic map interpolates affinely
+// between projected corners, which misplaces a large triangle's interior
+// (004 Fig. 4.4; a masked hole moved by 40% of its light), so there the
+// pixel's ray (the inverse projection of its centre) meets the triangle's
+// plane.
+fn fragment_bary(in: VertexOut) -> vec2<f32> {
+    let s = samples[in.sample];
+    if (params.mode != 1u || s.power.w != 0.0) { return in.bary; }
+    let res = f32(params.res);
+    let m = vec2<f32>(in.clip.x / res * 2.0 - 1.0, 1.0 - in.clip.y / res * 2.0);
+    let q = dot(m, m);
+    let w = vec3<f32>(2.0 * m.x, 2.0 * m.y, 1.0 - q) / (1.0 + q);
+    let dir = w.x * s.t.xyz + w.y * s.b.xyz + w.z * s.n.xyz;
+    let p0 = vertices[3u * in.triangle].xyz;
+    let e1 = vertices[3u * in.triangle + 1u].xyz - p0;
+    let e2 = vertices[3u * in.triangle + 2u].xyz - p0;
+    let normal = cross(e1, e2);
+    let denom = dot(normal, dir);
+    if (denom == 0.0) { return in.bary; }
+    let x = s.position.xyz + dir * (dot(normal, p0 - s.position.xyz) / denom) - p0;
+    let d11 = dot(e1, e1);
+    let d12 = dot(e1, e2);
+    let d22 = dot(e2, e2);
+    let det = d11 * d22 - d12 * d12;
+    return vec2<f32>(d22 * dot(x, e1) - d12 * dot(x, e2), d11 * dot(x, e2) - d12 * dot(x, e1)) / det;
+}
+
 // The visibility maps of a scene with alpha masks: texels with alpha 0 do
 // not exist, so their fragments are discarded and light passes (004 Sec.
 // 4.3.4).
 @fragment
 fn fs_masked(in: VertexOut) -> @location(0) vec4<f32> {
-    if (!opaque(in.triangle, in.bary)) { discard; }
+    if (!opaque(in.triangle, fragment_bary(in))) { discard; }
     return distance_of(in);
 }
