@@ -76,6 +76,10 @@ pub struct VertexRecord {
     pub factors: u32,
 }
 
+/// One image row of the full gather: per pixel radiance, coverage, work
+/// and surface; the row's hits and specular rays.
+type Row = (Vec<([f32; 3], f32, Work, [u32; 3])>, u64, Followed);
+
 /// Everything the full gather reads.
 pub struct FullScene<'a> {
     /// Triangle geometry.
@@ -228,7 +232,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let spp = params.spp;
     let luminaires = DirectLight { lights: scene.lights, rays: &rays };
     let shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires };
-    let rows: Vec<(Vec<([f32; 3], f32, Work, [u32; 3])>, u64, Followed)> = (0..height)
+    let rows: Vec<Row> = (0..height)
         .into_par_iter()
         .map(|y| {
             let (mut links, mut back_links) = (Vec::new(), Vec::new());

@@ -77,6 +77,10 @@ pub struct Film {
     pub specular: Followed,
 }
 
+/// One image row: per pixel radiance, coverage and surface; the row's
+/// hits, back-face hits and specular rays.
+type Row = (Vec<([f32; 3], f32, [u32; 3])>, u64, u64, Followed);
+
 /// The `k`-th of `n` sample positions in the unit pixel: the first `m²`
 /// samples (`m = floor(sqrt n)`) are jittered in an `m x m` grid of
 /// strata, row by row; the remaining `n - m²` are uniform over the pixel.
@@ -100,7 +104,7 @@ pub fn pixel_offset(k: u32, n: u32, stream: &mut Stream) -> (f64, f64) {
 /// is black with no coverage. `rows_done` is called with 1 after each row.
 pub fn render(view: &View, sampling: Sampling, rows_done: &(dyn Fn(u64) + Sync)) -> Film {
     let Sampling { width, height, spp, seed } = sampling;
-    let rows: Vec<(Vec<([f32; 3], f32, [u32; 3])>, u64, u64, Followed)> = (0..height)
+    let rows: Vec<Row> = (0..height)
         .into_par_iter()
         .map(|y| {
             let (mut hits, mut back, mut followed) = (0, 0, Followed::default());

@@ -53,6 +53,10 @@ use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Node;
 
+/// A leaf's couplings as built: the leaf, `(sender, weight)` pairs, their
+/// spread and the rays cast.
+type LeafCouplings = (u32, Vec<(usize, [f64; 3])>, f64, u64);
+
 /// One window: the specular triangles of one material in one plane.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Window {
@@ -207,7 +211,7 @@ impl Windows {
         let nodes = b.len();
         let senders: Vec<u32> = (0..h.triangles.len() as u32).filter(|&t| self.of_triangle[t as usize].is_none()).flat_map(|t| self.senders_below(h, t)).collect();
         let leaves: Vec<u32> = (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf()).collect();
-        let per_leaf: Vec<(u32, Vec<(usize, [f64; 3])>, f64, u64)> = leaves
+        let per_leaf: Vec<LeafCouplings> = leaves
             .par_iter()
             .map(|&r| {
                 let (mut found, mut spread, mut rays) = (Vec::new(), 0.0, 0);
