@@ -155,7 +155,7 @@ fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
         (effects.alpha_masks && without, "alpha masks: surfaces are treated as opaque (no --surface given)"),
         (effects.normal_maps && without, "normal maps: texels use the geometric normal (no --surface given)"),
         (effects.textures && without, "textures: radiosity uses each material's diffuse reflectance (no --surface given)"),
-        (effects.fine_clustered_geometry, "adaptive subdivision: not done; region sizes are fixed per object"),
+        (effects.fine_clustered_geometry, "fine geometry: gpu-shoot does not cluster; every triangle keeps its own region (--adaptive splits receivers only at shadow boundaries)"),
     ])
 }
 
