@@ -347,6 +347,23 @@ fn a_closed_box_with_textured_walls_balances_with_the_textures_reflectance() {
     assert!(error < 0.01, "{sum} vs {expected}");
 }
 
+/// A floor an alpha mask removes whole does not exist even with ambient
+/// overshooting (its area is 0: no overshoot, no NaN): it receives
+/// nothing, every value stays finite, and the solve converges.
+#[test]
+fn a_wholly_masked_floor_takes_no_part() {
+    let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
+    list.extend(square(0.25, 0.75, 0.25, 0.75, 0.5, false, 1, 1));
+    let mesh = triangles(&list);
+    let m = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.5; 3], [E; 3])]);
+    let s = surface(uvs(&mesh, 0..2, 0.0, 1.0, 0.0, 1.0), Vec::new(), vec![[NONE, 0, NONE], [NONE; 3]], vec![mask(2, 2, |_, _| false)]);
+    let params = Params { texels: 2000.0, convergence_target: 0.999, overshoot: true, ..Params::default() };
+    let Some(solved) = run(&mesh, &m, Some(&s), &params) else { return };
+    assert!(solved.radiosity.iter().chain(&solved.residual).flatten().all(|v| v.is_finite()));
+    assert!(floor_texels(&solved).all(|(k, _)| solved.radiosity[k] == [0.0; 3] && solved.atlas.texels[k].area == 0.0));
+    assert!(solved.shots.last().is_none_or(|s| s.unshot_fraction <= 1e-3), "{:?}", solved.shots.last());
+}
+
 /// Without surface detail nothing changes: a surface artifact whose
 /// materials have no texture gives the same bits as none, and allocates
 /// no texture atlas (item 8).

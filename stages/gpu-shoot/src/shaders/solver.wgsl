@@ -99,8 +99,9 @@ fn reduce(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
 }
 
 fn overshoot_of(t: u32, total: vec3<f32>, ambient: vec3<f32>) -> vec3<f32> {
-    if (params.overshoot == 0u) { return vec3<f32>(0.0); }
     let tri = tris[t];
+    // A triangle an alpha mask removes whole has no area to overshoot.
+    if (params.overshoot == 0u || tri.area <= 0.0) { return vec3<f32>(0.0); }
     let own = tri_power[2u * t].xyz;
     // 004 Eq. 4.9: dB'_i = min(rho_i ambient, sum_j dB_j A_j / A_i - dB_i),
     // never negative (a negative ambient would not converge).
