@@ -37,6 +37,15 @@ fn polygon(x0: f64, x1: f64, z0: f64, z1: f64, y: f64) -> Vec<DVec3> {
     vec![DVec3::new(x0, y, z0), DVec3::new(x1, y, z0), DVec3::new(x1, y, z1), DVec3::new(x0, y, z1)]
 }
 
+/// A grey floor `[0, 1]^2` (rho 1/2, material 0, triangles 0 and 1)
+/// under a black lamp `[0.25, 0.75]^2` at height `h` (material 1,
+/// emitting `E`, triangles 2 and 3).
+fn floor_and_lamp(h: f64) -> (Mesh, Manifest) {
+    let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
+    list.extend(square(0.25, 0.75, 0.25, 0.75, h, false, 1, 1));
+    (triangles(&list), manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [E; 3])]))
+}
+
 /// Texture coordinates `((x - x0) / (x1 - x0), (z - z0) / (z1 - z0))` for
 /// the triangles `range` of `mesh`.
 fn uvs(mesh: &Mesh, range: std::ops::Range<usize>, x0: f64, x1: f64, z0: f64, z1: f64) -> Vec<(u32, [[f32; 2]; 3])> {
@@ -94,10 +103,7 @@ fn checker(x: f64, z: f64) -> [f64; 3] {
 #[test]
 fn checkerboard_floor_takes_each_texels_reflectance() {
     let h = 0.5;
-    let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
-    list.extend(square(0.25, 0.75, 0.25, 0.75, h, false, 1, 1));
-    let mesh = triangles(&list);
-    let m = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [E; 3])]);
+    let (mesh, m) = floor_and_lamp(h);
     // 64 x 64 texels, clamped, so the bilinear reflectance is the check's
     // but within half a texture texel (1/128) of a check's edge; row 0 is
     // the top (z near 1).
@@ -178,10 +184,7 @@ fn mask(width: usize, height: usize, opaque: impl Fn(usize, usize) -> bool) -> T
 /// at height `h`, with or without an alpha mask of 8 stripes along x
 /// that removes every second one.
 fn striped_emitter(h: f64, masked: bool) -> Option<(Solved, Mesh)> {
-    let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
-    list.extend(square(0.25, 0.75, 0.25, 0.75, h, false, 1, 1));
-    let mesh = triangles(&list);
-    let m = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [E; 3])]);
+    let (mesh, m) = floor_and_lamp(h);
     let s = surface(uvs(&mesh, 2..4, 0.25, 0.75, 0.25, 0.75), Vec::new(), vec![[NONE; 3], [NONE, 0, NONE]], vec![mask(8, 1, |x, _| x % 2 == 0)]);
     let solved = run(&mesh, &m, masked.then_some(&s), &params(32))?;
     Some((solved, mesh))
@@ -301,10 +304,7 @@ fn an_occluder_masked_with_a_hole_casts_the_shadow_of_its_geometry() {
 #[test]
 fn a_normal_map_tilts_the_receivers_cosine() {
     let (h, angle) = (0.5, 30f64.to_radians());
-    let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
-    list.extend(square(0.25, 0.75, 0.25, 0.75, h, false, 1, 1));
-    let mesh = triangles(&list);
-    let m = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [E; 3])]);
+    let (mesh, m) = floor_and_lamp(h);
     let texel = [((angle.sin() + 1.0) / 2.0) as f32, 0.5, ((angle.cos() + 1.0) / 2.0) as f32, 1.0];
     let tangents = vec![(0, [1.0, 0.0, 0.0, 1.0]), (1, [1.0, 0.0, 0.0, 1.0])];
     let s = surface(uvs(&mesh, 0..2, 0.0, 1.0, 0.0, 1.0), tangents, vec![[NONE, NONE, 0], [NONE; 3]], vec![texture(TextureKind::Normal, 1, 1, vec![texel])]);
@@ -352,10 +352,7 @@ fn a_closed_box_with_textured_walls_balances_with_the_textures_reflectance() {
 /// nothing, every value stays finite, and the solve converges.
 #[test]
 fn a_wholly_masked_floor_takes_no_part() {
-    let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
-    list.extend(square(0.25, 0.75, 0.25, 0.75, 0.5, false, 1, 1));
-    let mesh = triangles(&list);
-    let m = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.5; 3], [E; 3])]);
+    let (mesh, m) = floor_and_lamp(0.5);
     let s = surface(uvs(&mesh, 0..2, 0.0, 1.0, 0.0, 1.0), Vec::new(), vec![[NONE, 0, NONE], [NONE; 3]], vec![mask(2, 2, |_, _| false)]);
     let params = Params { texels: 2000.0, convergence_target: 0.999, overshoot: true, ..Params::default() };
     let Some(solved) = run(&mesh, &m, Some(&s), &params) else { return };
@@ -369,10 +366,7 @@ fn a_wholly_masked_floor_takes_no_part() {
 /// no texture atlas (item 8).
 #[test]
 fn a_surface_without_textures_changes_no_bit() {
-    let mut list = square(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0);
-    list.extend(square(0.25, 0.75, 0.25, 0.75, 0.5, false, 1, 1));
-    let mesh = triangles(&list);
-    let m = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [E; 3])]);
+    let (mesh, m) = floor_and_lamp(0.5);
     let s = surface(uvs(&mesh, 0..4, 0.0, 1.0, 0.0, 1.0), Vec::new(), vec![[NONE; 3]; 2], Vec::new());
     let params = Params { texels: 3000.0, convergence_target: 0.999, ..Params::default() };
     let (Some(plain), Some(with)) = (run(&mesh, &m, None, &params), run(&mesh, &m, Some(&s), &params)) else { return };
