@@ -30,6 +30,7 @@
 //! | `max_passes` | refine-and-solve passes, at most | 8 |
 //! | `seed` | seed of the visibility rays | 1 |
 //! | `specular_rays` | rays per coupling through a mirror or pane ([`mirrors`]) | 16 |
+//! | `specular_depth` | most mirrors and panes along a path of light (virtual senders of virtual senders) | 2 |
 //! | `specular_sender_level` | levels below each input triangle the senders through mirrors and panes are taken at (their leaves where coarser) | 2 |
 //! | `specular_min_factor` | couplings through a mirror or pane whose `rho_s F` or `tau_s F` is under this are dropped | 1e-6 |
 //!
@@ -134,6 +135,8 @@ pub struct Params {
     /// Levels below each input triangle the senders through mirrors and
     /// panes are taken at ([`mirrors`]).
     pub specular_sender_level: u32,
+    /// Most mirrors and panes along a path of light ([`mirrors`]).
+    pub specular_depth: u32,
 }
 
 impl Default for Params {
@@ -156,6 +159,7 @@ impl Default for Params {
             specular_rays: 16,
             specular_min_factor: 1e-6,
             specular_sender_level: 2,
+            specular_depth: 2,
         }
     }
 }
@@ -202,6 +206,9 @@ impl Params {
         }
         if self.specular_rays == 0 || self.specular_rays > 4096 {
             return Some(format!("specular_rays must be in 1..=4096, not {}", self.specular_rays));
+        }
+        if self.specular_depth > 16 {
+            return Some(format!("specular_depth must be at most 16, not {}", self.specular_depth));
         }
         if self.specular_sender_level > 8 {
             return Some(format!("specular_sender_level must be at most 8, not {}", self.specular_sender_level));
@@ -353,7 +360,15 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         scene = scene.with_alpha_masks(masks);
     }
     let mut work = Work::default();
-    let windows = mirrors::Windows::new(mesh, manifest, &h, (params.specular_rays, params.specular_min_factor, params.quadrature_depth, params.seed, params.specular_sender_level));
+    let knobs = mirrors::Knobs {
+        rays: params.specular_rays,
+        min_factor: params.specular_min_factor,
+        quadrature: params.quadrature_depth,
+        seed: params.seed,
+        sender_level: params.specular_sender_level,
+        max_events: params.specular_depth,
+    };
+    let windows = mirrors::Windows::new(mesh, manifest, &h, knobs);
     // Luminaires first (crate::luminaires): their direct light on the input
     // triangles, which joins the emission in the scale of the threshold,
     // then the elements refined for it.

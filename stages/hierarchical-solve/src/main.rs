@@ -98,6 +98,9 @@ struct Args {
     /// Levels below each input triangle the senders through mirrors and panes are taken at [default: 2].
     #[arg(long)]
     specular_sender_level: Option<u32>,
+    /// Most mirrors and panes along a path of light [default: 2].
+    #[arg(long)]
+    specular_depth: Option<u32>,
 }
 
 fn params_of(args: &Args) -> schemas::Result<Params> {
@@ -119,6 +122,7 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
     p.specular_rays = args.specular_rays.unwrap_or(p.specular_rays);
     p.specular_min_factor = args.specular_min_factor.unwrap_or(p.specular_min_factor);
     p.specular_sender_level = args.specular_sender_level.unwrap_or(p.specular_sender_level);
+    p.specular_depth = args.specular_depth.unwrap_or(p.specular_depth);
     match p.problem() {
         Some(problem) => Err(bad_parameter(problem)),
         None => Ok(p),
@@ -133,7 +137,7 @@ fn skipped(effects: &Effects, surface: bool, one_sided: usize) -> Vec<String> {
     let transmits = format!("diffuse transmission: {one_sided} triangles of translucent materials that are not two-sided transmit nothing (their back face has no elements; make the material two_sided)");
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
-        (effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, one reflection per path (light meeting a second mirror or pane stops there), senders at their elements' mean radiosity --specular-sender-level levels down; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
+        (effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, up to --specular-depth mirrors and panes per path (light meeting one more stops there), senders at their elements' mean radiosity --specular-sender-level levels down; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
         (effects.specular_transmission, "specular transmission: thin panes by transmitted senders, one pane per path; no refraction bending by thick glass"),
         (effects.diffuse_transmission && one_sided > 0, &transmits),
         (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),

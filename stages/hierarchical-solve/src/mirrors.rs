@@ -32,10 +32,17 @@
 //! below each input triangle (its leaves where it is coarser), each at its
 //! area-mean radiosity: exact for a uniform emitter, an approximation for
 //! a sender whose radiosity varies across it (in a closed box with a mirror
-//! wall, level 0 loses 0.96% of the energy, level 2 0.07%). One specular event per path (depth
-//! 1): light that meets a second mirror or pane on its way is stopped
-//! there. Couplings whose `coefficient x F` (largest channel) falls under
-//! `specular_min_factor` are dropped (the energy bound). Goniometric point
+//! wall, level 0 loses 0.96% of the energy, level 2 0.07%).
+//!
+//! Chains: an image is itself a sender for the next window (the image of
+//! an image, paper 004's reflection tree), up to `specular_depth` windows
+//! per path, each step chosen by the sides of the previous image and the
+//! receiver as above, the coefficients multiplied; `V'` follows the pair's
+//! ray back through every window in turn (each must be met first, inside
+//! it) to the sender. Light that meets one window more than the depth
+//! allows is stopped there. Couplings whose coefficients times `F`
+//! (largest channel) fall under `specular_min_factor` are dropped, and
+//! their chains not followed further (the energy bound). Goniometric point
 //! lights are not mirrored. The couplings are rebuilt on the leaves of
 //! every pass and join the gather ([`crate::gather::solve`]) as extra terms
 //! of the receiving leaves' irradiance. The links' refinement oracle does
@@ -44,8 +51,8 @@
 //! is split before the next pass ([`Couplings::to_split`]).
 
 use crate::elements::Hierarchy;
-use glam::DVec3;
 use crate::links::Allowance;
+use glam::DVec3;
 use radiometry::form_factor::{point_kernel, triangle_to_polygon, AreaFactor};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
@@ -73,6 +80,23 @@ pub struct Window {
     pub two_sided: bool,
 }
 
+/// The knobs of the couplings (the solver's `specular_*` parameters).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Knobs {
+    /// Rays per coupling.
+    pub rays: usize,
+    /// Smallest `coefficients x F` kept.
+    pub min_factor: f64,
+    /// Quadrature depth of the form factors.
+    pub quadrature: u32,
+    /// Seed of the rays.
+    pub seed: u64,
+    /// Levels below each input triangle its senders are taken at.
+    pub sender_level: u32,
+    /// Most windows along a path.
+    pub max_events: u32,
+}
+
 /// The scene's windows and which triangle belongs to which.
 pub struct Windows {
     /// The windows.
@@ -84,7 +108,9 @@ pub struct Windows {
     /// Smallest `coefficient x F` kept.
     min_factor: f64,
     /// Quadrature depth of the form factors.
-    depth: u32,
+    quadrature: u32,
+    /// Most windows along a path (mirror reflections and pane passages).
+    max_events: u32,
     /// Seed of the rays.
     seed: u64,
     /// Levels below each input triangle its senders are taken at.
@@ -155,6 +181,66 @@ impl Couplings {
     }
 }
 
+/// A sender as seen through a chain of windows.
+#[derive(Clone, Debug)]
+struct Image {
+    /// The sender's corners, then its image after each window.
+    corners: Vec<[DVec3; 3]>,
+    /// Front normal of the last image.
+    normal: DVec3,
+    /// The windows, sender side first.
+    path: Vec<u32>,
+    /// Product of the specular coefficients along the path.
+    coefficient: [f64; 3],
+}
+
+impl Image {
+    /// The image after window `w` for a receiver with corners `receiver`:
+    /// mirrored where it and the receiver lie in front of the window and
+    /// the window reflects, the same where they lie on either side and it
+    /// transmits (a two-sided pane from its front only); `None` otherwise.
+    fn through(&self, w: u32, window: &Window, receiver: &[DVec3; 3]) -> Option<Image> {
+        let last = self.corners[self.corners.len() - 1];
+        let side = |p: &[DVec3; 3]| {
+            let d = p.map(|q| (q - window.origin).dot(window.normal));
+            if d.iter().all(|&x| x >= 0.0) {
+                1
+            } else if d.iter().all(|&x| x <= 0.0) {
+                -1
+            } else {
+                0
+            }
+        };
+        let (r_side, s_side) = (side(receiver), side(&last));
+        let any = |c: [f64; 3]| c.iter().any(|&x| x > 0.0);
+        let (coefficient, corners, normal) = if r_side > 0 && s_side > 0 && any(window.reflectance) {
+            (window.reflectance, last.map(|p| mirror_point(p, window.origin, window.normal)), mirror_direction(self.normal, window.normal))
+        } else if r_side * s_side < 0 && (r_side > 0 || !window.two_sided) && any(window.transmittance) {
+            (window.transmittance, last, self.normal)
+        } else {
+            return None;
+        };
+        let mut next = self.clone();
+        next.corners.push(corners);
+        next.normal = normal;
+        next.path.push(w);
+        next.coefficient = std::array::from_fn(|c| self.coefficient[c] * coefficient[c]);
+        Some(next)
+    }
+}
+
+/// Barycentric weights of point `p` (in the plane of `t`) in triangle `t`.
+fn barycentric(p: DVec3, t: &[DVec3; 3]) -> [f64; 3] {
+    let (e1, e2, d) = (t[1] - t[0], t[2] - t[0], p - t[0]);
+    let (d11, d12, d22, d1, d2) = (e1.dot(e1), e1.dot(e2), e2.dot(e2), d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    if det <= 0.0 {
+        return [1.0 / 3.0; 3];
+    }
+    let (b1, b2) = ((d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det);
+    [1.0 - b1 - b2, b1, b2]
+}
+
 /// `p` mirrored in the plane through `origin` with unit normal `n`.
 pub fn mirror_point(p: DVec3, origin: DVec3, n: DVec3) -> DVec3 {
     p - 2.0 * (p - origin).dot(n) * n
@@ -169,7 +255,7 @@ impl Windows {
     /// The windows of `mesh`, or `None` when the scene has no specular
     /// reflection or transmission. `rays` per coupling, couplings under
     /// `min_factor` dropped, form factors to quadrature depth `depth`.
-    pub fn new(mesh: &Mesh, manifest: &Manifest, h: &Hierarchy, (rays, min_factor, depth, seed, sender_level): (usize, f64, u32, u64, u32)) -> Option<Windows> {
+    pub fn new(mesh: &Mesh, manifest: &Manifest, h: &Hierarchy, knobs: Knobs) -> Option<Windows> {
         let e = &manifest.effects;
         if !(e.specular_reflection || e.specular_transmission) {
             return None;
@@ -202,29 +288,29 @@ impl Windows {
             };
             of_triangle[t] = Some(index as u32);
         }
-        Some(Windows { windows: windows.into_iter().map(|(_, w)| w).collect(), of_triangle, rays, min_factor, depth, seed, sender_level })
+        let Knobs { rays, min_factor, quadrature, seed, sender_level, max_events } = knobs;
+        Some(Windows { windows: windows.into_iter().map(|(_, w)| w).collect(), of_triangle, rays, min_factor, quadrature, max_events, seed, sender_level })
     }
 
-    /// The couplings into the current leaves of `h` (module docs), over
-    /// `nodes` dense indices.
+    /// The couplings into the current leaves of `h` (module docs), with
+    /// the spread of their light from radiosity `b` (one entry per dense
+    /// node index).
     pub fn couplings(&self, h: &Hierarchy, scene: &SceneRays, b: &[[f64; 3]]) -> Couplings {
         let nodes = b.len();
         let senders: Vec<u32> = (0..h.triangles.len() as u32).filter(|&t| self.of_triangle[t as usize].is_none()).flat_map(|t| self.senders_below(h, t)).collect();
-        let leaves: Vec<u32> = (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf()).collect();
+        let leaves: Vec<u32> =
+            (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf() && self.of_triangle[h.elements[e as usize].triangle as usize].is_none()).collect();
         let per_leaf: Vec<LeafCouplings> = leaves
             .par_iter()
             .map(|&r| {
                 let (mut found, mut spread, mut rays) = (Vec::new(), 0.0, 0);
-                for (w, window) in self.windows.iter().enumerate() {
-                    for &s in &senders {
-                        if let Some((weight, f, cast)) = self.coupling(h, scene, w as u32, window, r, s) {
-                            let sender = h.flat(Node::Element(s));
-                            rays += cast;
-                            // weight / F_mean x (F_max - F_min), per channel.
-                            spread += (0..3).map(|c| weight[c] * b[sender][c] * (f.max - f.min) / f.mean).fold(0.0, f64::max);
-                            found.push((sender, weight));
-                        }
-                    }
+                for &s in &senders {
+                    let sender = h.flat(Node::Element(s));
+                    rays += self.images(h, scene, r, s, &mut |weight, f| {
+                        // weight / F_mean x (F_max - F_min), per channel.
+                        spread += (0..3).map(|c| weight[c] * b[sender][c] * (f.max - f.min) / f.mean).fold(0.0, f64::max);
+                        found.push((sender, weight));
+                    });
                 }
                 (r, found, spread, rays)
             })
@@ -264,80 +350,83 @@ impl Windows {
         found
     }
 
-    /// The coupling of leaf `r` with sender element `s` through window
-    /// `w`, the unclipped factor it comes from, and the rays it cost;
-    /// `None` where none.
-    fn coupling(&self, h: &Hierarchy, scene: &SceneRays, w: u32, window: &Window, r: u32, s: u32) -> Option<([f64; 3], AreaFactor, u64)> {
-        let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
-        if self.of_triangle[re.triangle as usize].is_some() {
-            return None;
-        }
-        let side = |p: &[DVec3; 3]| {
-            let d: Vec<f64> = p.iter().map(|&q| (q - window.origin).dot(window.normal)).collect();
-            if d.iter().all(|&x| x >= 0.0) {
-                1
-            } else if d.iter().all(|&x| x <= 0.0) {
-                -1
-            } else {
-                0
-            }
-        };
-        let (r_side, s_side) = (side(&re.points), side(&se.points));
-        let (nr, ns) = (h.normal(r), h.normal(s));
-        let reflect = r_side > 0 && s_side > 0 && window.reflectance.iter().any(|&x| x > 0.0);
-        let transmit = r_side * s_side < 0 && (r_side > 0 || !window.two_sided) && window.transmittance.iter().any(|&x| x > 0.0);
-        let (coefficient, sender, sender_normal) = if reflect {
-            let m = se.points.map(|p| mirror_point(p, window.origin, window.normal));
-            (window.reflectance, [m[0], m[2], m[1]], mirror_direction(ns, window.normal))
-        } else if transmit {
-            (window.transmittance, se.points, ns)
-        } else {
-            return None;
-        };
-        let f = triangle_to_polygon(&re.points, nr, &sender, sender_normal, self.depth);
-        if f.mean <= 0.0 || coefficient.iter().fold(0.0f64, |a, &c| a.max(c)) * f.mean < self.min_factor {
-            return None;
-        }
-        let (v, cast) = self.through(h, scene, w, r, s, &sender, sender_normal, reflect);
-        (v > 0.0).then(|| (coefficient.map(|c| c * f.mean * v), f, cast))
-    }
-
-    /// Kernel-weighted fraction of stratified pairs `(x on r, y on s)`
-    /// whose light passes through window `w` unoccluded (module docs);
-    /// `image` is `s` as seen through the window (mirrored where
-    /// `reflect`). Returns the fraction and the rays cast.
-    #[allow(clippy::too_many_arguments)]
-    fn through(&self, h: &Hierarchy, scene: &SceneRays, w: u32, r: u32, s: u32, image: &[DVec3; 3], image_normal: DVec3, reflect: bool) -> (f64, u64) {
+    /// The images of sender element `s` that leaf `r` sees through chains
+    /// of up to `max_events` windows (module docs): `found(weight, F)` for
+    /// each, `weight = coefficients x F x V'`, `F` the unclipped factor to
+    /// the image. Returns the rays cast.
+    fn images(&self, h: &Hierarchy, scene: &SceneRays, r: u32, s: u32, found: &mut dyn FnMut([f64; 3], AreaFactor)) -> u64 {
         let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
         let nr = h.normal(r);
-        let mut stream = Stream::new(self.seed ^ 0x4d49_5252_4f52, r.into(), (u64::from(s) << 20) | u64::from(w));
+        let mut cast = 0;
+        let mut stack = vec![Image { corners: vec![se.points], normal: h.normal(s), path: Vec::new(), coefficient: [1.0; 3] }];
+        while let Some(image) = stack.pop() {
+            if image.path.len() >= self.max_events as usize {
+                continue;
+            }
+            for (w, window) in self.windows.iter().enumerate() {
+                if image.path.last().is_some_and(|&last| last as usize == w) {
+                    continue;
+                }
+                let Some(next) = image.through(w as u32, window, &re.points) else { continue };
+                let last = next.corners[next.corners.len() - 1];
+                let f = triangle_to_polygon(&re.points, nr, &last, next.normal, self.quadrature);
+                if f.mean <= 0.0 || next.coefficient.iter().fold(0.0f64, |a, &c| a.max(c)) * f.mean < self.min_factor {
+                    continue;
+                }
+                let (v, rays) = self.visible(h, scene, r, s, &next);
+                cast += rays;
+                if v > 0.0 {
+                    found(next.coefficient.map(|c| c * f.mean * v), f);
+                }
+                stack.push(next);
+            }
+        }
+        cast
+    }
+
+    /// Kernel-weighted fraction of stratified pairs `(x on r, y on the
+    /// image)` whose light comes from the sender through the image's
+    /// windows, in order, unoccluded (module docs). Returns the fraction
+    /// and the rays cast.
+    fn visible(&self, h: &Hierarchy, scene: &SceneRays, r: u32, s: u32, image: &Image) -> (f64, u64) {
+        let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
+        let nr = h.normal(r);
+        let path_key = image.path.iter().fold(u64::from(s), |key, &w| key.wrapping_mul(1_000_003).wrapping_add(u64::from(w) + 1));
+        let mut stream = Stream::new(self.seed ^ 0x4d49_5252_4f52, r.into(), path_key);
         // Receiver stratum k with a shuffled sender stratum, as the links' rays.
         let mut order: Vec<usize> = (0..self.rays).collect();
         for i in (1..self.rays).rev() {
             let j = (stream.next_f64() * (i + 1) as f64) as usize;
             order.swap(i, j.min(i));
         }
+        let last = image.corners[image.corners.len() - 1];
         let (mut clear, mut total, mut cast) = (0.0, 0.0, 0u64);
-        for (k, &k_sender) in order.iter().enumerate() {
+        'pairs: for (k, &k_sender) in order.iter().enumerate() {
             let x = stratified_point(&re.points, k, self.rays, &mut stream);
-            let seen = stratified_point(image, k_sender, self.rays, &mut stream);
-            let g = point_kernel(x, nr, seen, image_normal);
+            let seen = stratified_point(&last, k_sender, self.rays, &mut stream);
+            let g = point_kernel(x, nr, seen, image.normal);
             if g <= 0.0 {
                 continue;
             }
             total += g;
-            cast += 1;
-            let d = seen - x;
-            let length = d.length();
-            let Some(hit) = scene.closest_hit(x, d / length, (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32, [re.triangle, u32::MAX]) else { continue };
-            if self.of_triangle[hit.triangle as usize] != Some(w) {
-                continue;
+            // The same point on every image of the chain, back to the sender.
+            let weights = barycentric(seen, &last);
+            let on = |corners: &[DVec3; 3]| corners[0] * weights[0] + corners[1] * weights[1] + corners[2] * weights[2];
+            let (mut from, mut skip) = (x, re.triangle);
+            for (step, &w) in image.path.iter().enumerate().rev() {
+                let target = on(&image.corners[step + 1]);
+                let d = target - from;
+                let length = d.length();
+                cast += 1;
+                let Some(hit) = scene.closest_hit(from, d / length, (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32, [skip, u32::MAX]) else { continue 'pairs };
+                if self.of_triangle[hit.triangle as usize] != Some(w) {
+                    continue 'pairs;
+                }
+                from += d / length * f64::from(hit.t);
+                skip = hit.triangle;
             }
-            let at = x + d / length * f64::from(hit.t);
-            // The real sender point: the image point mirrored back, or itself.
-            let y = if reflect { mirror_point(seen, self.windows[w as usize].origin, self.windows[w as usize].normal) } else { seen };
             cast += 1;
-            if scene.segment_clear(at, y, [hit.triangle, se.triangle]) {
+            if scene.segment_clear(from, on(&image.corners[0]), [skip, se.triangle]) {
                 clear += g;
             }
         }
