@@ -11,7 +11,7 @@ GPU_SHOOT_LEVEL ?= 3
 GPU_RESOLUTION ?= 128
 GPU_OVERSHOOT ?= --overshoot
 
-.PHONY: gpu bench-gpu
+.PHONY: gpu bench-gpu bench-gpu-detail
 gpu: $(GPU_OUT)/image.png
 
 $(GPU_OUT) $(GPU_OUT)/params:
@@ -42,3 +42,9 @@ $(GPU_OUT)/image.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(GPU_OUT)/previe
 # stereographic, with and without overshooting (see README, Performance).
 bench-gpu: $(BIN)/bench-gpu | out
 	$(BIN)/bench-gpu -o out/bench-gpu.ron
+
+# The shape of paper 004 Table 2.1: a closed box with and without a normal
+# map, the Cornell box with and without adaptive subdivision, 8000 texels
+# to 99% (see README, Performance).
+bench-gpu-detail: $(BIN)/bench-gpu | out
+	$(BIN)/bench-gpu --detail -o out/bench-gpu-detail.ron
