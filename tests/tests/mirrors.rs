@@ -437,3 +437,65 @@ fn a_closed_box_with_a_mirror_wall_conserves_energy() {
     eprintln!("closed box with a mirror wall: absorbed / emitted = {:.5}", absorbed / emitted);
     assert!((absorbed / emitted - 1.0).abs() < 1e-2, "absorbed {absorbed} of {emitted} emitted");
 }
+
+#[test]
+fn two_facing_mirrors_give_the_series_of_images_to_the_depth_bound_and_report_a_truncation_bound() {
+    // Mirrors x = 0 (facing +x) and x = 1 (facing -x), 20 x 20 m; between
+    // them a floor patch and, 2 m above it, an emitter facing down, so that
+    // the images of order 1 to 3 bring 64%, 25% and 10% of the direct light.
+    let dir = scratch("mirror_parallel");
+    let (rho_s, depth) = (0.9f64, 3usize);
+    let mut obj = String::from("mtllib scene.mtl\n");
+    let quads: [(&str, &str, [[f64; 3]; 4]); 3] = [
+        ("floor", "floor", [[0.3, -0.2, 0.0], [0.7, -0.2, 0.0], [0.7, 0.2, 0.0], [0.3, 0.2, 0.0]]),
+        ("left", "mirror", [[0.0, -10.0, -10.0], [0.0, 10.0, -10.0], [0.0, 10.0, 10.0], [0.0, -10.0, 10.0]]),
+        ("right", "mirror", [[1.0, -10.0, -10.0], [1.0, -10.0, 10.0], [1.0, 10.0, 10.0], [1.0, 10.0, -10.0]]),
+    ];
+    for (object, material, corners) in quads {
+        obj += &format!("o {object}\nusemtl {material}\n");
+        for v in corners {
+            obj += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+        }
+        obj += "f -4 -3 -2 -1\n";
+    }
+    std::fs::write(dir.join("scene.obj"), obj).unwrap();
+    std::fs::write(dir.join("scene.mtl"), format!("newmtl floor\nKd {RHO}\nnewmtl mirror\nKd 0\nKs {rho_s}\nillum 3\n")).unwrap();
+    let scene = format!(
+        "Scene(meshes: [Obj(file: \"scene.obj\")], camera: Camera(eye: (0.5, -2.0, 0.3), target: (0.5, 0.0, 0.2), up: (0.0, 0.0, 1.0), vertical_fov_deg: 60.0, width: 8, height: 8), lights: [Area(corner: (0.4, -0.1, 2.0), edge_u: (0.0, 0.2, 0.0), edge_v: (0.2, 0.0, 0.0), emission: ({EXITANCE:?}, {EXITANCE:?}, {EXITANCE:?}))])"
+    );
+    std::fs::write(dir.join("scene.ron"), scene).unwrap();
+    let depth_arg = depth.to_string();
+    let solved = Solved::new(&dir, &dir.join("scene.ron"), &["--eps-relative", "1e-5", "--min-area", "1e-6", "--specular-depth", &depth_arg]);
+    let lamp = [[0.4, -0.1, 2.0], [0.4, 0.1, 2.0], [0.6, 0.1, 2.0], [0.6, -0.1, 2.0]];
+    // The images after k reflections, starting in either mirror: x -> -x
+    // in the left one, x -> 2 - x in the right one, alternately.
+    let series = |p: [f64; 3], orders: usize| {
+        let mut e = lambert_polygon(p, [0.0, 0.0, 1.0], &lamp);
+        for first in [0, 1] {
+            let mut image = lamp;
+            for k in 1..=orders {
+                let at = if (k + first) % 2 == 0 { 0.0 } else { 1.0 };
+                image = image.map(|c| [2.0 * at - c[0], c[1], c[2]]);
+                e += rho_s.powi(k as i32) * lambert_polygon(p, [0.0, 0.0, 1.0], &image);
+            }
+        }
+        EXITANCE * e
+    };
+    let (leaves, worst) = solved.check("floor", RHO, 0.001, &|p| series(p, depth));
+    eprintln!("floor between facing mirrors: {leaves} leaves, largest error {worst:.2e} against the series to order {depth}");
+    assert!(leaves >= 8, "only {leaves} floor leaves");
+    // One order less would be far outside that.
+    let centre = [0.5, 0.0, 0.0];
+    assert!(series(centre, depth) > 1.05 * series(centre, depth - 1));
+    // The truncation the solver reports bounds the true one (the series
+    // to order 60 less the series to the depth bound), on every leaf.
+    let line = solved.report.lines().find(|l| l.contains("\"specular_truncation_bound\"")).unwrap_or_else(|| panic!("{}", solved.report));
+    let bound: f64 = line.split(':').nth(1).unwrap().trim().trim_end_matches(',').parse().unwrap();
+    let mut largest = 0.0f64;
+    for e in solved.leaves_of("floor") {
+        let truncated = solved.mean(e, 2, &|p| series(p, 60) - series(p, depth));
+        largest = largest.max(truncated);
+    }
+    eprintln!("truncation: largest {largest:.3e} W/m2, reported bound {bound:.3e}");
+    assert!(largest > 0.0 && largest <= bound, "truncation {largest} over the reported bound {bound}");
+}

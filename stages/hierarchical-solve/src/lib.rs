@@ -278,6 +278,9 @@ pub struct Work {
     pub specular_rays: u64,
     /// Seconds building them, all passes.
     pub specular_seconds: f64,
+    /// Bound of the irradiance the specular depth bound leaves out, W/m²
+    /// ([`mirrors::Couplings::truncation`]), last pass.
+    pub specular_truncation: f64,
 }
 
 /// Progress of a solve, reported as each phase of a pass begins and when
@@ -492,6 +495,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         specular = windows.as_ref().map(|w| w.couplings(&h, &scene, &b));
         if let Some(s) = &specular {
             work.specular_couplings = s.len();
+            work.specular_truncation = s.truncation;
             work.specular_rays += s.rays;
             work.specular_seconds += started.elapsed().as_secs_f64();
         }

@@ -228,11 +228,17 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("luminaires".to_string(), manifest.goniometric_lights.len() as f64),
             ("luminaire_rays".to_string(), w.luminaire_rays as f64),
             ("luminaire_seconds".to_string(), w.luminaire_seconds),
-            ("specular_couplings".to_string(), w.specular_couplings as f64),
-            ("specular_rays".to_string(), w.specular_rays as f64),
-            ("specular_seconds".to_string(), w.specular_seconds),
             ("visibility_rays_per_second".to_string(), w.rays as f64 / w.visibility_seconds.max(1e-9)),
         ]);
+        // Only where the scene has mirrors or panes; the bound where finite.
+        if manifest.effects.specular_reflection || manifest.effects.specular_transmission {
+            counters.insert("specular_couplings".to_string(), w.specular_couplings as f64);
+            counters.insert("specular_rays".to_string(), w.specular_rays as f64);
+            counters.insert("specular_seconds".to_string(), w.specular_seconds);
+            if w.specular_truncation.is_finite() {
+                counters.insert("specular_truncation_bound".to_string(), w.specular_truncation);
+            }
+        }
         // Left out where unknown (no contraction below 1 was known).
         for (name, value) in [("error_bound", w.error_bound), ("contraction", w.contraction)] {
             if value.is_finite() {

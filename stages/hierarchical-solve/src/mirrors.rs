@@ -61,8 +61,8 @@ use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Node;
 
 /// A leaf's couplings as built: the leaf, `(sender, weight)` pairs, their
-/// spread and the rays cast.
-type LeafCouplings = (u32, Vec<(usize, [f64; 3])>, f64, u64);
+/// spread, the rays cast and the truncated irradiance.
+type LeafCouplings = (u32, Vec<(usize, [f64; 3])>, f64, u64, f64);
 
 /// One window: the specular triangles of one material in one plane.
 #[derive(Clone, Debug, PartialEq)]
@@ -133,6 +133,14 @@ pub struct Couplings {
     spread: Vec<f64>,
     /// Rays cast to build them.
     pub rays: u64,
+    /// Bound of the irradiance the depth bound leaves out on a leaf (the
+    /// largest over leaves, brightest channel, W/m², from the radiosity the
+    /// couplings were built with): what the images one window past the
+    /// bound would bring unoccluded, over `1 - c`, `c` the largest specular
+    /// coefficient (the further orders as a geometric series; a bound
+    /// where images get no closer with each window, as between parallel
+    /// mirrors).
+    pub truncation: f64,
 }
 
 impl Couplings {
@@ -303,21 +311,32 @@ impl Windows {
         let per_leaf: Vec<LeafCouplings> = leaves
             .par_iter()
             .map(|&r| {
-                let (mut found, mut spread, mut rays) = (Vec::new(), 0.0, 0);
+                let (mut found, mut spread, mut rays, mut tail) = (Vec::new(), 0.0, 0, [0.0; 3]);
                 for &s in &senders {
                     let sender = h.flat(Node::Element(s));
-                    rays += self.images(h, scene, r, s, &mut |weight, f| {
-                        // weight / F_mean x (F_max - F_min), per channel.
-                        spread += (0..3).map(|c| weight[c] * b[sender][c] * (f.max - f.min) / f.mean).fold(0.0, f64::max);
-                        found.push((sender, weight));
-                    });
+                    let mut truncated = [0.0; 3];
+                    rays += self.images(
+                        h,
+                        scene,
+                        r,
+                        s,
+                        &mut |weight, f| {
+                            // weight / F_mean x (F_max - F_min), per channel.
+                            spread += (0..3).map(|c| weight[c] * b[sender][c] * (f.max - f.min) / f.mean).fold(0.0, f64::max);
+                            found.push((sender, weight));
+                        },
+                        &mut truncated,
+                    );
+                    (0..3).for_each(|c| tail[c] += truncated[c] * b[sender][c]);
                 }
-                (r, found, spread, rays)
+                (r, found, spread, rays, tail.into_iter().fold(0.0, f64::max))
             })
             .collect();
         let mut rows: Vec<Vec<(usize, [f64; 3])>> = vec![Vec::new(); nodes];
         let mut couplings = Couplings { spread: vec![0.0; nodes], ..Couplings::default() };
-        for (r, found, spread, rays) in per_leaf {
+        let largest = self.windows.iter().flat_map(|w| w.reflectance.into_iter().chain(w.transmittance)).fold(0.0, f64::max);
+        for (r, found, spread, rays, tail) in per_leaf {
+            couplings.truncation = couplings.truncation.max(if largest < 1.0 { tail / (1.0 - largest) } else { f64::INFINITY });
             let i = h.flat(Node::Element(r));
             rows[i] = found;
             couplings.spread[i] = spread;
@@ -354,15 +373,15 @@ impl Windows {
     /// of up to `max_events` windows (module docs): `found(weight, F)` for
     /// each, `weight = coefficients x F x V'`, `F` the unclipped factor to
     /// the image. Returns the rays cast.
-    fn images(&self, h: &Hierarchy, scene: &SceneRays, r: u32, s: u32, found: &mut dyn FnMut([f64; 3], AreaFactor)) -> u64 {
+    /// `truncated` receives the coefficients times unoccluded factors of
+    /// the images one window past the depth bound.
+    fn images(&self, h: &Hierarchy, scene: &SceneRays, r: u32, s: u32, found: &mut dyn FnMut([f64; 3], AreaFactor), truncated: &mut [f64; 3]) -> u64 {
         let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
         let nr = h.normal(r);
         let mut cast = 0;
         let mut stack = vec![Image { corners: vec![se.points], normal: h.normal(s), path: Vec::new(), coefficient: [1.0; 3] }];
         while let Some(image) = stack.pop() {
-            if image.path.len() >= self.max_events as usize {
-                continue;
-            }
+            let past = image.path.len() >= self.max_events as usize;
             for (w, window) in self.windows.iter().enumerate() {
                 if image.path.last().is_some_and(|&last| last as usize == w) {
                     continue;
@@ -370,6 +389,10 @@ impl Windows {
                 let Some(next) = image.through(w as u32, window, &re.points) else { continue };
                 let last = next.corners[next.corners.len() - 1];
                 let f = triangle_to_polygon(&re.points, nr, &last, next.normal, self.quadrature);
+                if past {
+                    (0..3).for_each(|c| truncated[c] += next.coefficient[c] * f.mean);
+                    continue;
+                }
                 if f.mean <= 0.0 || next.coefficient.iter().fold(0.0f64, |a, &c| a.max(c)) * f.mean < self.min_factor {
                     continue;
                 }
