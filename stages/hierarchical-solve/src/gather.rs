@@ -350,10 +350,11 @@ pub enum Senders {
 /// the Cornell box without its blocks, the area means made every surface's
 /// mean radiosity 0.24% (floor) to 0.66% (ceiling) darker than the
 /// radiosity equation over the same leaves with a quadrature kernel (issue
-/// 10; with this, 0.01% to 0.03%). On the Cornell box at the default
-/// settings, against Mitsuba: the preview's mean error -1.16% -> -0.75%
+/// 10; the leaves' residual in that equation, +0.10% to +0.31% per
+/// surface, is now +0.02% to +0.05%). On the Cornell box at the default
+/// settings, against Mitsuba: the preview's mean error -1.16% -> -0.76%
 /// (every surface within 0.9%), the full gather's relative RMSE 0.99% ->
-/// 0.81% (ceiling -1.14% -> -0.81%, tall block -1.49% -> -1.11%), for a
+/// 0.81% (ceiling -1.14% -> -0.81%, tall block -1.49% -> -1.12%), for a
 /// last solve of about 9 s more on 2 loaded cores. Only the last pass
 /// resolves senders: refinement needs the radiosity's shape, not this
 /// last fraction of a percent. Cluster receivers, leaf senders, clusters
