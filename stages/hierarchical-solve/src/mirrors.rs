@@ -78,6 +78,25 @@ pub struct Window {
     /// Whether its material is two-sided (each face a window of its own,
     /// which transmits only from its front, so the pane counts once).
     pub two_sided: bool,
+    /// The corners of its triangles.
+    pub corners: Vec<DVec3>,
+}
+
+impl Window {
+    /// Whether light can go from window `from` on to this one: some corner
+    /// of each lies strictly on the other's side its light leaves by or
+    /// arrives from (either side of a transmitting window, the front of a
+    /// reflecting one). Two faces of a convex mirror never pass light on.
+    fn follows(&self, from: &Window) -> bool {
+        let reaches = |a: &Window, b: &Window| {
+            let transmits = a.transmittance.iter().any(|&x| x > 0.0);
+            b.corners.iter().any(|&p| {
+                let d = (p - a.origin).dot(a.normal);
+                d > 0.0 || (transmits && d < 0.0)
+            })
+        };
+        reaches(from, self) && reaches(self, from)
+    }
 }
 
 /// The knobs of the couplings (the solver's `specular_*` parameters).
@@ -289,12 +308,14 @@ impl Windows {
                         reflectance: m.specular_reflectance,
                         transmittance: m.specular_transmittance,
                         two_sided: m.two_sided,
+                        corners: Vec::new(),
                     };
                     windows.push((triangle.material, window));
                     windows.len() - 1
                 }
             };
             of_triangle[t] = Some(index as u32);
+            windows[index].1.corners.extend(g.corners);
         }
         let Knobs { rays, min_factor, quadrature, seed, sender_level, max_events } = knobs;
         Some(Windows { windows: windows.into_iter().map(|(_, w)| w).collect(), of_triangle, rays, min_factor, quadrature, max_events, seed, sender_level })
@@ -383,7 +404,7 @@ impl Windows {
         while let Some(image) = stack.pop() {
             let past = image.path.len() >= self.max_events as usize;
             for (w, window) in self.windows.iter().enumerate() {
-                if image.path.last().is_some_and(|&last| last as usize == w) {
+                if image.path.last().is_some_and(|&last| last as usize == w || !window.follows(&self.windows[last as usize])) {
                     continue;
                 }
                 let Some(next) = image.through(w as u32, window, &re.points) else { continue };
