@@ -499,3 +499,21 @@ fn two_facing_mirrors_give_the_series_of_images_to_the_depth_bound_and_report_a_
     eprintln!("truncation: largest {largest:.3e} W/m2, reported bound {bound:.3e}");
     assert!(largest > 0.0 && largest <= bound, "truncation {largest} over the reported bound {bound}");
 }
+
+#[test]
+fn out_of_range_specular_knobs_are_refused_in_one_line() {
+    let (dir, scene) = mirror_scene("mirror_knobs", "Kd 0\nKs 0.8\nillum 3\n", MIRROR);
+    let manifest = prepare_and_solve(&dir, &scene, &["--eps", "1e-3"]);
+    assert!(manifest.effects.specular_reflection);
+    let p = |f: &str| dir.join(f);
+    let (mesh, manifest, solution) = (p("mesh.exr"), p("manifest.ron"), p("solution.exr"));
+    let out = p("refused.exr");
+    let solve = |flag: &str, value: &str| vec!["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&out), flag, value].into_iter().map(String::from).collect::<Vec<_>>();
+    for (flag, value, needle) in [("--specular-depth", "17", "specular_depth"), ("--specular-rays", "0", "specular_rays"), ("--specular-min-factor", "-1", "specular_min_factor")] {
+        let args = solve(flag, value);
+        assert_refused("hierarchical-solve", &args.iter().map(String::as_str).collect::<Vec<_>>(), &[needle], &[&out]);
+    }
+    for (flag, value, needle) in [("--specular-depth", "65", "specular_depth"), ("--specular-min-weight", "2", "specular_min_weight")] {
+        assert_refused("grid-gather", &["--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "-o", s(&out), flag, value], &[needle], &[&out]);
+    }
+}
