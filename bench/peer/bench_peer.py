@@ -31,6 +31,9 @@ machine, against one converged Mitsuba reference:
    error first reaches the target, interpolated log-log between the
    neighbouring points; "not reached" where it never does; ratio = Mitsuba
    time / pipeline time. Written as a table (text and CSV) and an SVG plot.
+6. per surface: the mean signed error (luminance) of every object for
+   Mitsuba's largest spp and for each pipeline series' most accurate point
+   (from the `compare` reports the sweep keeps, [`best_runs`]).
 
 Standard library, numpy and mitsuba only.
 """
@@ -267,6 +270,29 @@ def read_sweep(path):
     return series
 
 
+def best_runs(sweep_dir, names):
+    """Per series ("solver/gather"), its most accurate run of the sweep:
+    (its point's folder, e.g. "EPS=0.0001"; relative RMSE; [(object, mean
+    signed error)]), read from
+    the `compare-<gather>.ron` reports the sweep keeps under
+    runs/<solver>/<point>/rep<k>/ (`compare`'s per-object luminance means)."""
+    best = {}
+    for path in sorted(glob.glob(os.path.join(sweep_dir, "runs", "*", "*", "rep*", "compare-*.ron"))):
+        text = open(path).read()
+        found = re.search(r'"relative_rmse":\s*([0-9.eE+-]+)', text)
+        if not found:
+            continue
+        solver = os.path.basename(os.path.dirname(os.path.dirname(os.path.dirname(path))))
+        gather = os.path.basename(path)[len("compare-"):-len(".ron")]
+        error = float(found.group(1))
+        key = f"{solver}/{gather}"
+        if key not in best or error < best[key][1]:
+            means = [(int(i), float(v)) for i, v in re.findall(r'"object\[#(\d+)\]\.mean_signed_error":\s*([0-9.eE+-]+)', text)]
+            objects = [(names[i] if i < len(names) else f"#{i}", v) for i, v in sorted(means)]
+            best[key] = (os.path.basename(os.path.dirname(os.path.dirname(path))), error, objects)
+    return best
+
+
 # --- output -------------------------------------------------------------------
 
 def svg_plot(series, targets, title):
@@ -381,6 +407,7 @@ def main():
     # Interleaved: Mitsuba rep 1, the pipeline sweep, Mitsuba reps 2..n.
     mitsuba_runs = {s: [] for s in spps}
     sweep_series, sweep_s = {}, None
+    last = []  # per object, the first repetition at the most samples
 
     def mitsuba_rep(rep):
         for i, spp in enumerate(spps):
@@ -391,7 +418,7 @@ def main():
             mitsuba_runs[spp].append((t, e))
             if rep == 0 and spp == spps[-1]:
                 renderer.write(os.path.join(args.out, f"mitsuba_{spp}spp.exr"), pixels)
-                last = per_object(pixels, ref, mask, objects, names)
+                last[:] = per_object(pixels, ref, mask, objects, names)
                 log(f"mitsuba {spp} spp per object: " + "; ".join(f"{n} {100 * m:+.2f}%" for n, _, _, m in last))
             log(f"mitsuba rep {rep + 1}: {spp} spp {t:.2f} s, relative RMSE {100 * e:.2f}%")
 
@@ -449,6 +476,12 @@ def main():
         text.append("~: the reference's noise is over a fifth of this target: the time is indicative only")
     if sweep_s is not None:
         text.append(f"the pipeline sweep took {sweep_s:.0f} s in all (every point, every rep, compare included)")
+        text.append("")
+        text.append("per surface, mean signed error (luminance) of each series' most accurate point:")
+        text.append(f"  mitsuba {spps[-1]} spp: " + "; ".join(f"{n} {100 * m:+.2f}%" for n, _, _, m in last))
+        sweep_dir = os.path.dirname(args.sweep_csv) if args.sweep_csv else os.path.join(args.out, "sweep")
+        for name, (run, error, objects) in best_runs(sweep_dir, names).items():
+            text.append(f"  {name} {run} ({100 * error:.2f}%): " + "; ".join(f"{n} {100 * m:+.2f}%" for n, m in objects))
     table = "\n".join(text) + "\n"
     print(table, end="")
     atomic_write(os.path.join(args.out, "time_to_error.txt"), table)

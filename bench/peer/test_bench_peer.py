@@ -47,5 +47,25 @@ class Mask(unittest.TestCase):
         self.assertAlmostEqual(estimate, actual, delta=0.03 * actual)
 
 
+class BestRuns(unittest.TestCase):
+    def test_most_accurate_run_per_series_and_its_surfaces(self):
+        import tempfile
+        with tempfile.TemporaryDirectory() as sweep:
+            def report(solver, point, gather, rmse, means):
+                d = os.path.join(sweep, "runs", solver, point, "rep0")
+                os.makedirs(d, exist_ok=True)
+                lines = [f'    "relative_rmse": {rmse},'] + [f'    "object[#{i}].mean_signed_error": {m},' for i, m in enumerate(means)]
+                open(os.path.join(d, f"compare-{gather}.ron"), "w").write("(\n" + "\n".join(lines) + "\n)\n")
+            report("hierarchical", "EPS=0.01", "full", 0.05, [-0.02, 0.01])
+            report("hierarchical", "EPS=0.001", "full", 0.01, [-0.004, 0.003])
+            report("hierarchical", "EPS=0.001", "preview", 0.03, [0.02, -0.01])
+            best = bp.best_runs(sweep, ["floor", "ceiling"])
+            self.assertEqual(sorted(best), ["hierarchical/full", "hierarchical/preview"])
+            run, error, objects = best["hierarchical/full"]
+            self.assertEqual(run, "EPS=0.001")
+            self.assertEqual(error, 0.01)
+            self.assertEqual(objects, [("floor", -0.004), ("ceiling", 0.003)])
+
+
 if __name__ == "__main__":
     unittest.main()
