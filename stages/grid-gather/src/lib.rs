@@ -522,7 +522,11 @@ fn full_gather(
     let transmission = transmission(scene);
     let specular = specular::Specular::new(scene.mesh, scene.manifest, triangles, params.specular_depth, params.specular_min_weight);
     let window_light = match specular {
-        Some(_) => Some(specular::window_light(scene, triangles, &senders::Senders::new(triangles, scene.solution, extras.clusters, params.seed), &surfaces, smoothing)?),
+        Some(_) => {
+            let senders = senders::Senders::new(triangles, scene.solution, extras.clusters, params.seed);
+            let rays = scene_rays(triangles, extras.detail);
+            Some(specular::window_light(scene, triangles, &senders, &surfaces, &radiometry::photometry::DirectLight { lights: &lights, rays: &rays }, smoothing)?)
+        }
         None => None,
     };
     let full_scene = final_gather::FullScene {
