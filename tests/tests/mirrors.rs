@@ -517,3 +517,47 @@ fn out_of_range_specular_knobs_are_refused_in_one_line() {
         assert_refused("grid-gather", &["--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "-o", s(&out), flag, value], &[needle], &[&out]);
     }
 }
+
+#[test]
+fn an_occluder_before_and_after_the_mirror_blocks_the_mirrored_light_where_it_lies() {
+    // The large mirror wall and, against it, a black horizontal plate at
+    // height H over y in [0.9, 1] (paper 004 Fig. 4.1's mirror-object
+    // case: the plate can block the leg to the mirror and the leg back).
+    const H: f64 = 0.6;
+    let (dir, scene) = mirror_scene("mirror_occluder", "Kd 0\nKs 0.8\nillum 3\n", MIRROR);
+    let obj = std::fs::read_to_string(dir.join("scene.obj")).unwrap();
+    std::fs::write(dir.join("scene.obj"), format!("{obj}o plate\nusemtl plate\nv -0.5 0.9 {H}\nv 1.5 0.9 {H}\nv 1.5 1 {H}\nv -0.5 1 {H}\nf 9 10 11 12\n")).unwrap();
+    let mtl = std::fs::read_to_string(dir.join("scene.mtl")).unwrap();
+    std::fs::write(dir.join("scene.mtl"), format!("{mtl}newmtl plate\nKd 0\n")).unwrap();
+    let solved = Solved::new(&dir, &scene, &["--eps", "1e-4", "--specular-rays", "1024"]);
+    // Unfolded, the mirrored light comes from the emitter's image (y in
+    // [1.3, 1.7] at z = 1.2) past the plate and the plate's image: the
+    // strip y in [0.9, 1.1] at z = H, which from floor point p hides the
+    // image's rows y in [p_y + (0.9 - p_y) 1.2 / H, p_y + (1.1 - p_y) 1.2 / H]
+    // (the strip spans the floor's x range, so every column).
+    let (c, u, v) = EMITTER;
+    let (x0, x1, z) = (c[0], c[0] + v[0], c[2]);
+    let (y0, y1) = (2.0 * MIRROR_Y - (c[1] + u[1]), 2.0 * MIRROR_Y - c[1]);
+    let rectangle = |lo: f64, hi: f64| [[x0, lo, z], [x1, lo, z], [x1, hi, z], [x0, hi, z]];
+    let up = [0.0, 0.0, 1.0];
+    let visible = |p: [f64; 3]| {
+        let (lo, hi) = (p[1] + (0.9 - p[1]) * z / H, p[1] + (1.1 - p[1]) * z / H);
+        let mut f = 0.0;
+        if lo > y0 {
+            f += lambert_polygon(p, up, &rectangle(y0, lo.min(y1)));
+        }
+        if hi < y1 {
+            f += lambert_polygon(p, up, &rectangle(hi.max(y0), y1));
+        }
+        f
+    };
+    let expected = |p: [f64; 3]| EXITANCE * (lambert_polygon(p, up, &emitter()) + RHO_S * visible(p));
+    let (leaves, worst) = solved.check("floor", RHO, 0.01, &expected);
+    // At leaf centroids the plate hides almost all of the image (under
+    // y = 0.5, all of it) and none of it.
+    let whole = |p: [f64; 3]| lambert_polygon(p, up, &rectangle(y0, y1));
+    let shares: Vec<f64> = solved.leaves_of("floor").iter().map(|e| solved.mean(e, 0, &|p| visible(p) / whole(p))).collect();
+    let (least, most) = shares.iter().fold((1.0f64, 0.0f64), |(a, b), &f| (a.min(f), b.max(f)));
+    assert!(least < 0.05 && most == 1.0, "visible shares from {least} to {most}");
+    eprintln!("floor beside a mirror with an occluder: {leaves} leaves, largest irradiance error {worst:.4}");
+}
