@@ -525,7 +525,7 @@ fn full_gather(
         Some(_) => {
             let senders = senders::Senders::new(triangles, scene.solution, extras.clusters, params.seed);
             let rays = scene_rays(triangles, extras.detail);
-            Some(specular::window_light(scene, triangles, &senders, &surfaces, &radiometry::photometry::DirectLight { lights: &lights, rays: &rays }, smoothing)?)
+            Some(specular::window_light(scene, triangles, &senders, &surfaces, extras.detail, &radiometry::photometry::DirectLight { lights: &lights, rays: &rays }, smoothing)?)
         }
         None => None,
     };

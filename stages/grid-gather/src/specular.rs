@@ -22,11 +22,11 @@ use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::photometry::DirectLight;
 use radiometry::rays::{Hit, SceneRays};
+use crate::detail::Detail;
 use crate::full::Surface;
 use crate::gouraud::{Gouraud, Smoothing};
 use crate::senders::Senders;
 use schemas::mesh::{Manifest, Mesh};
-use schemas::solution::Solution;
 
 /// Ideal specular reflectance and transmittance of one triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,37 +158,41 @@ impl Specular {
 /// the links into it, its ancestors and clusters bring (the light
 /// hierarchical-solve gathered through mirrors and glass by virtual
 /// senders, which the solution's links do not carry), interpolated over
-/// the surfaces like the preview's radiosity ([`Gouraud::of`]). The full
-/// gather adds it to what it gathers from the links. The solver's
-/// radiosity also holds the goniometric lights' direct light, which the
-/// full gather adds per point: `lights`' irradiance at the leaf's centroid
-/// is taken off (the solver's is the leaf's mean).
-pub fn window_light(scene: &crate::Scene, triangles: &[TriangleGeometry], senders: &Senders, surfaces: &[Surface], lights: &DirectLight, smoothing: Smoothing) -> schemas::Result<Gouraud> {
+/// the surfaces like the preview's radiosity ([`Gouraud::of`]): per
+/// channel `max(0, H_e - sum V E_unoccluded - E_lights)`, `H_e = (B_e - E)
+/// / rho_e` the leaf's irradiance (`rho_e` its texture average where
+/// `detail` has textures, [`Detail::irradiance`]; 0 where `rho_e` is 0,
+/// such a leaf reflects none of it). The full gather adds it to what it
+/// gathers from the links. The solver's radiosity also holds the
+/// goniometric lights' direct light, which the full gather adds per
+/// point: `lights`' irradiance `E_lights` at the leaf's centroid is taken
+/// off (the solver's is the leaf's mean).
+#[allow(clippy::too_many_arguments)]
+pub fn window_light(
+    scene: &crate::Scene,
+    triangles: &[TriangleGeometry],
+    senders: &Senders,
+    surfaces: &[Surface],
+    detail: Option<&Detail>,
+    lights: &DirectLight,
+    smoothing: Smoothing,
+) -> schemas::Result<Gouraud> {
     let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    Gouraud::of(triangles, &materials, scene.solution, scene.solution_path, smoothing, &|_, e| {
-        let centroid = [0, 1].map(|k| (0..3).map(|c| f64::from(e.corners[c][k])).sum::<f64>() / 3.0);
+    let solution = scene.solution;
+    Gouraud::of(triangles, &materials, solution, scene.solution_path, smoothing, &|corners, e| {
+        let centroid = [0, 1].map(|k| (0..3).map(|c| corners[c][k]).sum::<f64>() / 3.0);
         let mut links = Vec::new();
-        let leaf = senders.chain(e.triangle, centroid, &mut links);
+        senders.chain(e.triangle, centroid, &mut links);
         let t = &triangles[e.triangle as usize];
         let direct = if lights.lights.is_empty() { 0.0 } else { lights.at_point(t.point(centroid), t.normal, e.triangle).0 };
-        through_windows(scene.solution, leaf, &links, surfaces[e.triangle as usize], direct)
-    })
-}
-
-/// What [`window_light`] holds for `leaf`: per channel `max(0, (B - E) /
-/// rho - sum V E_unoccluded - direct)` over `links` (its chain's),
-/// `direct` the lights' irradiance; 0 where `rho` is 0 (such a leaf
-/// reflects none of it).
-fn through_windows(solution: &Solution, leaf: u32, links: &[usize], surface: Surface, direct: f64) -> [f64; 3] {
-    let b = solution.elements[leaf as usize].radiosity;
-    let from_links = |c: usize| links.iter().map(|&l| f64::from(solution.links[l].visibility) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
-    std::array::from_fn(|c| {
-        let rho = surface.reflectance[c];
-        if rho > 0.0 {
-            ((f64::from(b[c]) - surface.emission[c]) / rho - from_links(c) - direct).max(0.0)
-        } else {
-            0.0
-        }
+        let s = surfaces[e.triangle as usize];
+        let b = e.radiosity.map(f64::from);
+        let h: [f64; 3] = match detail {
+            Some(detail) => detail.irradiance(e.triangle, corners, b, s.emission, s.reflectance),
+            None => std::array::from_fn(|c| if s.reflectance[c] > 0.0 { (b[c] - s.emission[c]) / s.reflectance[c] } else { 0.0 }),
+        };
+        let from_links = |c: usize| links.iter().map(|&l| f64::from(solution.links[l].visibility) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
+        std::array::from_fn(|c| if h[c] > 0.0 { (h[c] - from_links(c) - direct).max(0.0) } else { 0.0 })
     })
 }
 
