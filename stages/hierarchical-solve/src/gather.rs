@@ -434,6 +434,15 @@ impl SenderTerms {
     }
 }
 
+/// The radiosity each of `links` sends with its sender resolved by the
+/// kernel ([`SenderTerms`]), as the last pass's solve sent it: the links'
+/// unoccluded irradiance in the solution is `F_rs` times this, so that a
+/// leaf's radiosity is what its links bring.
+pub fn sent_radiosity(h: &Hierarchy, links: &[Link], b: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let terms = SenderTerms::new(h, links, Senders::Resolved);
+    (0..links.len()).into_par_iter().map(|l| terms.radiosity(l, b)).collect()
+}
+
 /// Changes below this many units of round-off of the largest radiosity say
 /// nothing about the rate: sums over thousands of links jitter by about a
 /// thousand ulps.

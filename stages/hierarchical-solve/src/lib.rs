@@ -596,14 +596,18 @@ fn output_elements(h: &Hierarchy, b: &[[f64; 3]]) -> Vec<solution::Element> {
 }
 
 fn output_links(h: &Hierarchy, links: &[Link], b: &[[f64; 3]]) -> Vec<solution::Link> {
+    // What each link sent in the last solve (its sender resolved by the
+    // kernel, gather::SenderTerms), not the sender's area mean.
+    let sent = gather::sent_radiosity(h, links, b);
     links
         .iter()
-        .map(|l| solution::Link {
+        .zip(&sent)
+        .map(|(l, s)| solution::Link {
             receiver: l.receiver,
             sender: l.sender,
             form_factor: l.form_factor as f32,
             visibility: l.visibility.unwrap_or(1.0),
-            unoccluded_irradiance: f32x3(b[h.flat(l.sender)].map(|x| x * l.form_factor)),
+            unoccluded_irradiance: f32x3(s.map(|x| x * l.form_factor)),
             occluder_distance: l.occluder_distance,
         })
         .collect()
