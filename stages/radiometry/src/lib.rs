@@ -7,6 +7,8 @@
 //! - [`subdivision`]: the 1:4 element subdivision rule and point location.
 //! - [`geometry`]: triangle corners, normals and areas in f64.
 //! - [`rays`]: ray casting over obvhs's CWBVH.
+//! - [`watertight`]: the watertight ray/triangle test (Woop et al. 2013)
+//!   the ray caster uses.
 //! - [`photometry`]: goniometric point lights: the type C distribution,
 //!   its Catmull-Rom lookup and flux, irradiance from a luminaire.
 //! - [`texture`]: texture lookups and their exact averages over elements.
@@ -24,3 +26,4 @@ pub mod rays;
 pub mod sampling;
 pub mod subdivision;
 pub mod texture;
+pub mod watertight;
