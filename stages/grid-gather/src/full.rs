@@ -639,7 +639,7 @@ impl<'a> FullGather<'a> {
                 work.classes[2] += 1;
                 v
             };
-            let b = self.senders.radiosity(sender);
+            let b = self.senders.link_radiosity(l);
             (0..3).for_each(|c| h[c] += b[c] * f * v);
         }
         h
@@ -701,7 +701,7 @@ impl<'a> FullGather<'a> {
                 fv += w[i] * f * v;
             }
             work.classes[entries[heaviest].map_or(0, |e| e.class())] += 1;
-            let b = self.senders.radiosity(s);
+            let b = self.senders.link_radiosity(l);
             (0..3).for_each(|c| h[c] += b[c] * fv);
         }
         h

@@ -279,6 +279,21 @@ impl<'a> Senders<'a> {
         }
     }
 
+    /// Radiosity link `l` sends, W/m², RGB: its unoccluded irradiance over
+    /// its form factor, which is what the solve sent through it (the
+    /// sender's parts weighted by the kernel, hierarchical-solve's
+    /// `gather::SenderTerms`), or the sender's own where the factor is 0.
+    /// The sender's area mean instead left the Cornell box's full gather
+    /// 0.2-0.6% darker per surface.
+    pub fn link_radiosity(&self, l: usize) -> [f64; 3] {
+        let link = &self.solution.links[l];
+        if link.form_factor > 0.0 {
+            link.unoccluded_irradiance.map(|e| f64::from(e) / f64::from(link.form_factor))
+        } else {
+            self.radiosity(link.sender)
+        }
+    }
+
     /// Centre of a sender (element centroid, cluster box centre), m.
     pub fn centre(&self, node: Node) -> DVec3 {
         match node {
