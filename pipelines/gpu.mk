@@ -9,7 +9,9 @@ GPU_VISIBILITY ?= hemicube
 GPU_CONVERGENCE ?= 0.99
 GPU_SHOOT_LEVEL ?= 3
 GPU_RESOLUTION ?= 128
-GPU_OVERSHOOT ?= --overshoot
+# Ambient overshooting is off by default: by the unshot magnitude
+# sum |dB| A it takes more shots (README, gpu-shoot).
+GPU_OVERSHOOT ?= --no-overshoot
 
 .PHONY: gpu bench-gpu bench-gpu-detail
 gpu: $(GPU_OUT)/image.png
@@ -31,9 +33,20 @@ $(GPU_OUT)/solution.exr $(GPU_OUT)/lightmap.exr &: $(BIN)/gpu-shoot $(GPU_OUT)/p
 	  -o $(GPU_OUT)/solution.exr --lightmap $(GPU_OUT)/lightmap.exr --convergence-log $(GPU_OUT)/convergence.ron \
 	  --plot $(GPU_OUT)/convergence.svg --report $(GPU_OUT)/gpu-shoot.report.ron
 
-$(GPU_OUT)/preview.exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(GPU_OUT)/solution.exr
+# preview(solution, image, report): grid-gather's preview of a solution of
+# the prepared scene, with its surface detail as hierarchical.mk passes it
+# (read only for a scene with textures, alpha masks or normal maps: the
+# display modulates the element's irradiance by the texture per hit, taking
+# as the element's reflectance the texture average where the solver read
+# surface.exr, as gpu-shoot does, else the material's). photon.mk uses it
+# too (the pipelines are included in name order).
+define preview
+$(2): $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(1)
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --solution $(GPU_OUT)/solution.exr -o $@ --report $(GPU_OUT)/gather.report.ron
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr --solution $(1) -o $$@ --report $(3)
+endef
+
+$(eval $(call preview,$(GPU_OUT)/solution.exr,$(GPU_OUT)/preview.exr,$(GPU_OUT)/gather.report.ron))
 
 $(GPU_OUT)/image.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(GPU_OUT)/preview.exr
 	$(BIN)/tonemap --params $(OUT)/params/tonemap.ron $(GPU_OUT)/preview.exr -o $@ --report $(GPU_OUT)/tonemap.report.ron

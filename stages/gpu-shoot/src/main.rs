@@ -159,17 +159,17 @@ fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
     ])
 }
 
-/// An SVG plot of the unshot fraction (log scale) against time.
+/// An SVG plot of the unshot magnitude fraction (log scale) against time.
 fn plot_svg(convergence: &Convergence) -> String {
     let (w, h, m) = (640.0, 400.0, 50.0);
     let t_max = convergence.shots.last().map(|s| s.seconds).unwrap_or(1.0).max(1e-9);
-    let floor = convergence.shots.iter().map(|s| s.unshot_fraction).fold(1.0f64, f64::min).max(1e-6);
+    let floor = convergence.shots.iter().map(|s| s.unshot_magnitude_fraction).fold(1.0f64, f64::min).max(1e-6);
     let decades = (-floor.log10()).ceil().max(1.0);
     let x = |t: f64| m + (w - 2.0 * m) * t / t_max;
     let y = |f: f64| m + (h - 2.0 * m) * (-f.max(1e-12).log10() / decades).min(1.0);
     let mut points = format!("{:.1},{:.1}", x(0.0), y(convergence.initial_unshot_fraction));
     for s in &convergence.shots {
-        points += &format!(" {:.1},{:.1}", x(s.seconds), y(s.unshot_fraction));
+        points += &format!(" {:.1},{:.1}", x(s.seconds), y(s.unshot_magnitude_fraction));
     }
     let mut svg = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n");
     svg += &format!("<rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>\n");
@@ -179,7 +179,7 @@ fn plot_svg(convergence: &Convergence) -> String {
         svg += &format!("<text x=\"4\" y=\"{:.1}\">1e-{d}</text><line x1=\"{m}\" x2=\"{}\" y1=\"{yy:.1}\" y2=\"{yy:.1}\" stroke=\"#ddd\"/>\n", yy + 4.0, w - m);
     }
     svg += &format!("<text x=\"{}\" y=\"{}\">{t_max:.3} s</text>\n", w - m - 30.0, h - m + 16.0);
-    svg += &format!("<text x=\"{m}\" y=\"20\">unshot fraction vs time, {} shots ({})</text>\n", convergence.shots.len(), convergence.adapter);
+    svg += &format!("<text x=\"{m}\" y=\"20\">unshot fraction (sum |dB| A / emitted) vs time, {} shots ({})</text>\n", convergence.shots.len(), convergence.adapter);
     svg += &format!("<polyline fill=\"none\" stroke=\"#c33\" stroke-width=\"1.5\" points=\"{points}\"/>\n</svg>\n");
     svg
 }
@@ -219,12 +219,13 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let mut fired = 0usize;
     let solved = solve(&device, &queue, &mesh, &manifest, surface.as_ref(), &lights, &params, &mut |shot| {
         fired += 1;
-        bar.set_position(((1.0 - shot.unshot_fraction).clamp(0.0, 1.0) * 1000.0) as u64);
+        bar.set_position(((1.0 - shot.unshot_magnitude_fraction).clamp(0.0, 1.0) * 1000.0) as u64);
         bar.set_message(format!("{fired} shots"));
     })
     .map_err(|m| schemas::Error::invalid(mesh_path, None, m))?;
     bar.finish_and_clear();
-    let final_unshot = solved.shots.last().map(|s| s.unshot_fraction).unwrap_or(solved.initial_unshot);
+    let final_unshot = solved.shots.last().map(|s| s.unshot_magnitude_fraction).unwrap_or(solved.initial_unshot);
+    let final_net = solved.shots.last().map_or(solved.initial_unshot, |s| s.unshot_fraction);
     eprintln!(
         "gpu-shoot: {} shots, {} texels, unshot {:.4}, {:.3} s shooting on {adapter}",
         solved.work.shots,
@@ -267,7 +268,8 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("subdivision_texels_added".to_string(), w.elements_added as f64),
             ("subdivision_tiles_added".to_string(), w.tiles_added as f64),
             ("subdivision_seconds".to_string(), w.subdivision_seconds),
-            ("unshot_fraction".to_string(), final_unshot),
+            ("unshot_fraction".to_string(), final_net),
+            ("unshot_magnitude_fraction".to_string(), final_unshot),
             ("setup_seconds".to_string(), w.setup_seconds),
             ("shoot_seconds".to_string(), w.shoot_seconds),
             ("seconds_per_shot".to_string(), w.shoot_seconds / (w.shots.max(1) as f64)),

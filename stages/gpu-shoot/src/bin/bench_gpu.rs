@@ -148,7 +148,7 @@ fn run(args: Args) -> Result<ExitCode, String> {
                 overshoot,
                 texels: solved.atlas.texels.len(),
                 shots: solved.work.shots,
-                unshot_fraction: solved.shots.last().map(|s| s.unshot_fraction).unwrap_or(1.0),
+                unshot_fraction: solved.shots.last().map_or(1.0, |s| s.unshot_magnitude_fraction),
                 setup_seconds: solved.work.setup_seconds,
                 shoot_seconds: solved.work.shoot_seconds,
             };

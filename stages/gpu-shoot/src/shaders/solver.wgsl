@@ -37,7 +37,7 @@ struct Selection {
     ambient: vec4<f32>,     // rgb: ambient term (004 Eq. 2.4-2.6), W/m^2
     unshot: vec4<f32>,      // rgb: sum dB A over covered texels, W
     unshot_abs: vec4<f32>,  // rgb: sum |dB| A, W
-    score: vec4<f32>,       // x: the shooter's (dB + dB') A summed over channels, W
+    score: vec4<f32>,       // x: the shooter's |dB + dB'| A summed over channels, W
 };
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -60,6 +60,7 @@ var<workgroup> sum_a: array<vec4<f32>, 256>;
 var<workgroup> sum_b: array<vec4<f32>, 256>;
 var<workgroup> best_score: array<f32, 256>;
 var<workgroup> best_index: array<u32, 256>;
+var<workgroup> best_class: array<u32, 256>;
 
 fn group_index(wg: vec3<u32>) -> u32 {
     return wg.x + wg.y * 32768u;
@@ -109,9 +110,24 @@ fn overshoot_of(t: u32, total: vec3<f32>, ambient: vec3<f32>) -> vec3<f32> {
     return max(min(tri.rho.xyz * ambient, rest), vec3<f32>(0.0));
 }
 
-// Shooter selection (one workgroup): the triangle with the largest
-// |dB + dB'| A (channels summed), lowest index on ties, and the ambient term
+// Whether candidate (class ca, key va, index ia) beats (cb, vb, ib): the
+// higher class, then the larger key, then the lower index.
+fn beats(ca: u32, va: f32, ia: u32, cb: u32, vb: f32, ib: u32) -> bool {
+    if (ca != cb) { return ca > cb; }
+    if (va != vb) { return va > vb; }
+    return ia < ib;
+}
+
+// Shooter selection (one workgroup), and the ambient term
 // A = R sum_j dB_j A_j / sum_k A_k (004 Eq. 2.4-2.6) in the same pass.
+// 004 Sec. 4.3.5 shoots the triangle with the largest (dB + dB') A
+// (channels summed, signed): class 1, key that sum, for every triangle
+// where it is positive. Overshooting leaves negative residuals (-dB') that
+// must be shot back too or the solution keeps light it should not have
+// (Feda and Purgathofer); ranking them by magnitude with the rest would let
+// a triangle that overshot a lamp's power shoot it back and forth while
+// the lamp never shoots. So a negative remainder goes only once nothing
+// positive is left: class 0, key |dB + dB'| A. Lowest index on ties.
 @compute @workgroup_size(256)
 fn select_shooter(@builtin(local_invocation_index) li: u32) {
     var s = vec4<f32>(0.0);
@@ -132,26 +148,29 @@ fn select_shooter(@builtin(local_invocation_index) li: u32) {
     }
     let total = sum_a[0].xyz;
     let ambient = params.interreflection.xyz * total / params.total_area;
-    var score = -3.4e38;
+    var rank = 0u;
+    var score = -1.0;
     var index = 0xffffffffu;
     for (var t = li; t < params.n_tris; t += WG) {
         let own = tri_power[2u * t].xyz;
         let shot = own + overshoot_of(t, total, ambient) * tris[t].area;
-        // Magnitude: a negative residual (left by overshooting) must be
-        // shot back too, or it would never converge (Feda and Purgathofer).
-        let value = abs(shot.x) + abs(shot.y) + abs(shot.z);
-        if (value > score) { score = value; index = t; }
+        let net = shot.x + shot.y + shot.z;
+        var c = 0u;
+        var value = abs(shot.x) + abs(shot.y) + abs(shot.z);
+        if (net > 0.0) { c = 1u; value = net; }
+        if (beats(c, value, t, rank, score, index)) { rank = c; score = value; index = t; }
     }
+    best_class[li] = rank;
     best_score[li] = score;
     best_index[li] = index;
     workgroupBarrier();
     for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
         if (li < stride) {
-            let other = best_score[li + stride];
-            let oi = best_index[li + stride];
-            if (other > best_score[li] || (other == best_score[li] && oi < best_index[li])) {
-                best_score[li] = other;
-                best_index[li] = oi;
+            let j = li + stride;
+            if (beats(best_class[j], best_score[j], best_index[j], best_class[li], best_score[li], best_index[li])) {
+                best_class[li] = best_class[j];
+                best_score[li] = best_score[j];
+                best_index[li] = best_index[j];
             }
         }
         workgroupBarrier();
@@ -165,7 +184,12 @@ fn select_shooter(@builtin(local_invocation_index) li: u32) {
         selection.ambient = vec4<f32>(ambient, 0.0);
         selection.unshot = vec4<f32>(total, 0.0);
         selection.unshot_abs = sum_b[0];
-        selection.score = vec4<f32>(best_score[0], 0.0, 0.0, 0.0);
+        var magnitude = 0.0;
+        if (shooter != 0xffffffffu) {
+            let shot = tri_power[2u * shooter].xyz + o * tris[shooter].area;
+            magnitude = abs(shot.x) + abs(shot.y) + abs(shot.z);
+        }
+        selection.score = vec4<f32>(magnitude, 0.0, 0.0, 0.0);
     }
 }
 
