@@ -29,11 +29,13 @@ $(PHOTON_OUT)/solution.exr $(PHOTON_OUT)/snapshots/stochastic.exr $(PHOTON_OUT)/
 	$(BIN)/photon-trace --params $(PHOTON_OUT)/params/photon-trace.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron \
 	  -o $(PHOTON_OUT)/solution.exr --snapshot-dir $(PHOTON_OUT)/snapshots --report $(PHOTON_OUT)/photon-trace.report.ron
 
-# photon_image(name, solution): the preview of one solution, tone mapped.
+# photon_image(name, solution): the preview of one solution (gpu.mk's
+# preview, with the surface detail), tone mapped. photon-trace transports
+# with each material's diffuse reflectance and treats alpha-masked surfaces
+# as opaque (it says so in its report's skipped effects), so a textured
+# scene's preview shows the texture times an irradiance solved without it.
 define photon_image
-$(PHOTON_OUT)/$(1).exr: $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(2)
-	$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --solution $(2) -o $$@ --report $(PHOTON_OUT)/$(1).gather.report.ron
+$(call preview,$(2),$(PHOTON_OUT)/$(1).exr,$(PHOTON_OUT)/$(1).gather.report.ron)
 
 $(PHOTON_OUT)/$(1).png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(PHOTON_OUT)/$(1).exr
 	$(BIN)/tonemap --params $(OUT)/params/tonemap.ron $(PHOTON_OUT)/$(1).exr -o $$@ --report $(PHOTON_OUT)/$(1).tonemap.report.ron
