@@ -24,7 +24,7 @@
 //! three are evaluated again in f64 (Sec. 4), where the f32 products are
 //! exact.
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec3Swizzles};
 use obvhs::triangle::Triangle;
 
 /// A ray in the sheared frame of the module documentation, set up once and
@@ -50,33 +50,37 @@ impl ShearedRay {
         ShearedRay { origin, axes: [kx, ky, kz], shear: [direction[kx] / dz, direction[ky] / dz, 1.0 / dz] }
     }
 
-    /// Vertex `v` relative to the origin, sheared (`x`, `y`) and the
-    /// relative coordinate along `k_z` (not yet scaled by `S_z`).
-    fn sheared(&self, v: Vec3A) -> [f32; 3] {
-        let a = v - self.origin;
-        let [kx, ky, kz] = self.axes;
-        [a[kx] - self.shear[0] * a[kz], a[ky] - self.shear[1] * a[kz], a[kz]]
-    }
-
     /// The ray parameter of the hit on `triangle` within `[t_min, t_max]`,
-    /// or infinity for a miss; both faces are hit.
+    /// or infinity for a miss; both faces are hit. The three vertices are
+    /// processed side by side, one per SIMD lane, each with the scalar
+    /// operations of the module documentation in the same order (so the
+    /// same rounding).
     pub fn intersect(&self, triangle: &Triangle, t_min: f32, t_max: f32) -> f32 {
-        let (a, b, c) = (self.sheared(triangle.v0), self.sheared(triangle.v1), self.sheared(triangle.v2));
-        let edge = |p: [f32; 3], q: [f32; 3]| q[0] * p[1] - q[1] * p[0];
-        let (mut u, mut v, mut w) = (edge(b, c), edge(c, a), edge(a, b));
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            let edge64 = |p: [f32; 3], q: [f32; 3]| f64::from(q[0]) * f64::from(p[1]) - f64::from(q[1]) * f64::from(p[0]);
-            (u, v, w) = (edge64(b, c) as f32, edge64(c, a) as f32, edge64(a, b) as f32);
+        let (v0, v1, v2) = (triangle.v0, triangle.v1, triangle.v2);
+        let relative = [
+            Vec3A::new(v0.x, v1.x, v2.x) - self.origin.x,
+            Vec3A::new(v0.y, v1.y, v2.y) - self.origin.y,
+            Vec3A::new(v0.z, v1.z, v2.z) - self.origin.z,
+        ];
+        let [kx, ky, kz] = self.axes;
+        let [sx, sy, sz] = self.shear;
+        // Lanes: vertices A, B, C.
+        let x = relative[kx] - sx * relative[kz];
+        let y = relative[ky] - sy * relative[kz];
+        // Lanes: U (edge BC), V (edge CA), W (edge AB).
+        let mut uvw = x.zxy() * y.yzx() - y.zxy() * x.yzx();
+        if uvw.cmpeq(Vec3A::ZERO).any() {
+            let edge = |p: usize, q: usize| (f64::from(x[q]) * f64::from(y[p]) - f64::from(y[q]) * f64::from(x[p])) as f32;
+            uvw = Vec3A::new(edge(1, 2), edge(2, 0), edge(0, 1));
         }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        if uvw.cmplt(Vec3A::ZERO).any() && uvw.cmpgt(Vec3A::ZERO).any() {
             return f32::INFINITY;
         }
-        let det = u + v + w;
+        let det = uvw.x + uvw.y + uvw.z;
         if det == 0.0 {
             return f32::INFINITY;
         }
-        let sz = self.shear[2];
-        let t = (u * sz * a[2] + v * sz * b[2] + w * sz * c[2]) / det;
+        let t = uvw.dot(sz * relative[kz]) / det;
         if t >= t_min && t <= t_max {
             t
         } else {
