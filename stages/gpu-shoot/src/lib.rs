@@ -549,9 +549,9 @@ pub fn solve(
     let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
     let total_area: f64 = tris.iter().map(|t| t.area as f64).sum();
     let mut interreflection = [0.0f32; 4];
-    for c in 0..3 {
+    for (c, r) in interreflection.iter_mut().take(3).enumerate() {
         let mean_rho: f64 = tris.iter().map(|t| t.rho[c] as f64 * t.area as f64).sum::<f64>() / total_area;
-        interreflection[c] = (1.0 / (1.0 - mean_rho).max(1e-6)) as f32;
+        *r = (1.0 / (1.0 - mean_rho).max(1e-6)) as f32;
     }
     let mut emitted = [0.0f64; 3];
     for (t, tri) in tris.iter().enumerate() {

@@ -353,8 +353,8 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile],
         let mut sum = [0.0f64; 3];
         let mut area = 0.0f64;
         for child in &elements[first..first + 4] {
-            for k in 0..3 {
-                sum[k] += child.radiosity[k] as f64 * child.area as f64;
+            for (s, b) in sum.iter_mut().zip(child.radiosity) {
+                *s += b as f64 * child.area as f64;
             }
             area += child.area as f64;
         }

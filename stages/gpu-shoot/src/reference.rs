@@ -12,9 +12,9 @@ use glam::DVec3;
 pub fn triangle_power(atlas: &Atlas, residual: &[[f32; 3]], t: usize) -> [f64; 3] {
     let r = atlas.triangles[t];
     let mut sum = [0.0; 3];
-    for k in r.first as usize..(r.first + r.count) as usize {
-        for c in 0..3 {
-            sum[c] += residual[k][c] as f64 * atlas.texels[k].area as f64;
+    for (d_b, texel) in residual.iter().zip(&atlas.texels).skip(r.first as usize).take(r.count as usize) {
+        for (s, d) in sum.iter_mut().zip(d_b) {
+            *s += *d as f64 * texel.area as f64;
         }
     }
     sum
