@@ -207,8 +207,10 @@ pub struct Shot {
     pub samples: u32,
     /// Fraction of the emitted power still unshot after this shot, net:
     /// `|sum_i ΔB_i A_i| / sum emitted` (channels summed). Overshooting
-    /// leaves negative residuals for power already sent ahead; the net sum
-    /// is the power the radiosity still lacks.
+    /// leaves negative residuals for power already sent ahead, which cancel
+    /// positive ones here: this net figure does not bound the remaining
+    /// error; gpu-shoot stops on the magnitude sum `sum_i |ΔB_i| A_i`
+    /// (its report's `unshot_magnitude_fraction`).
     pub unshot_fraction: f64,
     /// The same with magnitudes, `sum_i |ΔB_i| A_i / sum emitted`: 0 only
     /// when every residual is 0.

@@ -102,7 +102,11 @@ pub struct Link {
     pub form_factor: f32,
     /// Fraction of receiver-sender rays not blocked, in [0, 1].
     pub visibility: f32,
-    /// Unoccluded irradiance F_rs B_s at the receiver, W/m², RGB.
+    /// Unoccluded irradiance F_rs B_s at the receiver, W/m², RGB, where B_s
+    /// is what the last solve sent through the link: the sender's leaves
+    /// weighted by the kernel seen from the receiver, not their area mean
+    /// (so `E_u / F` is that kernel-weighted radiosity, which the full
+    /// gather resamples).
     pub unoccluded_irradiance: [f32; 3],
     /// Distance from the receiver to the nearest occluder found by the
     /// visibility rays, m; +inf when no ray was blocked.
