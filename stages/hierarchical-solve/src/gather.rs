@@ -26,6 +26,7 @@
 use crate::elements::Hierarchy;
 use crate::links::Link;
 use crate::mirrors::Couplings;
+use crate::rows::Rows;
 use radiometry::form_factor::point_to_one_sided_polygon;
 use rayon::prelude::*;
 use schemas::solution::Node;
@@ -362,14 +363,7 @@ pub enum Senders {
 /// receiver sees keep the sender's mean. The weights are geometric,
 /// computed once per solve, and sum to 1, so `||M||` and the stopping rule
 /// are unchanged.
-struct SenderTerms {
-    /// `start[l]..start[l + 1]`: the terms of link `l`.
-    start: Vec<usize>,
-    /// Dense index of each term's node.
-    node: Vec<usize>,
-    /// Each term's weight `w_j`.
-    weight: Vec<f64>,
-}
+struct SenderTerms(Rows<f64>);
 
 impl SenderTerms {
     fn new(h: &Hierarchy, links: &[Link], senders: Senders) -> Self {
@@ -380,16 +374,7 @@ impl SenderTerms {
                 Senders::Resolved => Self::of_link(h, l),
             })
             .collect();
-        let mut terms = SenderTerms { start: Vec::with_capacity(links.len() + 1), node: Vec::new(), weight: Vec::new() };
-        terms.start.push(0);
-        for list in per_link {
-            for (node, weight) in list {
-                terms.node.push(node);
-                terms.weight.push(weight);
-            }
-            terms.start.push(terms.node.len());
-        }
-        terms
+        SenderTerms(Rows::from_lists(per_link))
     }
 
     /// The terms `(dense index, w_j)` of link `l`'s sender.
@@ -425,7 +410,7 @@ impl SenderTerms {
     /// The radiosity link `l` sends, `sum_j w_j B_j`.
     fn radiosity(&self, l: usize, b: &[[f64; 3]]) -> [f64; 3] {
         let mut sent = [0.0; 3];
-        for (&node, &w) in self.node[self.start[l]..self.start[l + 1]].iter().zip(&self.weight[self.start[l]..self.start[l + 1]]) {
+        for (node, &w) in self.0.row(l) {
             for c in 0..3 {
                 sent[c] += w * b[node][c];
             }

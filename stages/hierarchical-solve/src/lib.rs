@@ -73,6 +73,7 @@ pub mod links;
 pub mod luminaires;
 pub mod mirrors;
 pub mod nodes;
+pub mod rows;
 pub mod transfer;
 pub mod transmission;
 pub mod visibility;

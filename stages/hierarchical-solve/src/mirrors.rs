@@ -52,6 +52,7 @@
 
 use crate::elements::Hierarchy;
 use crate::links::Allowance;
+use crate::rows::Rows;
 use glam::DVec3;
 use radiometry::form_factor::{point_kernel, triangle_to_polygon, AreaFactor};
 use radiometry::rays::SceneRays;
@@ -140,12 +141,9 @@ pub struct Windows {
 /// index, as the gather's links).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Couplings {
-    /// `offsets[i]..offsets[i + 1]` are node `i`'s couplings.
-    offsets: Vec<usize>,
-    /// Dense index of each coupling's sender (an input triangle's root).
-    senders: Vec<usize>,
-    /// `coefficient x F x V'`, RGB.
-    weights: Vec<[f64; 3]>,
+    /// Row `i`: node `i`'s couplings, each the dense index of its sender
+    /// (an input triangle's root) and `coefficient x F x V'`, RGB.
+    rows: Rows<[f64; 3]>,
     /// Per node, what its couplings' light varies by over it: the sum of
     /// `coefficient (F_max - F_min) V' B_s` over them (largest channel,
     /// `F` at the receiver quadrature's points, `B` when they were built).
@@ -166,10 +164,8 @@ impl Couplings {
     /// Irradiance node `i` receives through the windows from radiosity `b`.
     pub fn gather(&self, i: usize, b: &[[f64; 3]]) -> [f64; 3] {
         let mut g = [0.0; 3];
-        if let Some(range) = self.offsets.get(i..=i + 1) {
-            for (w, &s) in self.weights[range[0]..range[1]].iter().zip(&self.senders[range[0]..range[1]]) {
-                (0..3).for_each(|c| g[c] += w[c] * b[s][c]);
-            }
+        for (s, w) in self.rows.row(i) {
+            (0..3).for_each(|c| g[c] += w[c] * b[s][c]);
         }
         g
     }
@@ -177,8 +173,7 @@ impl Couplings {
     /// Sum of node `i`'s weights, largest channel (its share of the
     /// gather's contraction bound).
     pub fn row_sum(&self, i: usize) -> f64 {
-        let Some(range) = self.offsets.get(i..=i + 1) else { return 0.0 };
-        (0..3).map(|c| self.weights[range[0]..range[1]].iter().map(|w| w[c]).sum::<f64>()).fold(0.0, f64::max)
+        (0..3).map(|c| self.rows.row(i).map(|(_, w)| w[c]).sum::<f64>()).fold(0.0, f64::max)
     }
 
     /// The leaves to split so that the light through windows is resolved
@@ -199,12 +194,12 @@ impl Couplings {
 
     /// Number of couplings.
     pub fn len(&self) -> usize {
-        self.senders.len()
+        self.rows.len()
     }
 
     /// Whether there is none.
     pub fn is_empty(&self) -> bool {
-        self.senders.is_empty()
+        self.rows.is_empty()
     }
 }
 
@@ -363,14 +358,7 @@ impl Windows {
             couplings.spread[i] = spread;
             couplings.rays += rays;
         }
-        couplings.offsets.push(0);
-        for row in rows {
-            for (s, w) in row {
-                couplings.senders.push(s);
-                couplings.weights.push(w);
-            }
-            couplings.offsets.push(couplings.senders.len());
-        }
+        couplings.rows = Rows::from_lists(rows);
         couplings
     }
 
