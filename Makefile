@@ -61,7 +61,7 @@ $(BINS) &: FORCE
 
 # The benchmark drivers (bench-solve, bench-scale, sweep, bench-gather's
 # summary, bench-structured).
-BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep bench-gather bench-structured)
+BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep bench-gather bench-structured bench-mask)
 $(BENCH_BINS) &: FORCE
 	@cargo build --release --quiet -p bench --bins
 

@@ -79,7 +79,7 @@ $(OUT)/final.exr $(OUT)/final.diagnostics.exr &: $(BIN)/grid-gather $(OUT)/param
 $(OUT)/final.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(OUT)/final.exr
 	$(BIN)/tonemap --params $(OUT)/params/tonemap.ron $(OUT)/final.exr -o $@ --report $(OUT)/final-tonemap.report.ron
 
-.PHONY: full bench-gather
+.PHONY: full bench-gather bench-mask
 full: $(OUT)/final.png
 
 # Tables 1-2 of paper 000 in shape: brute force and the full gather (with
@@ -124,3 +124,24 @@ bench-gather: $(BINS) $(BENCH_BINS) $(BIN)/mask
 	$(BIN)/tonemap --operator $(OPERATOR) $(BENCH_PLANTS)/preview.exr -o $(BENCH_PLANTS)/preview.png
 	$(BIN)/mask $(BENCH_PLANTS)/preview.png -o $(BENCH_PLANTS)/threshold.exr
 	$(call bench_runs,$(BENCH_PLANTS),$(BP_ARGS),128,4 8 16)
+
+# Paper 000 Table 1 in shape (never in `make test`): the full gather with
+# and without the visual mask on a room whose floor is a fine, high-contrast
+# checkerboard (bench-mask scene, bench/src/mask/), unclustered, at
+# BENCH_MASK_SIZE^2 pixels, against a brute-force reference of
+# BENCH_MASK_REFERENCE samples per link. The mask reads the tone-mapped
+# preview, which shows the texture (grid-gather --surface). Table (rays,
+# form factors, time, relative RMSE over the image and on the floor, share
+# of pixels whose error exceeds the mask's threshold) in
+# out/bench-mask/summary.txt.
+BENCH_MASK_SIZE ?= 128
+BENCH_MASK_REFERENCE ?= 64
+BENCH_MASK := out/bench-mask
+BM_ARGS = --mesh $(BENCH_MASK)/mesh.exr --manifest $(BENCH_MASK)/manifest.ron --surface $(BENCH_MASK)/surface.exr --solution $(BENCH_MASK)/solution.exr --width $(BENCH_MASK_SIZE) --height $(BENCH_MASK_SIZE)
+bench-mask: $(BINS) $(BENCH_BINS) $(BIN)/mask
+	$(BIN)/bench-mask scene --dir $(BENCH_MASK)/scene --width $(BENCH_MASK_SIZE) --height $(BENCH_MASK_SIZE)
+	$(MAKE) --no-print-directory SCENE=$(BENCH_MASK)/scene/scene.ron OUT=$(BENCH_MASK) CLUSTERS=0 WIDTH=$(BENCH_MASK_SIZE) HEIGHT=$(BENCH_MASK_SIZE) $(BENCH_MASK)/threshold.exr
+	$(BIN)/grid-gather $(BM_ARGS) --brute --brute-samples $(BENCH_MASK_REFERENCE) -o $(BENCH_MASK)/reference.exr --report $(BENCH_MASK)/reference.report.ron
+	$(BIN)/grid-gather $(BM_ARGS) --mode full -o $(BENCH_MASK)/unmasked.exr --report $(BENCH_MASK)/unmasked.report.ron
+	$(BIN)/grid-gather $(BM_ARGS) --mode full --threshold $(BENCH_MASK)/threshold.exr -o $(BENCH_MASK)/masked.exr --report $(BENCH_MASK)/masked.report.ron
+	$(BIN)/bench-mask summary --dir $(BENCH_MASK) -o $(BENCH_MASK)/summary.txt unmasked masked

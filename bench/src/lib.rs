@@ -4,6 +4,7 @@
 //! and the summary of `make bench-gather` ([`gather`], `bench-gather`).
 
 pub mod gather;
+pub mod mask;
 pub mod structured;
 pub mod sweep;
 
