@@ -93,7 +93,15 @@ fn summary(dir: &Path, floor: &str, names: &[String], output: &Path) -> Result<(
         let image = image_of(&dir.join(format!("{name}.exr")), size)?;
         runs.push((GatherRun::of(name, &report, 0.0), table::errors(&image, &reference, &floor_pixels, &threshold.contrast)));
     }
-    let text = format!("{} floor pixels of {}\n{}", floor_pixels.iter().filter(|&&f| f).count(), floor_pixels.len(), table::summary(&runs));
+    let floor_mean = |values: &[f32]| table::mean_over(values, &floor_pixels);
+    let text = format!(
+        "{} floor pixels of {}; the mask on the floor: mean threshold contrast {:.3}, mean elevation {:.2}\n{}",
+        floor_pixels.iter().filter(|&&f| f).count(),
+        floor_pixels.len(),
+        floor_mean(&threshold.contrast),
+        floor_mean(&threshold.elevation),
+        table::summary(&runs)
+    );
     write_bytes_atomically(output, text.as_bytes())?;
     print!("{text}");
     Ok(())

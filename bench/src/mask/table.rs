@@ -84,6 +84,16 @@ pub fn errors(image: &HdrImage, reference: &HdrImage, floor: &[bool], contrast: 
     }
 }
 
+/// The mean of `values` over the pixels `keep` selects; 0 where none.
+pub fn mean_over(values: &[f32], keep: &[bool]) -> f64 {
+    let (sum, n) = values.iter().zip(keep).filter(|(_, &k)| k).fold((0.0, 0usize), |(s, n), (&v, _)| (s + f64::from(v), n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}
+
 /// The table: a heading, per run its rays, form factors, time and errors,
 /// and, for two or more runs, the last run's rays and time over the
 /// first's (the masked run over the unmasked one, as `make bench-mask`
@@ -135,6 +145,7 @@ mod tests {
         // Over the threshold: pixel 0 (0.25 > 0.2), pixel 3 (1 > 1.2: no); pixel 2 is not covered.
         assert!(close(e.over_mask, 1.0 / 3.0), "{e:?}");
         assert_eq!(floor_pixels(&grey([1.0; 4]), 7), [false; 4], "no surfaces, no floor");
+        assert_eq!((mean_over(&[1.0, 5.0, 7.0, 2.0], &floor), mean_over(&[1.0; 4], &[false; 4])), (1.5, 0.0));
     }
 
     #[test]

@@ -28,6 +28,19 @@
 //!   the true slope is lower than the ratio, so the radiance threshold it
 //!   gives is smaller than the exact one: conservative.
 //!
+//! ## What the mask sees: textures come with the preview
+//!
+//! The stage reads only the tone-mapped preview, never the scene: surface
+//! detail masks errors exactly as far as the preview shows it. The
+//! pipelines render that preview with grid-gather `--surface surface.exr`
+//! (`make`, `make full MASK=1`, `make gpu`, `make photon`), which shades
+//! each pixel with its texel's reflectance `rho(x)`, so a textured floor's
+//! pattern reaches the contrast pyramid and raises `T_e` over it; the
+//! stage needs no texture of its own. A preview made without `--surface`
+//! shows each material's mean reflectance and the mask then sees no
+//! texture. `make bench-mask` (bench/src/mask/) measures what this buys on
+//! a checkerboard floor (paper 000 Table 1 in shape).
+//!
 //! ## Parameters
 //!
 //! | name | type | meaning | default |
