@@ -223,6 +223,9 @@ pub struct Gpu {
     receive: wgpu::ComputePipeline,
     /// The adaptive subdivision's count pass and its per-triangle counters.
     count: Option<(wgpu::ComputePipeline, wgpu::Buffer)>,
+    /// Diffuse transmission's receiver pass (storing each texel's
+    /// irradiance) and its pass adding `rho_d H + tau_d H_twin`.
+    transmit: Option<[wgpu::ComputePipeline; 2]>,
     render: wgpu::RenderPipeline,
     layer_views: Vec<wgpu::TextureView>,
     depth_view: wgpu::TextureView,
@@ -280,6 +283,9 @@ pub struct Setup<'a> {
     pub masks: Option<(&'a [[f32; 4]], &'a [f32])>,
     /// Build the visibility count of the adaptive subdivision.
     pub adaptive: bool,
+    /// Per texel, its diffuse transmittance (xyz) and the bits of its
+    /// twin texel (w, `u32::MAX` for none), where a material transmits.
+    pub transmission: Option<&'a [[f32; 4]]>,
 }
 
 const SAMPLE_SIZE: u64 = std::mem::size_of::<GpuSample>() as u64;
@@ -377,6 +383,14 @@ impl Gpu {
         if counts.is_some() {
             entries.push(storage(12, c, false));
         }
+        // Diffuse transmission: the table and the irradiance per texel,
+        // allocated only where a material transmits.
+        let transmission = setup.transmission.map(|table| {
+            [init("transmission", bytemuck::cast_slice(table), wgpu::BufferUsages::STORAGE), init("received", &vec![0u8; table.len() * 16], rw)]
+        });
+        if transmission.is_some() {
+            entries.extend([storage(13, c, true), storage(14, c, false)]);
+        }
         let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("solver"), entries: &entries });
         let buffers = [&params, &texels, &radiosity, &residual, &tris, &groups, &tri_power, &selection, &samples, &ldt];
         let mut bind: Vec<wgpu::BindGroupEntry> =
@@ -385,6 +399,9 @@ impl Gpu {
         bind.push(wgpu::BindGroupEntry { binding: 11, resource: vertices.as_entire_binding() });
         if let Some(buffer) = &counts {
             bind.push(wgpu::BindGroupEntry { binding: 12, resource: buffer.as_entire_binding() });
+        }
+        for (k, buffer) in transmission.iter().flatten().enumerate() {
+            bind.push(wgpu::BindGroupEntry { binding: 13 + k as u32, resource: buffer.as_entire_binding() });
         }
         let compute_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("solver"), layout: &compute_layout, entries: &bind });
         let compute_pipeline_layout =
@@ -465,6 +482,7 @@ impl Gpu {
             finish: pipeline("finish_shooter"),
             receive: pipeline("receive"),
             count: counts.map(|buffer| (pipeline("count_visible"), buffer)),
+            transmit: transmission.map(|_| [pipeline("receive_translucent"), pipeline("transmit")]),
             render,
             layer_views,
             depth_view,
@@ -513,7 +531,10 @@ impl Gpu {
     /// Renders the visibility maps of one batch of samples and runs the
     /// receiver pass over every texel.
     pub fn shoot_batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool) {
-        self.batch(device, queue, params, hemicube, &self.receive);
+        match &self.transmit {
+            Some(passes) => self.batch(device, queue, params, hemicube, passes),
+            None => self.batch(device, queue, params, hemicube, std::slice::from_ref(&self.receive)),
+        }
     }
 
     /// Renders the visibility maps of one batch of samples and adds every
@@ -521,7 +542,7 @@ impl Gpu {
     /// have been built with `adaptive`.
     pub fn count_batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool) {
         let (pipeline, _) = self.count.as_ref().expect("a solver built for adaptive subdivision");
-        self.batch(device, queue, params, hemicube, pipeline);
+        self.batch(device, queue, params, hemicube, std::slice::from_ref(pipeline));
     }
 
     /// Per triangle `[n_r, n_v]` since the last call (which clears them).
@@ -532,7 +553,9 @@ impl Gpu {
         bytemuck::pod_collect_to_vec(&bytes)
     }
 
-    fn batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool, pass: &wgpu::ComputePipeline) {
+    /// Renders the maps of a batch of samples, then runs `passes` over
+    /// every texel, in order.
+    fn batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool, passes: &[wgpu::ComputePipeline]) {
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let mut encoder = device.create_command_encoder(&Default::default());
         for sample in 0..params.sample_count {
@@ -570,7 +593,9 @@ impl Gpu {
         }
         let groups = self.texel_count.div_ceil(64);
         let (x, y) = if groups <= 65535 { (groups.max(1), 1) } else { (65535, groups.div_ceil(65535)) };
-        self.dispatch(&mut encoder, pass, x, y);
+        for pass in passes {
+            self.dispatch(&mut encoder, pass, x, y);
+        }
         queue.submit([encoder.finish()]);
     }
 

@@ -49,6 +49,7 @@ pub mod output;
 pub mod reference;
 pub mod testing;
 pub mod tiling;
+pub mod transmission;
 
 use atlas::Atlas;
 use detail::{Detail, TexelDetail};
@@ -245,6 +246,9 @@ pub struct Work {
     pub tiles_added: u64,
     /// Seconds it took (counting, splitting, copying down, rebuilding).
     pub subdivision_seconds: f64,
+    /// Triangles of translucent materials that are not two-sided: they
+    /// transmit nothing ([`transmission`]).
+    pub one_sided_translucent: u64,
 }
 
 /// The result of a solve.
@@ -307,8 +311,8 @@ struct Context<'a> {
     params: &'a Params,
     /// Region size per object, from the input mesh.
     sizes: Vec<u32>,
-    /// Per input triangle: whether it has a twin.
-    twinned: Vec<bool>,
+    /// Per input triangle: its twin, if any.
+    twins: Vec<Option<u32>>,
     layers: u32,
     ldt_capacity: usize,
 }
@@ -322,6 +326,8 @@ struct Built {
     /// Per tile: whether a normal map perturbs its texels' normals.
     normal_mapped: Vec<bool>,
     mask_texels: u64,
+    /// Translucent input triangles that transmit nothing (not two-sided).
+    one_sided: u64,
 }
 
 /// Initial radiosity and residual per covered texel of a new atlas.
@@ -421,13 +427,14 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
         .zip(tiles)
         .flat_map(|(t, tile)| t.vertices.map(|v| {
             let p = mesh.positions[v as usize];
-            [p[0], p[1], p[2], if c.twinned[tile.root as usize] { 2.0 } else { 1.0 }]
+            [p[0], p[1], p[2], if c.twins[tile.root as usize].is_some() { 2.0 } else { 1.0 }]
         }))
         .collect();
     let max_groups = atlas.triangles.iter().map(|t| t.group_count).max().unwrap_or(1).max(1);
     // The alpha masks for the visibility maps (004 Sec. 4.3.4), only where
     // some triangle is masked.
     let masks = detail.as_ref().filter(|d| d.masked(mesh)).map(|d| d.mask_tables(mesh));
+    let transmission = transmission::table(&atlas, tiles, c.mesh, manifest, &c.twins);
     let (radiosity, residual) = match init {
         Some(init) => init(&atlas),
         None => (emission.clone(), emission),
@@ -447,11 +454,13 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
             ldt_capacity: c.ldt_capacity,
             masks: masks.as_ref().map(|(t, m)| (t.as_slice(), m.as_slice())),
             adaptive: c.params.adaptive.is_some(),
+            transmission: transmission.as_ref().map(|(table, _)| table.as_slice()),
         },
     );
     let normal_mapped = (0..tiles.len()).map(|t| detail.as_ref().is_some_and(|d| d.normal_mapped(mesh, t))).collect();
     let mask_texels = masks.as_ref().map_or(0, |(_, m)| m.len() as u64);
-    Built { atlas, texels, tris, gpu, normal_mapped, mask_texels }
+    let one_sided = transmission.map_or(0, |(_, n)| n as u64);
+    Built { atlas, texels, tris, gpu, normal_mapped, mask_texels, one_sided }
 }
 
 /// The samples of tile `shooter` (positions, frames, polygons; the GPU
@@ -539,7 +548,7 @@ pub fn solve(
         surface,
         params,
         sizes: atlas::object_sizes(mesh, manifest.objects.len(), params.texels, params.min_size, params.max_size),
-        twinned: mesh.twins().iter().map(Option::is_some).collect(),
+        twins: mesh.twins(),
         layers,
         ldt_capacity: lights.iter().map(|l| light_table(l).len()).max().unwrap_or(4),
     };
@@ -580,7 +589,7 @@ pub fn solve(
         interreflection,
         ..Default::default()
     };
-    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), mask_texels: built.mask_texels, ..Default::default() };
+    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), mask_texels: built.mask_texels, one_sided_translucent: built.one_sided, ..Default::default() };
     let shooting = Instant::now();
     let mut shots = Vec::new();
     let mut unshot_lights: f64 = light_flux.iter().map(|f| 3.0 * f).sum();

@@ -145,11 +145,13 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
 
 /// The effects of the scene gpu-shoot does not simulate; textures, alpha
 /// masks and normal maps are simulated when `surface` (the artifact that
-/// holds them) was given.
-fn skipped(effects: &Effects, surface: bool) -> Vec<String> {
+/// holds them) was given, diffuse transmission where its material is
+/// two-sided (`one_sided` triangles are not).
+fn skipped(effects: &Effects, surface: bool, one_sided: u64) -> Vec<String> {
     let without = !surface;
+    let transmits = format!("diffuse transmission: {one_sided} triangles of translucent materials that are not two-sided transmit nothing (their back face has no texels; make the material two_sided)");
     Effects::skipped(&[
-        (effects.diffuse_transmission, "diffuse transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.1, a later issue)"),
+        (one_sided > 0, transmits.as_str()),
         (effects.specular_reflection, "specular reflection: not simulated by gpu-shoot yet (004 Sec. 4.3.2); mirrors keep their diffuse part"),
         (effects.specular_transmission, "specular transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.3)"),
         (effects.alpha_masks && without, "alpha masks: surfaces are treated as opaque (no --surface given)"),
@@ -278,7 +280,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         if args.surface.is_some() && !detailed {
             notes.push("surface.exr not read: the scene has no texture, alpha mask or normal map".into());
         }
-        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects, surface.is_some()), notes))?;
+        outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects, surface.is_some(), w.one_sided_translucent), notes))?;
     }
     outputs.keep()?;
     Ok(ExitCode::SUCCESS)

@@ -533,6 +533,13 @@ fn count_visible(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_work
     }
 }
 
+// Whether texel k receives this shot: not the shooter's, and not removed
+// by an alpha mask (a texel it removes does not exist, 004 Sec. 4.3.4).
+fn receives(k: u32) -> bool {
+    let texel = texels[k];
+    return bitcast<u32>(texel.normal.w) != params.shooter && texel.position.w > 0.0;
+}
+
 // The receiver pass (004 Sec. 2.3, Eq. 2.2 / 4.1-4.3): every covered texel
 // tests its depth against each sample's visibility map and gathers
 //   area sample:  H += dB_s A_s cos_s cos_r / (pi d^2 + A_s)
@@ -541,11 +548,17 @@ fn count_visible(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_work
 @compute @workgroup_size(64)
 fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
     let k = id.x + id.y * nw.x * 64u;
-    if (k >= params.n_texels) { return; }
+    if (k >= params.n_texels || !receives(k)) { return; }
+    let db = texels[k].rho.xyz * irradiance(k);
+    radiosity[k] += vec4<f32>(db, 0.0);
+    residual[k] += vec4<f32>(db, 0.0);
+}
+
+// The irradiance H that the texel k (one that `receives`) gathers from
+// the batch's samples through the visibility maps.
+fn irradiance(k: u32) -> vec3<f32> {
     let texel = texels[k];
     let tri = bitcast<u32>(texel.normal.w);
-    // A texel an alpha mask removes does not exist (004 Sec. 4.3.4).
-    if (tri == params.shooter || texel.position.w <= 0.0) { return; }
     let p = texel.position.xyz;
     let nr = texel.normal.xyz;
     let ns = texel.shading.xyz;
@@ -600,7 +613,42 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
             h += s.power.xyz * area_transfer(k, p, nr, ns, s, d2, cos_s, cos_r);
         }
     }
-    let db = texel.rho.xyz * h;
+    return h;
+}
+
+// Diffuse transmission (004 Sec. 4.3.1, Eq. 4.4), bound only where a
+// material transmits. A translucent two-sided surface is two faces, each
+// with its own texels; per texel, `transmission` holds its tau_d (xyz)
+// and the texel of the other face at the same place (w, bits; NONE where
+// it has none). The light H reaching one face leaves rho_d H from that
+// face and tau_d H from the other: the paper's two shots of what arrives,
+// weighted rho_d / (rho_d + tau_d) and tau_d / (rho_d + tau_d) out of
+// (rho_d + tau_d) H. So the receiver pass first stores every texel's H
+// (`receive_translucent`), then each texel adds
+//   dB = rho_d H + tau_d H_twin                      (`transmit`)
+// to its radiosity and residual: the same scene means the same as in
+// hierarchical-solve (B = E + rho_d H + tau_d H_twin).
+@group(0) @binding(13) var<storage, read> transmission: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read_write> received: array<vec4<f32>>;
+
+const NONE: u32 = 0xffffffffu;
+
+@compute @workgroup_size(64)
+fn receive_translucent(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
+    let k = id.x + id.y * nw.x * 64u;
+    if (k >= params.n_texels) { return; }
+    var h = vec3<f32>(0.0);
+    if (receives(k)) { h = irradiance(k); }
+    received[k] = vec4<f32>(h, 0.0);
+}
+
+@compute @workgroup_size(64)
+fn transmit(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
+    let k = id.x + id.y * nw.x * 64u;
+    if (k >= params.n_texels || texels[k].position.w <= 0.0) { return; }
+    var db = texels[k].rho.xyz * received[k].xyz;
+    let twin = bitcast<u32>(transmission[k].w);
+    if (twin != NONE) { db += transmission[k].xyz * received[twin].xyz; }
     radiosity[k] += vec4<f32>(db, 0.0);
     residual[k] += vec4<f32>(db, 0.0);
 }
