@@ -130,18 +130,26 @@ bench-gather: $(BINS) $(BENCH_BINS) $(BIN)/mask
 # checkerboard (bench-mask scene, bench/src/mask/), unclustered, at
 # BENCH_MASK_SIZE^2 pixels, against a brute-force reference of
 # BENCH_MASK_REFERENCE samples per link. The mask reads the tone-mapped
-# preview, which shows the texture (grid-gather --surface). Table (rays,
+# preview, which shows the texture (grid-gather --surface); the row
+# masked-untextured takes its mask from a preview without --surface (the
+# mask blind to the texture). Table (rays,
 # form factors, time, relative RMSE over the image and on the floor, share
 # of pixels whose error exceeds the mask's threshold) in
 # out/bench-mask/summary.txt.
 BENCH_MASK_SIZE ?= 128
 BENCH_MASK_REFERENCE ?= 64
 BENCH_MASK := out/bench-mask
-BM_ARGS = --mesh $(BENCH_MASK)/mesh.exr --manifest $(BENCH_MASK)/manifest.ron --surface $(BENCH_MASK)/surface.exr --solution $(BENCH_MASK)/solution.exr --width $(BENCH_MASK_SIZE) --height $(BENCH_MASK_SIZE)
+BM_UNTEXTURED = --mesh $(BENCH_MASK)/mesh.exr --manifest $(BENCH_MASK)/manifest.ron --solution $(BENCH_MASK)/solution.exr --width $(BENCH_MASK_SIZE) --height $(BENCH_MASK_SIZE)
+BM_ARGS = $(BM_UNTEXTURED) --surface $(BENCH_MASK)/surface.exr
 bench-mask: $(BINS) $(BENCH_BINS) $(BIN)/mask
+	@mkdir -p $(BENCH_MASK)/untextured
 	$(BIN)/bench-mask scene --dir $(BENCH_MASK)/scene --width $(BENCH_MASK_SIZE) --height $(BENCH_MASK_SIZE)
 	$(MAKE) --no-print-directory SCENE=$(BENCH_MASK)/scene/scene.ron OUT=$(BENCH_MASK) CLUSTERS=0 WIDTH=$(BENCH_MASK_SIZE) HEIGHT=$(BENCH_MASK_SIZE) $(BENCH_MASK)/threshold.exr
 	$(BIN)/grid-gather $(BM_ARGS) --brute --brute-samples $(BENCH_MASK_REFERENCE) -o $(BENCH_MASK)/reference.exr --report $(BENCH_MASK)/reference.report.ron
 	$(BIN)/grid-gather $(BM_ARGS) --mode full -o $(BENCH_MASK)/unmasked.exr --report $(BENCH_MASK)/unmasked.report.ron
 	$(BIN)/grid-gather $(BM_ARGS) --mode full --threshold $(BENCH_MASK)/threshold.exr -o $(BENCH_MASK)/masked.exr --report $(BENCH_MASK)/masked.report.ron
-	$(BIN)/bench-mask summary --dir $(BENCH_MASK) -o $(BENCH_MASK)/summary.txt unmasked masked
+	$(BIN)/grid-gather $(BM_UNTEXTURED) --mode preview -o $(BENCH_MASK)/untextured/preview.exr --report $(BENCH_MASK)/untextured/preview.report.ron
+	$(BIN)/tonemap --params $(BENCH_MASK)/params/tonemap.ron $(BENCH_MASK)/untextured/preview.exr -o $(BENCH_MASK)/untextured/preview.png
+	$(BIN)/mask --params $(BENCH_MASK)/params/mask.ron $(BENCH_MASK)/untextured/preview.png -o $(BENCH_MASK)/untextured/threshold.exr
+	$(BIN)/grid-gather $(BM_ARGS) --mode full --threshold $(BENCH_MASK)/untextured/threshold.exr -o $(BENCH_MASK)/masked-untextured.exr --report $(BENCH_MASK)/masked-untextured.report.ron
+	$(BIN)/bench-mask summary --dir $(BENCH_MASK) -o $(BENCH_MASK)/summary.txt unmasked masked-untextured masked

@@ -99,11 +99,11 @@ pub fn mean_over(values: &[f32], keep: &[bool]) -> f64 {
 /// first's (the masked run over the unmasked one, as `make bench-mask`
 /// orders them).
 pub fn summary(runs: &[(GatherRun, MaskError)]) -> String {
-    let mut out = format!("{:<10} {:>12} {:>12} {:>12} {:>8} {:>10} {:>10} {:>10}\n", "run", "vis_rays", "class_rays", "ff_evals", "time_s", "rel_rmse", "floor_rmse", "over_mask");
+    let mut out = format!("{:<17} {:>12} {:>12} {:>12} {:>8} {:>10} {:>10} {:>10}\n", "run", "vis_rays", "class_rays", "ff_evals", "time_s", "rel_rmse", "floor_rmse", "over_mask");
     for (r, e) in runs {
         let _ = writeln!(
             out,
-            "{:<10} {:>12} {:>12} {:>12} {:>8.2} {:>10.3e} {:>10.3e} {:>9.2}%",
+            "{:<17} {:>12} {:>12} {:>12} {:>8.2} {:>10.3e} {:>10.3e} {:>9.2}%",
             r.name, r.visibility_rays as i64, r.classification_rays as i64, r.form_factors as i64, r.time_s, e.image, e.floor, 100.0 * e.over_mask
         );
     }
@@ -157,7 +157,7 @@ mod tests {
         let e = MaskError { image: 1e-3, floor: 2e-3, over_mask: 0.125 };
         let table = summary(&[(unmasked, e), (masked, e)]);
         let lines: Vec<&str> = table.lines().collect();
-        assert_eq!(lines[1], "unmasked            800          200            0     4.00   1.000e-3   2.000e-3     12.50%");
+        assert_eq!(lines[1], "unmasked                   800          200            0     4.00   1.000e-3   2.000e-3     12.50%");
         assert_eq!(lines[3], "masked / unmasked: visibility rays 0.250, time 0.250");
     }
 }
