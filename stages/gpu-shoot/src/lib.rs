@@ -18,7 +18,9 @@
 //! Surface detail from `mesh-prep --surface` ([`detail`]): per-texel
 //! reflectance from diffuse textures (004 Sec. 4.2), alpha masks that
 //! remove texels and discard their fragments in the visibility maps (Sec.
-//! 4.3.4), normal maps for the cosines (Sec. 2.3.3). Adaptive subdivision
+//! 4.3.4), normal maps for the cosines (Sec. 2.3.3). Diffuse transmission
+//! through the twin faces of two-sided translucent materials
+//! ([`transmission`], Sec. 4.3.1, Eq. 4.4). Adaptive subdivision
 //! at shadow boundaries ([`tiling`], Sec. 2.4) splits receivers into tiles
 //! before a triangle first shoots.
 //!
