@@ -7,7 +7,12 @@
 //! its twin (the GPU side is in `solver.wgsl`, `transmit`), so each texel
 //! of a translucent face needs the texel of the twin over the same place:
 //! the one whose centre is nearest to its own (a twin's texel grid mirrors
-//! its triangle's, so without adaptive subdivision the centres coincide).
+//! its triangle's, so without adaptive subdivision the centres coincide
+//! and the pairing is one to one). Adaptive subdivision may split the two
+//! faces differently; the nearest texel is then a point sample of the
+//! other face's irradiance, and power is conserved only as far as it
+//! stands for its texel. The search is brute force over the twin's
+//! texels: `n^2` for a face of `n` texels.
 //! As in `hierarchical-solve`, a translucent material that is not
 //! two-sided has no back face to leave the transmitted light from: it
 //! transmits nothing, and the report counts its triangles.

@@ -197,7 +197,7 @@ fn a_closed_box_with_a_translucent_wall_balances_energy() {
 /// the floor under the lamp (`[0.25, 0.75]^2`) and around it; `parts`
 /// lists (centroid, triangle, area, radiosity).
 fn region_means(parts: impl Iterator<Item = (DVec3, u32, f64, f64)>) -> Vec<f64> {
-    let mut sums = vec![[0.0f64; 2]; 10];
+    let mut sums = [[0.0f64; 2]; 10];
     for (c, t, a, b) in parts {
         let mut add = |r: usize| {
             sums[r][0] += a * b;
