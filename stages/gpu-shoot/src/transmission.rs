@@ -64,3 +64,60 @@ pub fn table(atlas: &Atlas, tiles: &[Tile], mesh: &Mesh, manifest: &Manifest, tw
         .collect();
     Some((table, one_sided))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::{manifest, material};
+    use schemas::mesh::{Material, Triangle};
+
+    /// A translucent two-sided quad (triangles 0, 1 and their twins 2, 3),
+    /// a translucent one-sided triangle (4) and an opaque one (5): every
+    /// texel of the quad's faces is paired with the twin's texel at the
+    /// same centre, one to one (the pair of its pair is itself), carrying
+    /// its material's tau_d; the others have no twin, and the one-sided
+    /// translucent triangle is counted.
+    #[test]
+    fn the_texels_of_twin_faces_pair_one_to_one_at_the_same_place() {
+        let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]];
+        let triangle = |vertices: [u32; 3], material: u32, z: f32| Triangle { vertices, material, object: 0, area: 0.5, normal: [0.0, 0.0, z] };
+        let triangles = vec![
+            triangle([0, 1, 2], 0, 1.0),
+            triangle([0, 2, 3], 0, 1.0),
+            triangle([0, 2, 1], 0, -1.0),
+            triangle([0, 3, 2], 0, -1.0),
+            triangle([4, 5, 6], 1, 1.0),
+            triangle([4, 6, 5], 2, -1.0),
+        ];
+        let mut mesh = crate::testing::triangles(&[]);
+        mesh.positions = positions;
+        mesh.triangles = triangles;
+        let tau = [0.5, 0.4, 0.3];
+        let sheet = Material { two_sided: true, diffuse_transmittance: tau, ..material([0.2; 3], [0.0; 3]) };
+        let one_sided = Material { diffuse_transmittance: tau, ..material([0.2; 3], [0.0; 3]) };
+        let mut m = manifest(1, vec![sheet, one_sided, material([0.5; 3], [0.0; 3])]);
+        m.effects.diffuse_transmission = true;
+        let atlas = crate::atlas::bake_sized(&mesh, vec![16], 2);
+        let tiles = crate::tiling::identity(&mesh);
+        let (table, one_sided) = table(&atlas, &tiles, &mesh, &m, &mesh.twins()).unwrap();
+        assert_eq!(one_sided, 1);
+        let mut paired = 0;
+        for (k, texel) in atlas.texels.iter().enumerate() {
+            let twin = table[k][3].to_bits();
+            if texel.triangle >= 4 {
+                assert_eq!((twin, [table[k][0], table[k][1], table[k][2]]), (u32::MAX, [0.0; 3]), "texel {k}");
+                continue;
+            }
+            let other = &atlas.texels[twin as usize];
+            assert_eq!(table[twin as usize][3].to_bits(), k as u32, "texel {k}: not one to one");
+            assert_eq!((texel.triangle + 2) % 4, other.triangle, "texel {k}");
+            let distance = DVec3::from(texel.position.map(f64::from)).distance(DVec3::from(other.position.map(f64::from)));
+            assert!(distance < 1e-6, "texel {k}: {distance}");
+            assert_eq!([table[k][0], table[k][1], table[k][2]], tau.map(|x| x as f32));
+            paired += 1;
+        }
+        assert!(paired > 200, "{paired}");
+        m.effects.diffuse_transmission = false;
+        assert!(super::table(&atlas, &tiles, &mesh, &m, &mesh.twins()).is_none(), "no table without the effect");
+    }
+}
