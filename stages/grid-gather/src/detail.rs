@@ -46,6 +46,8 @@ pub struct Detail<'a> {
     maps: Vec<Maps<'a>>,
     /// Per material: normal map.
     normal_maps: Vec<Option<&'a Texture>>,
+    /// The alpha masks the rays pass through, where some triangle has one.
+    alpha: Option<AlphaMasks>,
     /// Whether the solver transported with the texture averages (it read
     /// this surface artifact) rather than the materials' `diffuse`.
     solved_with_textures: bool,
@@ -76,6 +78,7 @@ impl<'a> Detail<'a> {
             material: mesh.triangles.iter().map(|t| t.material).collect(),
             maps,
             normal_maps,
+            alpha: AlphaMasks::of(surface, mesh),
             solved_with_textures,
         }
     }
@@ -106,21 +109,10 @@ impl<'a> Detail<'a> {
     /// has one.
     pub fn rays(&self, corners: &[[DVec3; 3]]) -> SceneRays {
         let rays = SceneRays::new(corners);
-        let mut textures: Vec<&Texture> = Vec::new();
-        let masked: Vec<Option<([[f64; 2]; 3], u32)>> = (0..self.material.len() as u32)
-            .map(|t| {
-                let (alpha, uv) = (self.maps(t).alpha?, self.uv[t as usize]?);
-                let index = textures.iter().position(|x| std::ptr::eq(*x, alpha)).unwrap_or_else(|| {
-                    textures.push(alpha);
-                    textures.len() - 1
-                });
-                Some((uv.map(|c| c.map(f64::from)), index as u32))
-            })
-            .collect();
-        if textures.is_empty() {
-            return rays;
+        match &self.alpha {
+            Some(masks) => rays.with_alpha_masks(masks.clone()),
+            None => rays,
         }
-        rays.with_alpha_masks(AlphaMasks { masked, textures: textures.into_iter().cloned().collect() })
     }
 
     /// The reflectance the solver transported with on the element with

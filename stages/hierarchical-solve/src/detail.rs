@@ -155,27 +155,9 @@ impl Detail {
         Some(pieces.into_iter().map(|piece| piece.into_iter().map(|p| g.point(barycentric(p))).collect()).collect())
     }
 
-    /// The alpha masks for the visibility rays, where some triangle has
-    /// one.
-    pub fn alpha_masks(&self) -> Option<AlphaMasks> {
-        let mut textures = Vec::new();
-        let mut index = vec![NONE; self.surface.textures.len()];
-        let masked: Vec<_> = self
-            .mapped
-            .iter()
-            .map(|m| {
-                let (uv, material) = m.as_ref()?;
-                let t = self.surface.material_maps[*material as usize][TextureKind::Alpha.slot()];
-                if t == NONE {
-                    return None;
-                }
-                if index[t as usize] == NONE {
-                    index[t as usize] = textures.len() as u32;
-                    textures.push(self.surface.textures[t as usize].clone());
-                }
-                Some((uv.map(|p| p.map(f64::from)), index[t as usize]))
-            })
-            .collect();
-        (!textures.is_empty()).then_some(AlphaMasks { masked, textures })
+    /// The alpha masks of `mesh` (the mesh this detail was made for) for
+    /// the visibility rays, where some triangle has one.
+    pub fn alpha_masks(&self, mesh: &Mesh) -> Option<AlphaMasks> {
+        AlphaMasks::of(&self.surface, mesh)
     }
 }

@@ -360,7 +360,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let floors = Floors { area: min_area, shadow: min_area * 0.25f64.powi(params.shadow_levels as i32) };
     let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed, quadrature_depth: params.quadrature_depth };
     let mut scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
-    if let Some(masks) = h.detail.as_ref().and_then(detail::Detail::alpha_masks) {
+    if let Some(masks) = h.detail.as_ref().and_then(|d| d.alpha_masks(mesh)) {
         scene = scene.with_alpha_masks(masks);
     }
     let mut work = Work::default();

@@ -37,8 +37,8 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
-use schemas::mesh::{cyclic, reversed};
-use schemas::surface::Texture;
+use schemas::mesh::{cyclic, reversed, Mesh};
+use schemas::surface::{Surface, Texture, TextureKind, NONE};
 use std::collections::HashMap;
 use std::time::Duration;
 
@@ -68,12 +68,46 @@ pub struct SceneRays {
 }
 
 /// Which triangles a mask cuts, and the masks.
+#[derive(Clone, Debug)]
 pub struct AlphaMasks {
     /// Per mesh triangle: its corners' texture coordinates and its mask's
     /// index in `textures`, if it has one.
     pub masked: Vec<Option<([[f64; 2]; 3], u32)>>,
     /// The alpha textures.
     pub textures: Vec<Texture>,
+}
+
+impl AlphaMasks {
+    /// The alpha masks of `mesh`'s triangles in `surface` (read for this
+    /// mesh): each triangle with texture coordinates whose material has an
+    /// alpha texture, the textures numbered in order of first use; `None`
+    /// where no triangle has one.
+    pub fn of(surface: &Surface, mesh: &Mesh) -> Option<Self> {
+        let mut uv = vec![None; mesh.triangles.len()];
+        for &(t, corners) in &surface.uvs {
+            uv[t as usize] = Some(corners);
+        }
+        let mut index = vec![NONE; surface.textures.len()];
+        let mut textures = Vec::new();
+        let masked = mesh
+            .triangles
+            .iter()
+            .zip(uv)
+            .map(|(triangle, uv)| {
+                let uv = uv?;
+                let t = surface.material_maps[triangle.material as usize][TextureKind::Alpha.slot()];
+                if t == NONE {
+                    return None;
+                }
+                if index[t as usize] == NONE {
+                    index[t as usize] = textures.len() as u32;
+                    textures.push(surface.textures[t as usize].clone());
+                }
+                Some((uv.map(|p| p.map(f64::from)), index[t as usize]))
+            })
+            .collect();
+        (!textures.is_empty()).then_some(AlphaMasks { masked, textures })
+    }
 }
 
 /// Each triangle's twin (see the module documentation): the triangle with
