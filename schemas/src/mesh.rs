@@ -247,6 +247,13 @@ pub struct Effects {
 }
 
 impl Effects {
+    /// Whether the scene has surface detail the surface artifact
+    /// (`mesh-prep --surface`) carries: textures, alpha masks or normal
+    /// maps. Stages read that artifact only then.
+    pub fn surface_detail(&self) -> bool {
+        self.textures || self.alpha_masks || self.normal_maps
+    }
+
     /// The report's `skipped` list: the note of every `(present, note)`
     /// pair whose effect the scene has, in order. Each stage passes its own
     /// notes for the effects it does not simulate.

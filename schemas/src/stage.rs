@@ -207,6 +207,26 @@ pub fn read_prepared(run: &mut Run, mesh: &Path, manifest: &Path) -> Result<(cra
     Ok((mesh_value, loaded.value))
 }
 
+/// Reads the surface artifact at `path` (`mesh-prep --surface`) for
+/// `mesh`, read from `mesh_path` with its manifest, refusing one that
+/// another mesh-prep run wrote (its provenance differs from the mesh's,
+/// which the clusters' input check cannot see where no input was made from
+/// either). The caller records the returned input.
+pub fn read_surface(path: &Path, mesh_path: &Path, mesh: &crate::mesh::Mesh, manifest: &crate::mesh::Manifest) -> Result<(crate::surface::Surface, Input)> {
+    let (surface, input) = crate::surface::Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
+    if surface.header.provenance != mesh.header.provenance {
+        return Err(Error::invalid(
+            path,
+            None,
+            format!(
+                "does not belong with the mesh {}: not written by the mesh-prep run that wrote the mesh (their provenance differs); rerun mesh-prep to write both",
+                mesh_path.display()
+            ),
+        ));
+    }
+    Ok((surface, input))
+}
+
 /// Checks, before any work, that `path` can be written: its directory
 /// exists and accepts a new file. A stage that would fail only after
 /// minutes of computing fails at once instead.

@@ -403,6 +403,10 @@ fn a_surface_artifact_from_another_mesh_prep_run_is_refused() {
     let (image, solution) = (dir.join("image.exr"), dir.join("solution.exr"));
     let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "--solution", s(&solution), "--surface", s(&other), "-o", s(&image)];
     assert_refused("grid-gather", &args, &["other.surface.exr", "does not belong with the mesh"], &[&image]);
+    // The solver too (no clusters: no input made from either tells it).
+    let fresh = dir.join("fresh.solution.exr");
+    let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "--surface", s(&other), "-o", s(&fresh)];
+    assert_refused("hierarchical-solve", &args, &["other.surface.exr", "does not belong with the mesh"], &[&fresh]);
 }
 
 #[test]

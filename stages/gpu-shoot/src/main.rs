@@ -8,8 +8,7 @@ use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
 use schemas::ron_io::write_ron;
 use schemas::solution::Solution;
-use schemas::surface::Surface;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -201,14 +200,9 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     )?;
     let mut run = Run::start("gpu-shoot", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
-    let e = &manifest.effects;
-    let detailed = e.textures || e.alpha_masks || e.normal_maps;
-    let surface = match args.surface.as_ref().filter(|_| detailed) {
+    let surface = match args.surface.as_ref().filter(|_| manifest.effects.surface_detail()) {
         Some(path) => {
-            let (surface, input) = Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
-            if surface.header.provenance != mesh.header.provenance {
-                return Err(schemas::Error::invalid(path, None, "not written by the mesh-prep run that wrote the mesh"));
-            }
+            let (surface, input) = read_surface(path, mesh_path, &mesh, &manifest)?;
             run.input(input)?;
             Some(surface)
         }
@@ -277,7 +271,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("seconds_per_shot".to_string(), w.shoot_seconds / (w.shots.max(1) as f64)),
         ]);
         let mut notes = vec![format!("adapter: {adapter}")];
-        if args.surface.is_some() && !detailed {
+        if args.surface.is_some() && !manifest.effects.surface_detail() {
             notes.push("surface.exr not read: the scene has no texture, alpha mask or normal map".into());
         }
         outputs.write(report, |p| run.write_report(p, &params, counters, skipped(&manifest.effects, surface.is_some(), w.one_sided_translucent), notes))?;

@@ -14,7 +14,7 @@ use schemas::solution::Solution;
 use schemas::surface::Surface;
 use grid_gather::detail::Detail;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
 use schemas::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -296,9 +296,8 @@ fn run(args: &Args) -> Result<ExitCode> {
         None => None,
     };
 
-    let e = &manifest.effects;
     let surface = match &args.surface {
-        Some(path) if e.textures || e.alpha_masks || e.normal_maps => Some(read_surface(&mut run, path, &mesh, &manifest, &solution)?),
+        Some(path) if manifest.effects.surface_detail() => Some(read_surface_for(&mut run, path, mesh_path, &mesh, &manifest, &solution)?),
         _ => None,
     };
     let detail = surface.as_ref().map(|(s, solved_with)| Detail::new(s, &mesh, &manifest, *solved_with));
@@ -337,11 +336,8 @@ fn run(args: &Args) -> Result<ExitCode> {
 /// mesh-prep run that wrote the mesh. Also says whether `solution` was
 /// solved with it (an input of the solve has the same content), so that its
 /// element radiosity reflects the texture averages ([`Detail::new`]).
-fn read_surface(run: &mut Run, path: &std::path::Path, mesh: &Mesh, manifest: &Manifest, solution: &Solution) -> Result<(Surface, bool)> {
-    let (surface, input) = Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
-    if surface.header.provenance != mesh.header.provenance {
-        return Err(schemas::Error::invalid(path, None, "does not belong with the mesh: they come from different mesh-prep runs (their provenance differs); rerun it to write both"));
-    }
+fn read_surface_for(run: &mut Run, path: &std::path::Path, mesh_path: &std::path::Path, mesh: &Mesh, manifest: &Manifest, solution: &Solution) -> Result<(Surface, bool)> {
+    let (surface, input) = read_surface(path, mesh_path, mesh, manifest)?;
     let solved_with = solution.header.provenance.inputs.iter().any(|i| i.sha256 == input.sha256);
     // Recorded without the provenance it carries, which is the mesh's
     // (checked above, and recorded with the mesh): a solution solved

@@ -8,8 +8,7 @@ use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::Effects;
 use schemas::solution::Solution;
-use schemas::surface::Surface;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -169,7 +168,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     };
     let surface = match &args.surface {
         Some(path) => {
-            let (surface, input) = Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
+            let (surface, input) = read_surface(path, mesh_path, &mesh, &manifest)?;
             run.input(input)?;
             Some(surface)
         }
