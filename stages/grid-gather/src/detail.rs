@@ -53,6 +53,13 @@ pub struct Detail<'a> {
     solved_with_textures: bool,
 }
 
+/// The irradiance `H = (B - E) / rho` behind radiosity `radiosity` of a
+/// surface emitting `emission` with reflectance `rho`; 0 in a channel where
+/// `rho` is 0, and never negative.
+pub fn irradiance_of(radiosity: [f64; 3], emission: [f64; 3], rho: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|c| if rho[c] > 0.0 { ((radiosity[c] - emission[c]) / rho[c]).max(0.0) } else { 0.0 })
+}
+
 /// Per-triangle values of a table of `(triangle, value)` records.
 fn per_triangle<T: Copy>(records: &[(u32, T)], triangles: usize) -> Vec<Option<T>> {
     let mut out = vec![None; triangles];
@@ -132,8 +139,7 @@ impl<'a> Detail<'a> {
     /// material's `emission` and `diffuse` (module docs); 0 in a channel
     /// where `rho_e` is 0, and never negative.
     pub fn irradiance(&self, triangle: u32, corners: &Corners, radiosity: [f64; 3], emission: [f64; 3], diffuse: [f64; 3]) -> [f64; 3] {
-        let rho = self.solved_reflectance(triangle, corners, diffuse);
-        std::array::from_fn(|c| if rho[c] > 0.0 { ((radiosity[c] - emission[c]) / rho[c]).max(0.0) } else { 0.0 })
+        irradiance_of(radiosity, emission, self.solved_reflectance(triangle, corners, diffuse))
     }
 
     /// The normal for cosines at barycentric `b` of `triangle`, whose face

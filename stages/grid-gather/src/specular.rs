@@ -189,7 +189,7 @@ pub fn window_light(
         let b = e.radiosity.map(f64::from);
         let h: [f64; 3] = match detail {
             Some(detail) => detail.irradiance(e.triangle, corners, b, s.emission, s.reflectance),
-            None => std::array::from_fn(|c| if s.reflectance[c] > 0.0 { (b[c] - s.emission[c]) / s.reflectance[c] } else { 0.0 }),
+            None => crate::detail::irradiance_of(b, s.emission, s.reflectance),
         };
         let from_links = |c: usize| links.iter().map(|&l| f64::from(solution.links[l].visibility) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
         std::array::from_fn(|c| if h[c] > 0.0 { (h[c] - from_links(c) - direct).max(0.0) } else { 0.0 })
