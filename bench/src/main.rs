@@ -48,7 +48,7 @@ use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
-use schemas::stage::{bad_parameter, check_writable, exit_code};
+use stage_kit::run::{bad_parameter, check_writable, exit_code};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

@@ -6,7 +6,7 @@
 
 use end_to_end::{bin, refused, run_ok, s, scratch};
 use schemas::cluster::Clusters;
-use schemas::stage::PAUSE_AFTER_COMMITS;
+use stage_kit::run::PAUSE_AFTER_COMMITS;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::process::Command;

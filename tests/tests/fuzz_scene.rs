@@ -36,8 +36,8 @@ fn prepare(scene: &[u8], obj: &[u8], mtl: &[u8]) {
         ("s/room.obj".into(), obj.to_vec()),
         ("s/room.mtl".into(), mtl.to_vec()),
         ("s/cornell_box.mtl".into(), mtl.to_vec()),
-        ("s/floor texture.png".into(), schemas::png::encode_png(2, 2, &[[200, 100, 50]; 4]).unwrap()),
-        ("s/n.png".into(), schemas::png::encode_png(1, 1, &[[128, 128, 255]]).unwrap()),
+        ("s/floor texture.png".into(), stage_kit::png::encode_png(2, 2, &[[200, 100, 50]; 4]).unwrap()),
+        ("s/n.png".into(), stage_kit::png::encode_png(1, 1, &[[128, 128, 255]]).unwrap()),
     ]);
     let path = Path::new("s/scene.ron");
     if let Ok(scene) = mesh_prep::read_scene(&source, path) {

@@ -29,7 +29,7 @@ fn prepared(test: &str, maps: &str, left: u8, right: u8) -> PathBuf {
     std::fs::write(dir.join("a.obj"), obj).unwrap();
     std::fs::write(dir.join("m.mtl"), format!("newmtl floor\nKd 0.5 0.5 0.5\n{maps}")).unwrap();
     let texels: Vec<[u8; 3]> = (0..64).map(|i| [if i < 32 { left } else { right }; 3]).collect();
-    std::fs::write(dir.join("halves.png"), schemas::png::encode_png(64, 1, &texels).unwrap()).unwrap();
+    std::fs::write(dir.join("halves.png"), stage_kit::png::encode_png(64, 1, &texels).unwrap()).unwrap();
     let camera = "Camera(eye: (0.5, 0.5, 2.0), target: (0.5, 0.5, 0.0), up: (0.0, 1.0, 0.0), vertical_fov_deg: 60.0, width: 8, height: 8)";
     let lamp = "Area(corner: (0.4, 0.4, 1.0), edge_u: (0.0, 0.2, 0.0), edge_v: (0.2, 0.0, 0.0), emission: (10.0, 10.0, 10.0))";
     std::fs::write(dir.join("scene.ron"), format!("Scene(meshes: [Obj(file: \"a.obj\")], camera: {camera}, lights: [{lamp}])")).unwrap();

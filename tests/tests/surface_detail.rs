@@ -17,7 +17,7 @@ fn prepared(test: &str, maps: &str) -> (Surface, Mesh, Manifest) {
     let obj = "mtllib m.mtl\nusemtl tiles\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
     std::fs::write(dir.join("a.obj"), obj).unwrap();
     std::fs::write(dir.join("m.mtl"), format!("newmtl tiles\nKd 0.5\n{maps}")).unwrap();
-    std::fs::write(dir.join("tiles.png"), schemas::png::encode_png(2, 1, &[[255, 255, 255], [0, 0, 0]]).unwrap()).unwrap();
+    std::fs::write(dir.join("tiles.png"), stage_kit::png::encode_png(2, 1, &[[255, 255, 255], [0, 0, 0]]).unwrap()).unwrap();
     let camera = "Camera(eye: (0.5, 0.5, 2.0), target: (0.5, 0.5, 0.0), up: (0.0, 1.0, 0.0), vertical_fov_deg: 60.0, width: 8, height: 8)";
     let lamp = "Area(corner: (0.4, 0.4, 1.0), edge_u: (0.0, 0.2, 0.0), edge_v: (0.2, 0.0, 0.0), emission: (1.0, 1.0, 1.0))";
     std::fs::write(dir.join("scene.ron"), format!("Scene(meshes: [Obj(file: \"a.obj\")], camera: {camera}, lights: [{lamp}])")).unwrap();

@@ -66,7 +66,7 @@ fn check(u: f64, v: f64) -> usize {
 fn png(colour: impl Fn(f64, f64) -> [u8; 3]) -> Vec<u8> {
     let n = TEXELS;
     let texels: Vec<[u8; 3]> = (0..n * n).map(|k| colour(((k % n) as f64 + 0.5) / n as f64, 1.0 - ((k / n) as f64 + 0.5) / n as f64)).collect();
-    schemas::png::encode_png(n, n, &texels).unwrap()
+    stage_kit::png::encode_png(n, n, &texels).unwrap()
 }
 
 /// A scene in a fresh directory: the unit floor at z = 0 (texture

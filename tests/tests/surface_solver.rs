@@ -74,7 +74,7 @@ fn write_scene(dir: &Path, quads: &[Quad], mtl: &str, overrides: &[String]) -> P
 /// the value `value(i, j)`.
 fn png(dir: &Path, name: &str, w: usize, h: usize, value: impl Fn(usize, usize) -> u8) {
     let pixels: Vec<[u8; 3]> = (0..w * h).map(|k| [value(k % w, k / w); 3]).collect();
-    std::fs::write(dir.join(name), schemas::png::encode_png(w, h, &pixels).unwrap()).unwrap();
+    std::fs::write(dir.join(name), stage_kit::png::encode_png(w, h, &pixels).unwrap()).unwrap();
 }
 
 /// What a prepared and solved scene gives.
@@ -322,7 +322,7 @@ fn a_floor_whose_normal_map_tilts_every_normal_matches_lambert_for_the_tilted_no
     let (sin, cos) = 20f64.to_radians().sin_cos();
     let byte = |x: f64| ((x + 1.0) / 2.0 * 255.0).round() as u8;
     let pixels = vec![[byte(sin), byte(0.0), byte(cos)]; 4];
-    std::fs::write(dir.join("tilt.png"), schemas::png::encode_png(2, 2, &pixels).unwrap()).unwrap();
+    std::fs::write(dir.join("tilt.png"), stage_kit::png::encode_png(2, 2, &pixels).unwrap()).unwrap();
     let lamp = [[0.3, 0.3, 0.4], [0.7, 0.3, 0.4], [0.7, 0.7, 0.4], [0.3, 0.7, 0.4]];
     let quads = [floor("floor", "bumpy", 0.0), ceiling("lamp", "lamp", 0.3, 0.7, 0.4)];
     let mtl = "newmtl bumpy\nKd 0.5 0.5 0.5\nnorm tilt.png\nnewmtl lamp\nKd 0 0 0\n";

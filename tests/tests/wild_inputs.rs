@@ -53,7 +53,7 @@ fn scene_with_library_elsewhere(dir: &Path, library: &str, texture: &str) -> Pat
     let mtl = format!("newmtl wall\nKd 0.5\nmap_Kd -bm 1 {texture}\n");
     let ldt = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../stages/mesh-prep/tests/data/photometry/lidrs_example_prolicht_E30-0019.ldt")).unwrap();
     let lights = format!("{}, Goniometric(file: \"../{library}/lamp.ldt\", position: (0.5, 0.8, 0.5))", ceiling_light(true));
-    let png = schemas::png::encode_png(1, 1, &[[128, 128, 128]]).unwrap();
+    let png = stage_kit::png::encode_png(1, 1, &[[128, 128, 128]]).unwrap();
     write_scene(dir, "room.obj", &lights, &[("scene/room.obj", obj.as_bytes()), (&mtl_path, mtl.as_bytes()), (&texture_path, &png), (&ldt_path, &ldt)])
 }
 

@@ -20,7 +20,7 @@ use hierarchical_solve::{solve, Params};
 use radiometry::geometry::mesh_triangles;
 use schemas::cluster::Clusters;
 use schemas::header::{Provenance, Schema};
-use schemas::stage::{check_writable, exit_code};
+use stage_kit::run::{check_writable, exit_code};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -14,8 +14,8 @@ use bench::sweep::stages::Stages;
 use bench::PipelineArgs;
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
-use schemas::cli::main_of;
-use schemas::stage::{bad_parameter, check_writable};
+use stage_kit::cli::main_of;
+use stage_kit::run::{bad_parameter, check_writable};
 use schemas::{Error, Result};
 use std::process::ExitCode;
 

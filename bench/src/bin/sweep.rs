@@ -14,7 +14,7 @@ use bench::sweep::{plot, Config};
 use bench::PipelineArgs;
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
-use schemas::stage::{bad_parameter, check_writable, exit_code};
+use stage_kit::run::{bad_parameter, check_writable, exit_code};
 use schemas::{Error, Result};
 use std::process::ExitCode;
 

@@ -8,7 +8,7 @@
 //! (paper 000 Sec. 5.2, Fig. 4). The camera stands inside the box near its
 //! open side, looking down at the floor.
 
-use schemas::png::encode_png;
+use stage_kit::png::encode_png;
 
 /// sRGB byte of the dark checks (linear reflectance 0.08).
 pub const DARK: u8 = 79;

@@ -42,7 +42,7 @@ use figures::SurfaceGroup;
 use schemas::samples::Samples;
 use schemas::solution::Solution;
 use schemas::header::Schema;
-use schemas::stage::{bad_parameter, Run};
+use stage_kit::run::{bad_parameter, Run};
 use schemas::{Error, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};

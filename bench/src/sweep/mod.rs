@@ -70,7 +70,7 @@ use schemas::header::{Input, Schema};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::report::Report;
 use schemas::ron_io::read_bytes;
-use schemas::stage::{bad_parameter, read_prepared, Run};
+use stage_kit::run::{bad_parameter, read_prepared, Run};
 use schemas::{Error, Result};
 use serde::Serialize;
 use stages::Stages;

@@ -5,7 +5,7 @@
 //! dominates and only noise separates the points), each point labelled
 //! with its knob values, whiskers over its range across runs, the Pareto
 //! front ringed, the reference named in the title. Drawn by `plotters` as SVG
-//! and as PNG (its bitmap backend, encoded by [`schemas::png`]).
+//! and as PNG (its bitmap backend, encoded by [`stage_kit::png`]).
 //!
 //! The PNG's text is drawn with DejaVu Sans embedded in the binary
 //! (`bench/assets/DejaVuSans.ttf`, licence beside it), so it renders on a
@@ -59,7 +59,7 @@ pub fn png(sweep: &Sweep) -> Result<Vec<u8>, String> {
         root.present().map_err(|e| e.to_string())?;
     }
     let pixels: Vec<[u8; 3]> = buffer.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    schemas::png::encode_png(w as usize, h as usize, &pixels)
+    stage_kit::png::encode_png(w as usize, h as usize, &pixels)
 }
 
 /// A logarithmic axis range holding every positive finite value, out to

@@ -1,11 +1,11 @@
 //! `cluster`: see the library's documentation and `cluster --help`.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use cluster::{build, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
-use schemas::stage::{bad_parameter, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -131,14 +131,14 @@ impl Params {
     /// tolerance that is negative or not finite.
     pub fn validate(&self) -> schemas::Result<()> {
         if self.tau.is_empty() {
-            return Err(schemas::stage::bad_parameter("tau needs at least one value"));
+            return Err(stage_kit::run::bad_parameter("tau needs at least one value"));
         }
         if let Some(tau) = self.tau.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-            return Err(schemas::stage::bad_parameter(format!("tau must be positive, got {tau}")));
+            return Err(stage_kit::run::bad_parameter(format!("tau must be positive, got {tau}")));
         }
         for (name, tolerance) in self.tolerances() {
             if let Some(t) = tolerance.filter(|t| !(t.is_finite() && *t >= 0.0)) {
-                return Err(schemas::stage::bad_parameter(format!("{name} must be a non-negative number, got {t}")));
+                return Err(stage_kit::run::bad_parameter(format!("{name} must be a non-negative number, got {t}")));
             }
         }
         Ok(())

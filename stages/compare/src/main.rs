@@ -1,14 +1,14 @@
 //! `compare A.exr B.exr`: error of A against reference B, with tolerances.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use compare::{CompareError, Params, Which};
 use schemas::header::Schema;
 use schemas::image::HdrImage;
 use schemas::mesh::Manifest;
 use schemas::report::Report;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, load_params, print_params, Run};
+use stage_kit::run::{bad_parameter, load_params, print_params, Run};
 use schemas::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -145,7 +145,7 @@ fn compare_files(args: &Args, params: &Params, run: &mut Run, a: &Path, b: &Path
         Some(path) => {
             let picture = compare::images::difference_picture(&image_a, &image_b, &result.compared, params.tau_max());
             let (w, h, pixels) = compare::scale_bar::with_scale_bar(image_b.width, image_b.height, &picture, params.tau_max());
-            Some(schemas::png::encode_png(w, h, &pixels).map_err(|e| Error::invalid(path, None, e))?)
+            Some(stage_kit::png::encode_png(w, h, &pixels).map_err(|e| Error::invalid(path, None, e))?)
         }
         None => None,
     };

@@ -2,11 +2,11 @@
 
 use clap::Parser;
 use exact::{Exact, Params};
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use schemas::exr_io::Channel;
 use schemas::header::Schema;
 use schemas::image::HdrImage;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use schemas::Error;
 use std::collections::BTreeMap;
 use std::path::PathBuf;

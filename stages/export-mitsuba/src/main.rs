@@ -1,10 +1,10 @@
 //! `export-mitsuba`: see the library's documentation and `export-mitsuba --help`.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use export_mitsuba::{export, Params};
 use schemas::atomic::write_bytes_atomically;
-use schemas::stage::{bad_parameter, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, read_prepared, Outputs, Run, StageArgs};
 use schemas::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -1,14 +1,14 @@
 //! `gpu-shoot`: see the library's documentation and `--help`.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use gpu_shoot::{gpu, output, solve, Adaptive, Luminaire, Params, Visibility};
 use schemas::header::Schema;
 use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
 use schemas::ron_io::write_ron;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

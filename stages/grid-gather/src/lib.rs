@@ -78,7 +78,7 @@ use radiometry::rays::SceneRays;
 use render::{Sampling, View};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
-use schemas::stage::bad_parameter;
+use stage_kit::run::bad_parameter;
 use schemas::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -2,7 +2,7 @@
 //! mode: Gouraud interpolation of element radiosity). See the library docs.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use grid_gather::final_gather::{ContrastImage, Diagnostics, CLASS_NAMES_PIXEL};
 use grid_gather::{gather_with, image_size, Extras, GridKind, Mode, Params, Scene};
 use schemas::cluster::Clusters;
@@ -14,7 +14,7 @@ use schemas::solution::Solution;
 use schemas::surface::Surface;
 use grid_gather::detail::Detail;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
 use schemas::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -1,14 +1,14 @@
 //! `hierarchical-solve`: see the library's documentation and `--help`.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use hierarchical_solve::transmission::Transmission;
 use hierarchical_solve::{solve_with_surface, Criterion, Params, Phase};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
 use schemas::mesh::Effects;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, progress, read_prepared, read_surface, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;

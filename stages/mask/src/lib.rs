@@ -58,7 +58,7 @@ pub mod model;
 use model::{band_frequency_cpd, contrast_sensitivity, elevation_image, luminance_pyramid, tvi};
 use schemas::error::Result;
 use schemas::header::Header;
-use schemas::stage::bad_parameter;
+use stage_kit::run::bad_parameter;
 use schemas::threshold::ThresholdImage;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

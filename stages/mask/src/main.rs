@@ -2,12 +2,12 @@
 //! a tone-mapped preview (TVI x masking elevation). See the library docs.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use mask::{display_luminance, thresholds, Params};
 use schemas::header::{Input, Schema};
 use schemas::ron_io::read_bytes;
 use schemas::threshold::ThresholdImage;
-use schemas::stage::{load_params, print_params, Outputs, Run, StageArgs};
+use stage_kit::run::{load_params, print_params, Outputs, Run, StageArgs};
 use schemas::{Error, Result};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -75,7 +75,7 @@ fn run(args: &Args) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let (Some(input), Some(output)) = (&args.image, &args.output) else {
-        return Err(schemas::stage::bad_parameter("IMAGE and -o are required"));
+        return Err(stage_kit::run::bad_parameter("IMAGE and -o are required"));
     };
     check_outputs(&[Some(input)], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start(STAGE, env!("CARGO_PKG_VERSION"));

@@ -227,7 +227,7 @@ mod tests {
 
     /// A 2 x 1 PNG: a red texel and a mid-grey one (sRGB 128).
     fn png(name: &str) -> (String, Vec<u8>) {
-        (format!("s/{name}"), schemas::png::encode_png(2, 1, &[[255, 0, 0], [128, 128, 128]]).unwrap())
+        (format!("s/{name}"), stage_kit::png::encode_png(2, 1, &[[255, 0, 0], [128, 128, 128]]).unwrap())
     }
 
     #[test]

@@ -2,11 +2,11 @@
 
 use clap::Parser;
 use photon_trace::{solve, Observer, Params, Progress, Snapshot, Stage};
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use schemas::header::Schema;
 use schemas::mesh::Effects;
 use schemas::solution::Solution;
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;

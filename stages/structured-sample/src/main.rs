@@ -1,12 +1,12 @@
 //! `structured-sample`: see the library's documentation and `--help`.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use schemas::header::Schema;
 use schemas::image::HdrImage;
 use schemas::mesh::Effects;
 use schemas::samples::{Reason, Samples};
-use schemas::stage::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
+use stage_kit::run::{bad_parameter, load_params, print_params, progress, read_prepared, Outputs, Run, StageArgs};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;

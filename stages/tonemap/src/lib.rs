@@ -111,7 +111,7 @@ impl Params {
         for (name, setting) in [("key", self.key), ("exposure", self.exposure)] {
             if let Setting::Fixed(v) = setting {
                 if !(v.is_finite() && v > 0.0) {
-                    return Err(schemas::stage::bad_parameter(format!(
+                    return Err(stage_kit::run::bad_parameter(format!(
                         "{name} must be a positive number or 'auto', got {v}"
                     )));
                 }
@@ -460,8 +460,8 @@ mod tests {
     #[test]
     fn png_encoding_is_deterministic_and_sized() {
         let pixels = vec![[1, 2, 3], [4, 5, 6]];
-        let a = schemas::png::encode_png(2, 1, &pixels).unwrap();
-        assert_eq!(a, schemas::png::encode_png(2, 1, &pixels).unwrap());
+        let a = stage_kit::png::encode_png(2, 1, &pixels).unwrap();
+        assert_eq!(a, stage_kit::png::encode_png(2, 1, &pixels).unwrap());
         assert_eq!(&a[1..4], b"PNG");
         // IHDR width and height, big-endian, at bytes 16..24.
         assert_eq!(&a[16..24], &[0, 0, 0, 2, 0, 0, 0, 1]);

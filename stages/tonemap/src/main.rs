@@ -1,9 +1,9 @@
 //! `tonemap IMAGE.exr -o OUT.png`: linear HDR image to 8-bit sRGB PNG.
 
 use clap::Parser;
-use schemas::cli::{check_outputs, main_of};
+use stage_kit::cli::{check_outputs, main_of};
 use schemas::image::HdrImage;
-use schemas::stage::{load_params, print_params, Run, StageArgs};
+use stage_kit::run::{load_params, print_params, Run, StageArgs};
 use schemas::Error;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -64,7 +64,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     }
     run.input(record)?;
     let mapped = tonemap::tonemap(&image, &params).map_err(|e| Error::invalid(input, None, e.to_string()))?;
-    let png = schemas::png::encode_png(mapped.width, mapped.height, &mapped.pixels)
+    let png = stage_kit::png::encode_png(mapped.width, mapped.height, &mapped.pixels)
         .map_err(|e| Error::invalid(output, None, e))?;
     schemas::atomic::write_bytes_atomically(output, &png)?;
     if let Some(report) = args.stage.report.as_deref() {

@@ -1,8 +1,8 @@
 //! The command line every stage shares: one-line usage errors and output
 //! paths checked against the inputs before any work.
 
-use crate::error::{Error, Result};
-use crate::stage::{check_writable, exit_code, EXIT_ERROR};
+use schemas::error::{Error, Result};
+use crate::run::{check_writable, exit_code, EXIT_ERROR};
 use std::path::Path;
 use std::process::ExitCode;
 

@@ -3,7 +3,7 @@
 //!
 //! [`Staged`] is the first half alone: a complete file beside its target,
 //! put in place by [`Staged::commit`]. A stage with several outputs stages
-//! them all and commits them together (see [`crate::stage::Outputs`]).
+//! them all and commits them together (see `stage_kit::run::Outputs`).
 //!
 //! Every temporary file is removed on every path that can be caught: an
 //! error or a panic (by [`Staged`]'s `Drop`), and an interrupt (SIGINT,

@@ -25,7 +25,6 @@
 //! ```
 
 pub mod atomic;
-pub mod cli;
 pub mod cluster;
 pub mod error;
 pub mod exr_io;
@@ -33,12 +32,10 @@ pub mod header;
 pub mod image;
 pub mod lightmap;
 pub mod mesh;
-pub mod png;
 pub mod report;
 pub mod ron_io;
 pub mod samples;
 pub mod solution;
-pub mod stage;
 pub mod surface;
 pub mod threshold;
 

@@ -333,7 +333,7 @@ impl Manifest {
     /// material paired with its twin (the same vertices wound the other
     /// way, the same material), which is what makes the material two-sided
     /// for every solver. (That both come from one run is checked by
-    /// [`crate::stage::read_prepared`].)
+    /// `stage_kit::run::read_prepared`.)
     pub fn check_mesh(&self, mesh_path: &Path, mesh: &Mesh) -> Result<()> {
         for (i, t) in mesh.triangles.iter().enumerate() {
             for (field, index, count) in [("material", t.material, self.materials.len()), ("object", t.object, self.objects.len())] {

@@ -2,12 +2,12 @@
 //! files, `--print-params`, reports, progress bars and exit codes
 //! (0 ok, 1 a negative answer, 2 error).
 
-use crate::atomic::Staged;
-use crate::error::{Error, Result};
-use crate::header::{Input, Provenance};
-use crate::report::Report;
-use crate::ron_io::{parse_ron, read_bytes, to_ron_text, write_ron};
-use crate::header::Schema;
+use schemas::atomic::Staged;
+use schemas::error::{Error, Result};
+use schemas::header::{Input, Provenance};
+use schemas::report::Report;
+use schemas::ron_io::{parse_ron, read_bytes, to_ron_text, write_ron};
+use schemas::header::Schema;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -47,13 +47,13 @@ impl Run {
     /// kill (SIGXFSZ, whose default action ends the process before any
     /// cleanup, gets a handler that does nothing, so the write returns
     /// EFBIG and the run ends in its normal error path), and an interrupt
-    /// removes them (see [`crate::atomic::remove_temporaries_on_interrupt`]).
+    /// removes them (see [`schemas::atomic::remove_temporaries_on_interrupt`]).
     pub fn start(stage: &'static str, version: &'static str) -> Self {
         static HANDLERS: std::sync::Once = std::sync::Once::new();
         HANDLERS.call_once(|| {
             // Failing to install the handler only keeps the default action.
             let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, std::sync::Arc::default());
-            crate::atomic::remove_temporaries_on_interrupt();
+            schemas::atomic::remove_temporaries_on_interrupt();
         });
         Run { stage, version, started: Instant::now(), inputs: Vec::new() }
     }
@@ -187,9 +187,9 @@ fn made_from_another(derived: &Input, source: &Input) -> Option<Error> {
 /// a kill between mesh-prep's renames, or a copy of one file from another
 /// output directory, leaves a pair whose indices may still fit but whose
 /// materials and objects do not, which is refused naming both files.
-pub fn read_prepared(run: &mut Run, mesh: &Path, manifest: &Path) -> Result<(crate::mesh::Mesh, crate::mesh::Manifest)> {
-    let (mesh_value, mesh_input) = crate::mesh::Mesh::read(mesh)?;
-    let loaded = crate::ron_io::read_ron::<crate::mesh::Manifest>(manifest)?;
+pub fn read_prepared(run: &mut Run, mesh: &Path, manifest: &Path) -> Result<(schemas::mesh::Mesh, schemas::mesh::Manifest)> {
+    let (mesh_value, mesh_input) = schemas::mesh::Mesh::read(mesh)?;
+    let loaded = schemas::ron_io::read_ron::<schemas::mesh::Manifest>(manifest)?;
     if mesh_value.header.provenance != loaded.value.header.provenance {
         return Err(Error::invalid(
             mesh,
@@ -212,8 +212,8 @@ pub fn read_prepared(run: &mut Run, mesh: &Path, manifest: &Path) -> Result<(cra
 /// another mesh-prep run wrote (its provenance differs from the mesh's,
 /// which the clusters' input check cannot see where no input was made from
 /// either). The caller records the returned input.
-pub fn read_surface(path: &Path, mesh_path: &Path, mesh: &crate::mesh::Mesh, manifest: &crate::mesh::Manifest) -> Result<(crate::surface::Surface, Input)> {
-    let (surface, input) = crate::surface::Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
+pub fn read_surface(path: &Path, mesh_path: &Path, mesh: &schemas::mesh::Mesh, manifest: &schemas::mesh::Manifest) -> Result<(schemas::surface::Surface, Input)> {
+    let (surface, input) = schemas::surface::Surface::read(path, mesh.triangles.len(), manifest.materials.len())?;
     if surface.header.provenance != mesh.header.provenance {
         return Err(Error::invalid(
             path,
@@ -366,7 +366,7 @@ mod tests {
     fn outputs_appear_together_on_keep_and_not_at_all_on_failure() {
         let dir = scratch("outputs");
         let (a, b) = (dir.join("a.txt"), dir.join("b.txt"));
-        let write = |outputs: &mut Outputs, path: &Path, text: &'static str| outputs.write(path, |p| crate::atomic::write_bytes_atomically(p, text.as_bytes()));
+        let write = |outputs: &mut Outputs, path: &Path, text: &'static str| outputs.write(path, |p| schemas::atomic::write_bytes_atomically(p, text.as_bytes()));
         let old = vec![("a.txt".to_string(), "old a".to_string()), ("b.txt".to_string(), "old b".to_string())];
         let mut outputs = Outputs::new();
         write(&mut outputs, &a, "old a").unwrap();
