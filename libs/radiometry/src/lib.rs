@@ -3,7 +3,8 @@
 //! - [`form_factor`]: Lambert's point-to-polygon factor (paper 002 Eq. 3)
 //!   and area-averaged element factors by Dunavant quadrature.
 //! - [`sampling`]: deterministic per-work-item random streams, stratified
-//!   points on triangles.
+//!   points on triangles, the radical inverse and the Sobol (0,2)-sequence.
+//! - [`bounds`]: axis-aligned boxes.
 //! - [`subdivision`]: the 1:4 element subdivision rule and point location.
 //! - [`geometry`]: triangle corners, normals and areas in f64.
 //! - [`rays`]: ray casting over obvhs's CWBVH.
@@ -17,6 +18,7 @@
 //!
 //! Everything here takes data, not paths, and never prints.
 
+pub mod bounds;
 pub mod camera;
 pub mod color;
 pub mod form_factor;

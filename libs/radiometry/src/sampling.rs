@@ -57,6 +57,37 @@ pub fn stratified_point(corners: &[DVec3; 3], k: usize, n: usize, stream: &mut S
     corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2]
 }
 
+/// Radical inverse of `k` in base `b` (van der Corput): the digits of `k`
+/// in base `b` mirrored about the radix point.
+pub fn radical_inverse(mut k: u64, b: u64) -> f64 {
+    let (mut inv, mut f) = (0.0, 1.0 / b as f64);
+    while k > 0 {
+        inv += (k % b) as f64 * f;
+        k /= b;
+        f /= b as f64;
+    }
+    inv
+}
+
+/// Point `k` of the Sobol (0,2)-sequence as 32-bit fractions, each
+/// XOR-shifted by `shift`: van der Corput in base 2 (the bits of `k`
+/// reversed), and Sobol's second dimension, whose generator matrix is
+/// Pascal's triangle mod 2 (the direction numbers `v <- v ^ (v >> 1)`).
+/// Every block of `2^m` consecutive points starting at a multiple of `2^m`
+/// is a (0,m,2)-net, and the XOR shift keeps that.
+pub fn sobol_02(k: u32, shift: [u32; 2]) -> [f64; 2] {
+    let (mut i, mut v, mut second) = (k, 1u32 << 31, 0u32);
+    while i != 0 {
+        if i & 1 != 0 {
+            second ^= v;
+        }
+        i >>= 1;
+        v ^= v >> 1;
+    }
+    let scale = 1.0 / 4_294_967_296.0;
+    [f64::from(k.reverse_bits() ^ shift[0]) * scale, f64::from(second ^ shift[1]) * scale]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,5 +114,38 @@ mod tests {
         let n = 200_000;
         let hits = (0..n).filter(|_| square_to_triangle(s.next_f64(), s.next_f64())[0] > 0.5).count();
         assert!((hits as f64 / n as f64 - 0.25).abs() < 0.004);
+    }
+
+    #[test]
+    fn radical_inverse_mirrors_the_digits() {
+        // 11 = 102 in base 3 -> 0.201 in base 3 = 2/3 + 0/9 + 1/27.
+        assert!((radical_inverse(11, 3) - (2.0 / 3.0 + 1.0 / 27.0)).abs() < 1e-15);
+        // 6 = 110 in base 2 -> 0.011 = 1/4 + 1/8.
+        assert_eq!(radical_inverse(6, 2), 0.375);
+        assert_eq!(radical_inverse(0, 5), 0.0);
+    }
+
+    /// Every aligned block of `2^m` points, under any digital shift, is a
+    /// (0,m,2)-net: each elementary interval `[i/2^a, (i+1)/2^a) x
+    /// [j/2^(m-a), (j+1)/2^(m-a))` of area `2^-m` holds exactly one point.
+    #[test]
+    fn aligned_blocks_of_the_shifted_sobol_sequence_are_0_m_2_nets() {
+        for shift in [[0, 0], [0x9e37_79b9, 0x7f4a_7c15], [u32::MAX, 1 << 31]] {
+            for m in 0..=6u32 {
+                let n = 1u32 << m;
+                for block in [0, 1, 5] {
+                    let points: Vec<[f64; 2]> = (block * n..(block + 1) * n).map(|k| sobol_02(k, shift)).collect();
+                    for a in 0..=m {
+                        let (cols, rows) = (1u32 << a, 1u32 << (m - a));
+                        let mut count = vec![0; n as usize];
+                        for p in &points {
+                            let (i, j) = ((p[0] * f64::from(cols)) as u32, (p[1] * f64::from(rows)) as u32);
+                            count[(j * cols + i) as usize] += 1;
+                        }
+                        assert!(count.iter().all(|&c| c == 1), "shift {shift:?}, block {block} of {n}, intervals {cols}x{rows}: {count:?}");
+                    }
+                }
+            }
+        }
     }
 }

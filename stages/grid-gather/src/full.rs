@@ -126,7 +126,8 @@
 //! between); the leaf check then keeps the link's value.
 
 use crate::grid::Grid;
-use crate::senders::{Aabb, SenderSample, Senders};
+use crate::senders::{SenderSample, Senders};
+use radiometry::bounds::Aabb;
 use crate::Params;
 use glam::DVec3;
 use radiometry::color::luminance;

@@ -48,6 +48,7 @@
 //! later issue) replaces it and does not interpolate element radiosity.
 
 use glam::DVec3;
+use radiometry::bounds::Aabb;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, locate_child, Corners, ROOT};
 use rayon::prelude::*;
@@ -233,9 +234,8 @@ impl Gouraud {
 /// Side of the weld cell: `tolerance x` the bounding-box diagonal of the
 /// triangles (`tolerance` itself, in metres, for a scene of zero extent).
 fn weld_cell(triangles: &[TriangleGeometry], tolerance: f64) -> f64 {
-    let corners = triangles.iter().flat_map(|t| t.corners);
-    let (lo, hi) = corners.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    let diagonal = (hi - lo).length();
+    let bounds = Aabb::around(triangles.iter().flat_map(|t| t.corners));
+    let diagonal = (bounds.max - bounds.min).length();
     if diagonal.is_finite() && diagonal > 0.0 {
         tolerance * diagonal
     } else {

@@ -23,7 +23,8 @@
 use glam::DVec3;
 use radiometry::form_factor::point_to_one_sided_polygon;
 use radiometry::geometry::TriangleGeometry;
-use radiometry::sampling::{square_to_triangle, Stream};
+use radiometry::bounds::Aabb;
+use radiometry::sampling::{radical_inverse, sobol_02, square_to_triangle, Stream};
 use schemas::cluster::Clusters;
 use schemas::solution::{Node, Solution, NONE};
 use std::collections::HashMap;
@@ -35,60 +36,6 @@ use std::sync::OnceLock;
 /// polygon: the point-to-area kernel summed over this many of its fixed
 /// samples.
 pub const CLUSTER_FACTOR_SAMPLES: usize = 32;
-
-/// An axis-aligned box, m.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Aabb {
-    /// Smallest corner.
-    pub min: DVec3,
-    /// Largest corner.
-    pub max: DVec3,
-}
-
-impl Aabb {
-    /// The box around `points`.
-    pub fn around(points: impl IntoIterator<Item = DVec3>) -> Aabb {
-        points.into_iter().fold(Aabb { min: DVec3::INFINITY, max: DVec3::NEG_INFINITY }, |b, p| Aabb { min: b.min.min(p), max: b.max.max(p) })
-    }
-
-    /// Whether the two boxes share a point.
-    pub fn overlaps(&self, other: &Aabb) -> bool {
-        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
-    }
-
-    /// Whether `p` is inside.
-    pub fn contains(&self, p: DVec3) -> bool {
-        self.min.cmple(p).all() && p.cmple(self.max).all()
-    }
-}
-
-/// Radical inverse of `k` in base `b` (van der Corput).
-fn radical_inverse(mut k: u64, b: u64) -> f64 {
-    let (mut inv, mut f) = (0.0, 1.0 / b as f64);
-    while k > 0 {
-        inv += (k % b) as f64 * f;
-        k /= b;
-        f /= b as f64;
-    }
-    inv
-}
-
-/// Point `k` of the Sobol (0,2)-sequence as 32-bit fractions, each
-/// XOR-shifted by `shift`: van der Corput in base 2 (the bits of `k`
-/// reversed), and Sobol's second dimension, whose generator matrix is
-/// Pascal's triangle mod 2 (the direction numbers `v <- v ^ (v >> 1)`).
-fn sobol_02(k: u32, shift: [u32; 2]) -> [f64; 2] {
-    let (mut i, mut v, mut second) = (k, 1u32 << 31, 0u32);
-    while i != 0 {
-        if i & 1 != 0 {
-            second ^= v;
-        }
-        i >>= 1;
-        v ^= v >> 1;
-    }
-    let scale = 1.0 / 4_294_967_296.0;
-    [f64::from(k.reverse_bits() ^ shift[0]) * scale, f64::from(second ^ shift[1]) * scale]
-}
 
 /// One fixed sample on a sender.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -432,35 +379,6 @@ impl<'a> Senders<'a> {
                 }
             }
             (Node::Element(_), Node::Cluster(_)) => false,
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::sobol_02;
-
-    /// Every aligned block of `2^m` points, under any digital shift, is a
-    /// (0,m,2)-net: each elementary interval `[i/2^a, (i+1)/2^a) x
-    /// [j/2^(m-a), (j+1)/2^(m-a))` of area `2^-m` holds exactly one point.
-    #[test]
-    fn aligned_blocks_of_the_shifted_sequence_are_0_m_2_nets() {
-        for shift in [[0, 0], [0x9e37_79b9, 0x7f4a_7c15], [u32::MAX, 1 << 31]] {
-            for m in 0..=6u32 {
-                let n = 1u32 << m;
-                for block in [0, 1, 5] {
-                    let points: Vec<[f64; 2]> = (block * n..(block + 1) * n).map(|k| sobol_02(k, shift)).collect();
-                    for a in 0..=m {
-                        let (cols, rows) = (1u32 << a, 1u32 << (m - a));
-                        let mut count = vec![0; n as usize];
-                        for p in &points {
-                            let (i, j) = ((p[0] * f64::from(cols)) as u32, (p[1] * f64::from(rows)) as u32);
-                            count[(j * cols + i) as usize] += 1;
-                        }
-                        assert!(count.iter().all(|&c| c == 1), "shift {shift:?}, block {block} of {n}, intervals {cols}x{rows}: {count:?}");
-                    }
-                }
-            }
         }
     }
 }

@@ -19,6 +19,7 @@
 //! added is at most that weight times the radiance behind it.
 
 use glam::DVec3;
+use radiometry::bounds::Aabb;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::photometry::DirectLight;
 use radiometry::rays::{Hit, SceneRays};
@@ -108,8 +109,8 @@ impl Specular {
                 (c.reflectance.iter().chain(&c.transmittance).any(|&x| x > 0.0)).then_some(c)
             })
             .collect();
-        let (lo, hi) = triangles.iter().flat_map(|t| t.corners).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        let diagonal = if lo.x.is_finite() { (hi - lo).length() } else { 1.0 };
+        let bounds = Aabb::around(triangles.iter().flat_map(|t| t.corners));
+        let diagonal = if bounds.min.x.is_finite() { (bounds.max - bounds.min).length() } else { 1.0 };
         Some(Specular { per_triangle, max_depth, min_weight, t_min: (1e-6 * diagonal) as f32 })
     }
 

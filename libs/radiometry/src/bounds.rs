@@ -1,0 +1,48 @@
+//! Axis-aligned bounding boxes in f64, mesh frame.
+
+use glam::DVec3;
+
+/// An axis-aligned box, m.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: DVec3,
+    /// Largest corner.
+    pub max: DVec3,
+}
+
+impl Aabb {
+    /// The box around `points` (`min` +inf and `max` -inf for none).
+    pub fn around(points: impl IntoIterator<Item = DVec3>) -> Aabb {
+        points.into_iter().fold(Aabb { min: DVec3::INFINITY, max: DVec3::NEG_INFINITY }, |b, p| Aabb { min: b.min.min(p), max: b.max.max(p) })
+    }
+
+    /// Whether the two boxes share a point.
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
+    }
+
+    /// Whether `p` is inside (the faces included).
+    pub fn contains(&self, p: DVec3) -> bool {
+        self.min.cmple(p).all() && p.cmple(self.max).all()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::dvec3;
+
+    #[test]
+    fn the_box_around_points_holds_them_and_touching_boxes_overlap() {
+        let b = Aabb::around([dvec3(1.0, -2.0, 0.5), dvec3(-1.0, 3.0, 0.0), dvec3(0.0, 0.0, 2.0)]);
+        assert_eq!((b.min, b.max), (dvec3(-1.0, -2.0, 0.0), dvec3(1.0, 3.0, 2.0)));
+        assert!(b.contains(dvec3(1.0, 3.0, 2.0)) && !b.contains(dvec3(1.0 + 1e-12, 0.0, 1.0)));
+        let touching = Aabb { min: dvec3(1.0, 3.0, 2.0), max: dvec3(5.0, 5.0, 5.0) };
+        let apart = Aabb { min: dvec3(1.0, 3.0, 2.0 + 1e-9), max: dvec3(5.0, 5.0, 5.0) };
+        assert!(b.overlaps(&touching) && touching.overlaps(&b));
+        assert!(!b.overlaps(&apart) && !apart.overlaps(&b));
+        let empty = Aabb::around(std::iter::empty());
+        assert!(!empty.contains(DVec3::ZERO) && !empty.overlaps(&b));
+    }
+}
