@@ -17,7 +17,7 @@
 use bench::{peak_memory_mib, reset_peak_memory};
 use clap::Parser;
 use hierarchical_solve::{solve, Params};
-use radiometry::geometry::mesh_triangles;
+use stage_kit::scene::mesh_triangles;
 use schemas::cluster::Clusters;
 use schemas::header::{Provenance, Schema};
 use stage_kit::run::{check_writable, exit_code};

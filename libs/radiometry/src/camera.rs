@@ -1,7 +1,7 @@
-//! The pinhole camera of the manifest, as rays through pixels.
+//! A pinhole camera (the manifest's, through the stage kit's
+//! `scene::pinhole`), as rays through pixels.
 
 use glam::DVec3;
-use schemas::mesh::Camera;
 
 /// Camera rays: pixel `(x, y)` (continuous, `y` down, `(0, 0)` the top-left
 /// corner of the image) to a unit direction in the mesh frame.
@@ -19,18 +19,19 @@ pub struct Pinhole {
 }
 
 impl Pinhole {
-    /// The camera of `camera` rendering a `width` x `height` image. `None`
-    /// if the view direction is zero or parallel to `up`, or the field of
-    /// view is not in (0, 180) degrees.
-    pub fn new(camera: &Camera, width: u32, height: u32) -> Option<Self> {
-        let eye = DVec3::from(camera.eye);
-        let forward = (DVec3::from(camera.target) - eye).try_normalize()?;
-        let right = forward.cross(DVec3::from(camera.up)).try_normalize()?;
+    /// The camera at `eye` looking at `target`, `up` above (need not be
+    /// orthogonal to the view direction), with a full vertical field of
+    /// view of `vertical_fov_deg` degrees, rendering a `width` x `height`
+    /// image. `None` if the view direction is zero or parallel to `up`, or
+    /// the field of view is not in (0, 180) degrees.
+    pub fn new(eye: DVec3, target: DVec3, up: DVec3, vertical_fov_deg: f64, width: u32, height: u32) -> Option<Self> {
+        let forward = (target - eye).try_normalize()?;
+        let right = forward.cross(up).try_normalize()?;
         let up = right.cross(forward);
-        if !(camera.vertical_fov_deg > 0.0 && camera.vertical_fov_deg < 180.0) || width == 0 || height == 0 {
+        if !(vertical_fov_deg > 0.0 && vertical_fov_deg < 180.0) || width == 0 || height == 0 {
             return None;
         }
-        let half_height = (0.5 * camera.vertical_fov_deg.to_radians()).tan();
+        let half_height = (0.5 * vertical_fov_deg.to_radians()).tan();
         let half_width = half_height * f64::from(width) / f64::from(height);
         Some(Pinhole { eye, forward, right, up, half_height, half_width, width: width.into(), height: height.into() })
     }
@@ -49,8 +50,7 @@ mod tests {
 
     #[test]
     fn centre_pixel_looks_at_the_target_and_edges_span_the_fov() {
-        let camera = Camera { eye: [0.0, 0.0, 0.0], target: [0.0, 0.0, -5.0], up: [0.0, 1.0, 0.0], vertical_fov_deg: 90.0, width: 4, height: 2 };
-        let pinhole = Pinhole::new(&camera, 200, 100).unwrap();
+        let pinhole = Pinhole::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -5.0), DVec3::Y, 90.0, 200, 100).unwrap();
         assert!((pinhole.direction(100.0, 50.0) - DVec3::NEG_Z).length() < 1e-12);
         let top = pinhole.direction(100.0, 0.0);
         assert!((top.y.atan2(-top.z).to_degrees() - 45.0).abs() < 1e-9);

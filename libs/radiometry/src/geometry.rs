@@ -3,7 +3,6 @@
 
 use crate::subdivision::Corners;
 use glam::DVec3;
-use schemas::mesh::Mesh;
 
 /// Corners, unit normal and area of one triangle, f64.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,15 +62,6 @@ pub fn frame_with_normal(n: DVec3) -> [DVec3; 3] {
     let seed = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Z };
     let t = (seed - n * seed.dot(n)).normalize();
     [t, n.cross(t), n]
-}
-
-/// The geometry of every triangle of `mesh`.
-pub fn mesh_triangles(mesh: &Mesh) -> Vec<TriangleGeometry> {
-    let p = |i: u32| {
-        let v = mesh.positions[i as usize];
-        DVec3::new(v[0].into(), v[1].into(), v[2].into())
-    };
-    mesh.triangles.iter().map(|t| TriangleGeometry::new(t.vertices.map(p))).collect()
 }
 
 #[cfg(test)]

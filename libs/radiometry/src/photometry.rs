@@ -3,7 +3,8 @@
 //! 2.3.2, 3.4, 3.4.1), its total flux, and the point light placed in the
 //! mesh frame that every solver shoots or gathers from. The photometric
 //! files themselves are read by `mesh-prep` only; later stages get the
-//! table from the manifest ([`schemas::mesh::GoniometricLight`]).
+//! table from the manifest (the stage kit's `scene::luminaires` places
+//! them).
 //!
 //! # Angles
 //!
@@ -24,7 +25,6 @@
 use crate::form_factor::DUNAVANT_5;
 use crate::rays::SceneRays;
 use glam::DVec3;
-use schemas::mesh::GoniometricLight;
 
 /// Luminous efficacy of 555 nm radiation, lm/W (004 Eq. 2.11-2.12).
 pub const K_M: f64 = 683.0;
@@ -235,28 +235,21 @@ pub struct Luminaire {
 }
 
 impl Luminaire {
-    /// The light of a manifest entry, its table and placement checked
+    /// The light of `distribution` at `position` with nadir `n0` and C0
+    /// direction `r0`, its intensities times `scale`, the placement checked
     /// (finite position, unit nadir, C0 perpendicular to it, positive
     /// scale); the error says what is wrong.
-    pub fn new(light: &GoniometricLight) -> Result<Luminaire, String> {
-        let distribution = Distribution::new(light.c_angles_deg.clone(), light.gamma_angles_deg.clone(), light.intensity_cd.clone())?;
-        let (position, n0, r0) = (DVec3::from(light.position), DVec3::from(light.nadir), DVec3::from(light.c0));
+    pub fn new(distribution: Distribution, position: DVec3, n0: DVec3, r0: DVec3, scale: f64) -> Result<Luminaire, String> {
         if !position.is_finite() {
-            return Err(format!("position {:?} is not finite", light.position));
+            return Err(format!("position {:?} is not finite", position.to_array()));
         }
         if !(n0.is_finite() && (n0.length() - 1.0).abs() < 1e-6 && r0.is_finite() && (r0.length() - 1.0).abs() < 1e-6 && n0.dot(r0).abs() < 1e-6) {
             return Err("nadir and c0 must be perpendicular unit vectors".into());
         }
-        if !(light.scale.is_finite() && light.scale > 0.0 && (light.scale * distribution.i_max()).is_finite()) {
-            return Err(format!("scale {} must be finite and > 0 (and scale x largest intensity finite)", light.scale));
+        if !(scale.is_finite() && scale > 0.0 && (scale * distribution.i_max()).is_finite()) {
+            return Err(format!("scale {scale} must be finite and > 0 (and scale x largest intensity finite)"));
         }
-        Ok(Luminaire { distribution, position, frame: [r0, n0.cross(r0), n0], w_per_sr_per_cd: light.scale / K_M })
-    }
-
-    /// Every light of a manifest, or the first one's error naming its
-    /// index and label.
-    pub fn all(lights: &[GoniometricLight]) -> Result<Vec<Luminaire>, String> {
-        lights.iter().enumerate().map(|(k, l)| Luminaire::new(l).map_err(|e| format!("goniometric light {k} ('{}'): {e}", l.label))).collect()
+        Ok(Luminaire { distribution, position, frame: [r0, n0.cross(r0), n0], w_per_sr_per_cd: scale / K_M })
     }
 
     /// Radiant intensity towards unit direction `d` (from the light),

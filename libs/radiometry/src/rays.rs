@@ -37,8 +37,7 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
-use schemas::mesh::{cyclic, reversed, Mesh};
-use schemas::surface::{Surface, Texture, TextureKind, NONE};
+use crate::texture::TexelGrid;
 use std::collections::HashMap;
 use std::time::Duration;
 
@@ -67,47 +66,22 @@ pub struct SceneRays {
     alpha: Option<AlphaMasks>,
 }
 
-/// Which triangles a mask cuts, and the masks.
+/// Which triangles a mask cuts, and the masks (the stage kit's
+/// `scene::alpha_masks` reads them from a surface artifact).
 #[derive(Clone, Debug)]
 pub struct AlphaMasks {
     /// Per mesh triangle: its corners' texture coordinates and its mask's
     /// index in `textures`, if it has one.
     pub masked: Vec<Option<([[f64; 2]; 3], u32)>>,
-    /// The alpha textures.
-    pub textures: Vec<Texture>,
+    /// The alpha textures (coverage in channel A).
+    pub textures: Vec<TexelGrid<Vec<[f32; 4]>>>,
 }
 
-impl AlphaMasks {
-    /// The alpha masks of `mesh`'s triangles in `surface` (read for this
-    /// mesh): each triangle with texture coordinates whose material has an
-    /// alpha texture, the textures numbered in order of first use; `None`
-    /// where no triangle has one.
-    pub fn of(surface: &Surface, mesh: &Mesh) -> Option<Self> {
-        let mut uv = vec![None; mesh.triangles.len()];
-        for &(t, corners) in &surface.uvs {
-            uv[t as usize] = Some(corners);
-        }
-        let mut index = vec![NONE; surface.textures.len()];
-        let mut textures = Vec::new();
-        let masked = mesh
-            .triangles
-            .iter()
-            .zip(uv)
-            .map(|(triangle, uv)| {
-                let uv = uv?;
-                let t = surface.material_maps[triangle.material as usize][TextureKind::Alpha.slot()];
-                if t == NONE {
-                    return None;
-                }
-                if index[t as usize] == NONE {
-                    index[t as usize] = textures.len() as u32;
-                    textures.push(surface.textures[t as usize].clone());
-                }
-                Some((uv.map(|p| p.map(f64::from)), index[t as usize]))
-            })
-            .collect();
-        (!textures.is_empty()).then_some(AlphaMasks { masked, textures })
-    }
+/// The corners rotated to start at the smallest: one key for a triangle
+/// whichever corner it starts at; its twin's is the key of `[c0, c2, c1]`.
+fn rotated_to_smallest(c: [[u32; 3]; 3]) -> [[u32; 3]; 3] {
+    let first = (0..3).min_by_key(|&i| c[i]).unwrap_or(0);
+    std::array::from_fn(|k| c[(first + k) % 3])
 }
 
 /// Each triangle's twin (see the module documentation): the triangle with
@@ -117,9 +91,9 @@ pub fn twins(triangles: &[Triangle]) -> Vec<Option<u32>> {
     let corners: Vec<[[u32; 3]; 3]> = triangles.iter().map(|t| [bits(t.v0), bits(t.v1), bits(t.v2)]).collect();
     let mut first_of: HashMap<[[u32; 3]; 3], u32> = HashMap::with_capacity(triangles.len());
     for (i, c) in corners.iter().enumerate() {
-        first_of.entry(cyclic(*c)).or_insert(i as u32);
+        first_of.entry(rotated_to_smallest(*c)).or_insert(i as u32);
     }
-    let twin_of = |(i, c): (usize, &[[u32; 3]; 3])| first_of.get(&cyclic(reversed(*c))).copied().filter(|&j| j as usize != i);
+    let twin_of = |(i, c): (usize, &[[u32; 3]; 3])| first_of.get(&rotated_to_smallest([c[0], c[2], c[1]])).copied().filter(|&j| j as usize != i);
     corners.iter().enumerate().map(twin_of).collect()
 }
 
@@ -189,7 +163,7 @@ impl SceneRays {
         }
         let (b1, b2) = ((d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det);
         let at = std::array::from_fn(|k| (1.0 - b1 - b2) * uv[0][k] + b1 * uv[1][k] + b2 * uv[2][k]);
-        !crate::texture::opaque(&alpha.textures[texture as usize], at)
+        !crate::texture::opaque(alpha.textures[texture as usize].view(), at)
     }
 
     /// The mesh triangle `i`'s twin, if it has one.
@@ -285,16 +259,7 @@ mod tests {
         // above an unmasked one at z = 2.
         let mut tris = quad(1.0, 0.5).to_vec();
         tris.extend(quad(2.0, 0.5));
-        let texture = Texture {
-            kind: schemas::surface::TextureKind::Alpha,
-            width: 2,
-            height: 1,
-            texels: vec![[0.0; 4], [1.0; 4]],
-            scale: [1.0, 1.0],
-            offset: [0.0, 0.0],
-            clamp: true,
-            strength: 1.0,
-        };
+        let texture = TexelGrid { width: 2, height: 1, texels: vec![[0.0; 4], [1.0; 4]], scale: [1.0, 1.0], offset: [0.0, 0.0], clamp: true };
         // uv = xy + 1/2 on the quad's corners.
         let uv = |t: &[DVec3; 3]| t.map(|p| [p.x + 0.5, p.y + 0.5]);
         let masked = vec![Some((uv(&tris[0]), 0)), Some((uv(&tris[1]), 0)), None, None];

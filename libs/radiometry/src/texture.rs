@@ -1,6 +1,9 @@
 //! Texture lookups and texture averages over triangles, for the stages
 //! that simulate surface detail (paper 004 Sec. 4.2, per-texel colour, and
-//! Sec. 4.3.4, masking) from `surface.exr` ([`schemas::surface`]).
+//! Sec. 4.3.4, masking). A texture reaches these functions as [`Texels`]:
+//! its texels and how texture coordinates map onto them, borrowed from
+//! wherever it is kept (the stage kit's `scene` module lends those of
+//! `surface.exr`).
 //!
 //! # Coordinates
 //!
@@ -51,7 +54,6 @@
 //! the lookup at its centroid.
 
 use crate::subdivision::{children, Corners};
-use schemas::surface::{Surface, Texture, NONE};
 
 /// Most grid cells an exact average clips against (see the module docs).
 pub const MAX_CELLS: f64 = 65_536.0;
@@ -63,28 +65,66 @@ pub const FALLBACK_LEVELS: u32 = 8;
 /// A point in texture or texel space.
 type P2 = [f64; 2];
 
+/// A texture as the lookups read it: `width x height` RGBA texels, row 0
+/// the top of the image (`v = 1`), and how texture coordinates map onto
+/// them (module docs). `D` holds the texels: a borrowed slice for the
+/// lookups ([`Texels`]), a `Vec` where a texture is kept
+/// ([`crate::rays::AlphaMasks`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexelGrid<D> {
+    /// Texels per row.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// `width x height` texels, RGBA, row by row from the top.
+    pub texels: D,
+    /// MTL `-s`: texture coordinates are `scale * uv + offset`.
+    pub scale: [f32; 2],
+    /// MTL `-o`.
+    pub offset: [f32; 2],
+    /// MTL `-clamp on`: coordinates clamp to [0, 1]; otherwise they repeat.
+    pub clamp: bool,
+}
+
+/// A texture the lookups read, its texels borrowed.
+pub type Texels<'a> = TexelGrid<&'a [[f32; 4]]>;
+
+impl TexelGrid<Vec<[f32; 4]>> {
+    /// The texture with its texels borrowed, for the lookups.
+    pub fn view(&self) -> Texels<'_> {
+        TexelGrid { width: self.width, height: self.height, texels: &self.texels, scale: self.scale, offset: self.offset, clamp: self.clamp }
+    }
+}
+
+impl Texels<'_> {
+    /// A copy that owns its texels, to keep.
+    pub fn owned(&self) -> TexelGrid<Vec<[f32; 4]>> {
+        TexelGrid { width: self.width, height: self.height, texels: self.texels.to_vec(), scale: self.scale, offset: self.offset, clamp: self.clamp }
+    }
+}
+
 /// Texture coordinates `uv` to texel space (module docs).
-fn texel_space(t: &Texture, uv: P2) -> P2 {
+fn texel_space(t: Texels, uv: P2) -> P2 {
     let s = [f64::from(t.scale[0]) * uv[0] + f64::from(t.offset[0]), f64::from(t.scale[1]) * uv[1] + f64::from(t.offset[1])];
     [s[0] * t.width as f64, (1.0 - s[1]) * t.height as f64]
 }
 
 /// Texel space back to texture coordinates (the inverse of
 /// [`texel_space`]; the scale must not be 0).
-fn texture_space(t: &Texture, p: P2) -> P2 {
+fn texture_space(t: Texels, p: P2) -> P2 {
     let s = [p[0] / t.width as f64, 1.0 - p[1] / t.height as f64];
     [(s[0] - f64::from(t.offset[0])) / f64::from(t.scale[0]), (s[1] - f64::from(t.offset[1])) / f64::from(t.scale[1])]
 }
 
 /// The texel at column `i`, row `j`, repeated or clamped (module docs).
-fn texel(t: &Texture, i: i64, j: i64) -> [f32; 4] {
+fn texel(t: Texels, i: i64, j: i64) -> [f32; 4] {
     let fold = |k: i64, n: usize| if t.clamp { k.clamp(0, n as i64 - 1) as usize } else { k.rem_euclid(n as i64) as usize };
     t.texels[fold(j, t.height) * t.width + fold(i, t.width)]
 }
 
 /// Bilinear value in the cell of texel centres whose top left centre is
 /// `(i, j)` at fractions `(f, g)` across it.
-fn bilinear_in(t: &Texture, i: i64, j: i64, f: f64, g: f64) -> [f64; 4] {
+fn bilinear_in(t: Texels, i: i64, j: i64, f: f64, g: f64) -> [f64; 4] {
     let (a, b, c, d) = (texel(t, i, j), texel(t, i + 1, j), texel(t, i, j + 1), texel(t, i + 1, j + 1));
     std::array::from_fn(|k| {
         (1.0 - f) * (1.0 - g) * f64::from(a[k]) + f * (1.0 - g) * f64::from(b[k]) + (1.0 - f) * g * f64::from(c[k]) + f * g * f64::from(d[k])
@@ -92,7 +132,7 @@ fn bilinear_in(t: &Texture, i: i64, j: i64, f: f64, g: f64) -> [f64; 4] {
 }
 
 /// The texture's bilinear value (RGBA) at texture coordinates `uv`.
-pub fn bilinear(t: &Texture, uv: P2) -> [f64; 4] {
+pub fn bilinear(t: Texels, uv: P2) -> [f64; 4] {
     let [x, y] = texel_space(t, uv);
     let (cx, cy) = (x - 0.5, y - 0.5);
     let (i, j) = (cx.floor(), cy.floor());
@@ -101,7 +141,7 @@ pub fn bilinear(t: &Texture, uv: P2) -> [f64; 4] {
 
 /// Whether the texel holding `uv` is opaque: its alpha (channel A, which an
 /// alpha texture holds its coverage in) is above 0.
-pub fn opaque(t: &Texture, uv: P2) -> bool {
+pub fn opaque(t: Texels, uv: P2) -> bool {
     let [x, y] = texel_space(t, uv);
     texel(t, x.floor() as i64, y.floor() as i64)[3] > 0.0
 }
@@ -111,18 +151,12 @@ pub fn opaque(t: &Texture, uv: P2) -> bool {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Maps<'a> {
     /// Diffuse texture: linear reflectance in R, G, B.
-    pub diffuse: Option<&'a Texture>,
+    pub diffuse: Option<Texels<'a>>,
     /// Alpha texture: coverage.
-    pub alpha: Option<&'a Texture>,
+    pub alpha: Option<Texels<'a>>,
 }
 
-impl<'a> Maps<'a> {
-    /// Material `material`'s maps in `surface`.
-    pub fn of(surface: &'a Surface, material: u32) -> Self {
-        let get = |slot: usize| surface.material_maps.get(material as usize).map(|m| m[slot]).filter(|&t| t != NONE).map(|t| &surface.textures[t as usize]);
-        Maps { diffuse: get(0), alpha: get(1) }
-    }
-
+impl Maps<'_> {
     /// Whether neither map is there.
     pub fn is_empty(&self) -> bool {
         self.diffuse.is_none() && self.alpha.is_none()
@@ -220,7 +254,7 @@ fn integrate<const N: usize>(p: &[P2], f: impl Fn(P2) -> [f64; N]) -> [f64; N] {
 /// `(integral rho dA, area)` of the diffuse texture over convex polygon
 /// `uv` in texture coordinates, the area in texel units (exact, module
 /// docs).
-fn reflectance_integral(t: &Texture, uv: &[P2]) -> ([f64; 3], f64) {
+fn reflectance_integral(t: Texels, uv: &[P2]) -> ([f64; 3], f64) {
     // Texel space shifted by half a texel: the grid of texel centres.
     let p: Vec<P2> = uv.iter().map(|&q| texel_space(t, q)).map(|[x, y]| [x - 0.5, y - 0.5]).collect();
     let mut sum = [0.0; 3];
@@ -237,15 +271,15 @@ fn reflectance_integral(t: &Texture, uv: &[P2]) -> ([f64; 3], f64) {
 /// The average over the triangle with corner texture coordinates `uv`
 /// (module docs: exact, or the centroid rule past [`MAX_CELLS`]).
 pub fn average(maps: Maps, uv: [P2; 3]) -> Average {
-    let per_texel = |t: &Texture| f64::from(t.scale[0] * t.scale[1]).abs() * (t.width * t.height) as f64;
-    let texels = |t: &Texture| uv.map(|q| texel_space(t, q));
-    let flat = |t: &Texture| twice_area(&texels(t)).abs() <= 1e-12 * per_texel(t).max(1.0) || per_texel(t) == 0.0;
-    let too_many = |t: &Texture| cells(&texels(t)) > MAX_CELLS;
+    let per_texel = |t: Texels| f64::from(t.scale[0] * t.scale[1]).abs() * (t.width * t.height) as f64;
+    let texels = |t: Texels| uv.map(|q| texel_space(t, q));
+    let flat = |t: Texels| twice_area(&texels(t)).abs() <= 1e-12 * per_texel(t).max(1.0) || per_texel(t) == 0.0;
+    let too_many = |t: Texels| cells(&texels(t)) > MAX_CELLS;
     let all = [maps.diffuse, maps.alpha];
-    if all.iter().flatten().any(|t| flat(t)) {
+    if all.iter().flatten().any(|t| flat(*t)) {
         return at_point(maps, centroid(&uv));
     }
-    if all.iter().flatten().any(|t| too_many(t)) {
+    if all.iter().flatten().any(|t| too_many(*t)) {
         return centroid_rule(maps, uv);
     }
     let reflectance = |uv: &[P2]| maps.diffuse.map(|t| reflectance_integral(t, uv));
@@ -274,7 +308,7 @@ pub fn average(maps: Maps, uv: [P2; 3]) -> Average {
 /// under alpha texture `t`, as convex polygons in texture coordinates: per
 /// texel row, one polygon per run of consecutive opaque texels. `None`
 /// where the footprint spans more than `limit` texels or has no area.
-pub fn opaque_pieces(t: &Texture, uv: [P2; 3], limit: usize) -> Option<Vec<Vec<P2>>> {
+pub fn opaque_pieces(t: Texels, uv: [P2; 3], limit: usize) -> Option<Vec<Vec<P2>>> {
     let p = uv.map(|q| texel_space(t, q));
     if cells(&p) > limit as f64 || twice_area(&p).abs() <= 1e-12 || t.scale.contains(&0.0) {
         return None;
@@ -313,7 +347,7 @@ fn centroid(uv: &[P2; 3]) -> P2 {
 
 /// The lookups at one point, as an average.
 fn at_point(maps: Maps, uv: P2) -> Average {
-    let rgb = |t: &Texture| {
+    let rgb = |t: Texels| {
         let v = bilinear(t, uv);
         [v[0], v[1], v[2]]
     };
@@ -340,36 +374,35 @@ fn centroid_rule(maps: Maps, uv: [P2; 3]) -> Average {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use schemas::surface::TextureKind;
 
     /// A `w x h` texture whose texel `(i, j)` is `value(i, j)` in every
     /// channel.
-    fn texture(kind: TextureKind, w: usize, h: usize, value: impl Fn(usize, usize) -> f32) -> Texture {
+    fn texture(w: usize, h: usize, value: impl Fn(usize, usize) -> f32) -> TexelGrid<Vec<[f32; 4]>> {
         let texels = (0..w * h).map(|k| [value(k % w, k / w); 4]).collect();
-        Texture { kind, width: w, height: h, texels, scale: [1.0, 1.0], offset: [0.0, 0.0], clamp: false, strength: 1.0 }
+        TexelGrid { width: w, height: h, texels, scale: [1.0, 1.0], offset: [0.0, 0.0], clamp: false }
     }
 
     /// 2 x 2 checks of `n x n` texels each: 0.25 at top left and bottom
     /// right, 0.625 elsewhere (exact in f32).
-    fn checks(n: usize) -> Texture {
-        texture(TextureKind::Diffuse, 2 * n, 2 * n, |i, j| if (i / n + j / n).is_multiple_of(2) { 0.25 } else { 0.625 })
+    fn checks(n: usize) -> TexelGrid<Vec<[f32; 4]>> {
+        texture(2 * n, 2 * n, |i, j| if (i / n + j / n).is_multiple_of(2) { 0.25 } else { 0.625 })
     }
 
     #[test]
     fn bilinear_hits_texel_centres_and_interpolates_between_them() {
-        let t = texture(TextureKind::Diffuse, 4, 2, |i, j| (i + 10 * j) as f32);
+        let t = texture(4, 2, |i, j| (i + 10 * j) as f32);
         // Texel (1, 0), top row, centre (1.5, 0.5) -> uv (1.5/4, 1 - 0.5/2).
-        assert!((bilinear(&t, [0.375, 0.75])[0] - 1.0).abs() < 1e-12);
+        assert!((bilinear(t.view(), [0.375, 0.75])[0] - 1.0).abs() < 1e-12);
         // Halfway between the centres of (1, 0) and (2, 1): mean of 1, 2, 11, 12.
-        assert!((bilinear(&t, [0.5, 0.5])[0] - 6.5).abs() < 1e-12);
+        assert!((bilinear(t.view(), [0.5, 0.5])[0] - 6.5).abs() < 1e-12);
         // Repeat: u = 1 is between texels 3 and 0 (3 and 0 -> 1.5 in row 0).
-        assert!((bilinear(&t, [1.0, 0.75])[0] - 1.5).abs() < 1e-12);
+        assert!((bilinear(t.view(), [1.0, 0.75])[0] - 1.5).abs() < 1e-12);
         // Clamp: past the edge, the edge texel.
-        let clamped = Texture { clamp: true, ..t.clone() };
-        assert!((bilinear(&clamped, [1.3, 0.75])[0] - 3.0).abs() < 1e-12);
+        let clamped = TexelGrid { clamp: true, ..t.clone() };
+        assert!((bilinear(clamped.view(), [1.3, 0.75])[0] - 3.0).abs() < 1e-12);
         // Scale and offset: s = 2 u + 0.125 maps u = 0.125 to s = 0.375.
-        let moved = Texture { scale: [2.0, 1.0], offset: [0.125, 0.0], ..t };
-        assert!((bilinear(&moved, [0.125, 0.75])[0] - 1.0).abs() < 1e-12);
+        let moved = TexelGrid { scale: [2.0, 1.0], offset: [0.125, 0.0], ..t };
+        assert!((bilinear(moved.view(), [0.125, 0.75])[0] - 1.0).abs() < 1e-12);
     }
 
     /// The unit square of texture coordinates as two triangles:
@@ -383,8 +416,8 @@ mod tests {
 
     #[test]
     fn a_checkerboard_averages_to_the_fractions_of_its_checks_a_triangle_covers() {
-        let t = Texture { clamp: true, ..checks(8) };
-        let maps = Maps { diffuse: Some(&t), alpha: None };
+        let t = TexelGrid { clamp: true, ..checks(8) };
+        let maps = Maps { diffuse: Some(t.view()), alpha: None };
         // The triangle (0,0), (1,0), (0,1) covers all of the bottom-left
         // check (0.625, area 1/4) and half of the bottom-right and top-left
         // ones (0.25, 1/8 each). Bilinear blurs each check edge over a
@@ -400,7 +433,7 @@ mod tests {
         // The whole square, repeating: each texel's tent integrates to one
         // texel over a period, so the mean of the checks, 0.4375.
         let repeating = checks(8);
-        let (_, mean) = square(Maps { diffuse: Some(&repeating), alpha: None });
+        let (_, mean) = square(Maps { diffuse: Some(repeating.view()), alpha: None });
         assert!((mean - 0.4375).abs() < 1e-12, "{mean}");
         // Inside one check, a texel away from its edges: its value.
         let inside = average(maps, [[0.1, 0.1], [0.4, 0.1], [0.1, 0.4]]).reflectance.unwrap()[0];
@@ -412,8 +445,8 @@ mod tests {
         // Texel i has value i: between centres the bilinear lookup is the
         // linear ramp x - 1/2, whose mean over a triangle is its value at
         // the centroid (a closed form independent of the clipping).
-        let t = Texture { clamp: true, ..texture(TextureKind::Diffuse, 64, 4, |i, _| i as f32) };
-        let maps = Maps { diffuse: Some(&t), alpha: None };
+        let t = TexelGrid { clamp: true, ..texture(64, 4, |i, _| i as f32) };
+        let maps = Maps { diffuse: Some(t.view()), alpha: None };
         let tri = [[0.11, 0.2], [0.83, 0.35], [0.4, 0.9]];
         let got = average(maps, tri).reflectance.unwrap()[0];
         let expected = (tri[0][0] + tri[1][0] + tri[2][0]) / 3.0 * 64.0 - 0.5;
@@ -423,8 +456,8 @@ mod tests {
     #[test]
     fn alpha_stripes_cover_the_fraction_of_their_opaque_texels_and_the_reflectance_counts_only_them() {
         // Columns alternate opaque, transparent: half of the square.
-        let alpha = texture(TextureKind::Alpha, 8, 1, |i, _| if i % 2 == 0 { 1.0 } else { 0.0 });
-        let maps = Maps { diffuse: None, alpha: Some(&alpha) };
+        let alpha = texture(8, 1, |i, _| if i % 2 == 0 { 1.0 } else { 0.0 });
+        let maps = Maps { diffuse: None, alpha: Some(alpha.view()) };
         assert!((square(maps).0 - 0.5).abs() < 1e-12);
         // A triangle over the first stripe only: all opaque.
         assert!((average(maps, [[0.01, 0.0], [0.12, 0.0], [0.05, 1.0]]).coverage - 1.0).abs() < 1e-12);
@@ -444,8 +477,8 @@ mod tests {
         // transparent, 32 texels a stripe): over the opaque part, the
         // opaque stripes' mean. Bilinear ramps from 0.4375 at a stripe's
         // edge to 0.75 half a texel in, at each of its two edges.
-        let diffuse = texture(TextureKind::Diffuse, 8 * 32, 1, |i, _| if (i / 32) % 2 == 0 { 0.75 } else { 0.125 });
-        let (coverage, rho) = square(Maps { diffuse: Some(&diffuse), alpha: Some(&alpha) });
+        let diffuse = texture(8 * 32, 1, |i, _| if (i / 32) % 2 == 0 { 0.75 } else { 0.125 });
+        let (coverage, rho) = square(Maps { diffuse: Some(diffuse.view()), alpha: Some(alpha.view()) });
         let blurred = (31.0 * 0.75 + (0.4375 + 0.75) / 2.0) / 32.0;
         assert!((rho - blurred).abs() < 1e-9, "{rho} vs {blurred}");
         assert!((coverage - 0.5).abs() < 1e-12);
@@ -453,23 +486,23 @@ mod tests {
 
     #[test]
     fn opaque_pieces_are_the_runs_of_opaque_texels_and_cover_what_the_average_says() {
-        let alpha = texture(TextureKind::Alpha, 8, 2, |i, j| if i % 4 < 2 || j == 0 { 1.0 } else { 0.0 });
+        let alpha = texture(8, 2, |i, j| if i % 4 < 2 || j == 0 { 1.0 } else { 0.0 });
         let tri = [[0.05, 0.1], [0.95, 0.2], [0.4, 0.9]];
-        let pieces = opaque_pieces(&alpha, tri, 1000).unwrap();
+        let pieces = opaque_pieces(alpha.view(), tri, 1000).unwrap();
         let area: f64 = pieces.iter().map(|p| 0.5 * twice_area(p).abs()).sum();
-        let coverage = average(Maps { diffuse: None, alpha: Some(&alpha) }, tri).coverage;
+        let coverage = average(Maps { diffuse: None, alpha: Some(alpha.view()) }, tri).coverage;
         assert!((area / (0.5 * twice_area(&tri).abs()) - coverage).abs() < 1e-12);
         // The top row is one run, the bottom row's runs are columns 0-1
         // and 4-5 (the triangle reaches column 1 and 4 at least).
         assert_eq!(pieces.len(), 3, "{pieces:?}");
-        assert!(opaque_pieces(&alpha, tri, 4).is_none());
+        assert!(opaque_pieces(alpha.view(), tri, 4).is_none());
     }
 
     #[test]
     fn element_averages_of_the_four_children_average_to_the_parent() {
         let t = checks(5);
-        let alpha = texture(TextureKind::Alpha, 7, 3, |i, j| ((i * 3 + j) % 4 != 0) as u8 as f32);
-        let maps = Maps { diffuse: Some(&t), alpha: Some(&alpha) };
+        let alpha = texture(7, 3, |i, j| ((i * 3 + j) % 4 != 0) as u8 as f32);
+        let maps = Maps { diffuse: Some(t.view()), alpha: Some(alpha.view()) };
         let uv = [[0.1f32, 0.05], [0.9, 0.2], [0.3, 0.95]];
         let parent = average(maps, element_uv(&uv, &crate::subdivision::ROOT));
         let kids: Vec<Average> = children(&crate::subdivision::ROOT).iter().map(|c| average(maps, element_uv(&uv, c))).collect();
@@ -483,7 +516,7 @@ mod tests {
     #[test]
     fn large_and_flat_footprints_fall_back_to_point_rules() {
         let t = checks(8);
-        let maps = Maps { diffuse: Some(&t), alpha: None };
+        let maps = Maps { diffuse: Some(t.view()), alpha: None };
         // 200 repeats each way: far past MAX_CELLS; the mean is 0.4375 up
         // to the centroid rule's sampling of the checks.
         let big = average(maps, [[0.0, 0.0], [200.0, 0.0], [200.0, 200.0]]).reflectance.unwrap()[0];

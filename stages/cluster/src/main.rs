@@ -51,7 +51,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let mut run = Run::start("cluster", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let started = Instant::now();
-    let triangles = radiometry::geometry::mesh_triangles(&mesh);
+    let triangles = stage_kit::scene::mesh_triangles(&mesh);
     let reflectance: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.materials[t.material as usize].diffuse).collect();
     let hierarchy = build(&triangles, &reflectance, &params);
     let seconds = started.elapsed().as_secs_f64();

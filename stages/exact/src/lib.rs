@@ -132,7 +132,7 @@ impl Exact {
         if !(1..=MAX_SIDE).contains(&width) || !(1..=MAX_SIDE).contains(&height) || u64::from(width) * u64::from(height) > MAX_PIXELS {
             return Err(format!("image size {width}x{height} out of range (each side 1..={MAX_SIDE}, at most {MAX_PIXELS} pixels)"));
         }
-        let pinhole = Pinhole::new(&manifest.camera, width, height).ok_or("the camera looks nowhere (zero view direction, view along up, or field of view outside (0, 180) degrees)")?;
+        let pinhole = stage_kit::scene::pinhole(&manifest.camera, width, height).ok_or("the camera looks nowhere (zero view direction, view along up, or field of view outside (0, 180) degrees)")?;
         let triangles: Vec<[DVec3; 3]> = config.surfaces.iter().flat_map(|s| s.triangles.iter().copied()).collect();
         if triangles.is_empty() {
             return Err("the mesh has no triangle".into());

@@ -84,7 +84,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     let mut run = Run::start("export-mitsuba", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
     let (width, height) = (params.width.unwrap_or(manifest.camera.width), params.height.unwrap_or(manifest.camera.height));
-    if radiometry::camera::Pinhole::new(&manifest.camera, width, height).is_none() {
+    if stage_kit::scene::pinhole(&manifest.camera, width, height).is_none() {
         return Err(Error::invalid(
             manifest_path,
             None,

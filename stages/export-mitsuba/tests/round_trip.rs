@@ -230,7 +230,7 @@ fn a_point_lands_on_the_same_pixel_through_both_cameras() {
     manifest.camera.vertical_fov_deg = 50.0;
     let params = Params { width: Some(320), height: Some(200), ..Params::default() };
     let scene = parse_xml(&export(&mesh, &manifest, &params, "scene", "").xml);
-    let pinhole = radiometry::camera::Pinhole::new(&manifest.camera, 320, 200).unwrap();
+    let pinhole = stage_kit::scene::pinhole(&manifest.camera, 320, 200).unwrap();
     for (x, y) in [(0.5, 0.5), (319.5, 0.5), (0.5, 199.5), (319.5, 199.5), (160.0, 100.0), (40.25, 170.75), (300.0, 12.0)] {
         let point = pinhole.eye + 1.7 * pinhole.direction(x, y);
         let (mx, my) = mitsuba_pixel(&scene, point);

@@ -24,10 +24,11 @@
 //! map texels it spans.
 
 use glam::DVec3;
-use radiometry::texture::{average, bilinear, element_uv, Maps};
+use radiometry::texture::{average, bilinear, element_uv};
 use schemas::lightmap::Region;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::surface::{Surface, Texture, TextureKind, NONE};
+use stage_kit::scene::{material_maps, texels};
 
 /// Most sub-samples per texel side of a normal map.
 const MAX_SUBSAMPLES: u32 = 8;
@@ -99,7 +100,7 @@ impl<'a> Detail<'a> {
     pub fn texel(&self, mesh: &Mesh, manifest: &Manifest, t: usize, region: Region, i: u32, j: u32) -> Option<TexelDetail> {
         let tri = &mesh.triangles[t];
         let uv = self.uvs[t]?;
-        let maps = Maps::of(self.surface, tri.material);
+        let maps = material_maps(self.surface, tri.material);
         let normal_map = self.map(mesh, t, TextureKind::Normal);
         if maps.is_empty() && normal_map.is_none() {
             return None;
@@ -173,7 +174,7 @@ impl<'a> Detail<'a> {
                 (c[0] + bary[0] * (c[1] - c[0]) + bary[1] * (c[2] - c[0])).normalize_or(geometric)
             })
             .unwrap_or(geometric);
-        let c = bilinear(texture, at);
+        let c = bilinear(texels(texture), at);
         let s = texture.strength as f64;
         let m = DVec3::new(s * (2.0 * c[0] - 1.0), s * (2.0 * c[1] - 1.0), 2.0 * c[2] - 1.0);
         let handedness = tangent[3].signum() as f64;

@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use stage_kit::cli::{check_outputs, main_of};
-use gpu_shoot::{gpu, output, solve, Adaptive, Luminaire, Params, Visibility};
+use gpu_shoot::{gpu, output, solve, Adaptive, Params, Visibility};
 use schemas::header::Schema;
 use schemas::lightmap::{Convergence, Lightmap};
 use schemas::mesh::Effects;
@@ -208,7 +208,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         }
         None => None,
     };
-    let lights = Luminaire::all(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
+    let lights = stage_kit::scene::luminaires(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
     let (device, queue, info) = gpu::acquire().map_err(|m| schemas::Error::invalid(Path::new("gpu"), None, m))?;
     let adapter = gpu::describe(&info);
     let bar = progress(1000, "converged");

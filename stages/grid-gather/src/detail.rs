@@ -31,6 +31,7 @@ use radiometry::subdivision::Corners;
 use radiometry::texture::{self, Maps};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::surface::{Surface, Texture, NONE};
+use stage_kit::scene::{alpha_masks, material_maps, texels};
 
 /// The surface detail of every triangle.
 pub struct Detail<'a> {
@@ -76,7 +77,7 @@ impl<'a> Detail<'a> {
     /// averages).
     pub fn new(surface: &'a Surface, mesh: &Mesh, manifest: &Manifest, solved_with_textures: bool) -> Self {
         let n = mesh.triangles.len();
-        let maps = (0..manifest.materials.len() as u32).map(|m| Maps::of(surface, m)).collect();
+        let maps = (0..manifest.materials.len() as u32).map(|m| material_maps(surface, m)).collect();
         let normal_maps = surface.material_maps.iter().map(|m| (m[2] != NONE).then(|| &surface.textures[m[2] as usize])).collect();
         Detail {
             uv: per_triangle(&surface.uvs, n),
@@ -85,7 +86,7 @@ impl<'a> Detail<'a> {
             material: mesh.triangles.iter().map(|t| t.material).collect(),
             maps,
             normal_maps,
-            alpha: AlphaMasks::of(surface, mesh),
+            alpha: alpha_masks(surface, mesh),
             solved_with_textures,
         }
     }
@@ -160,7 +161,7 @@ impl<'a> Detail<'a> {
         // Gram-Schmidt: the tangent made perpendicular to the shading normal.
         let Some(t) = (t - n * n.dot(t)).try_normalize() else { return n };
         let bitangent = n.cross(t) * f64::from(tangent[3]);
-        let c = texture::bilinear(map, uv);
+        let c = texture::bilinear(texels(map), uv);
         let s = f64::from(map.strength);
         let [x, y, z] = [s * (2.0 * c[0] - 1.0), s * (2.0 * c[1] - 1.0), 2.0 * c[2] - 1.0];
         let perturbed = (t * x + bitangent * y + n * z).try_normalize().unwrap_or(n);

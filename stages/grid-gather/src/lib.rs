@@ -73,7 +73,7 @@ pub mod specular;
 
 use gouraud::{Gouraud, Smoothing};
 use radiometry::camera::Pinhole;
-use radiometry::geometry::mesh_triangles;
+use stage_kit::scene::{luminaires, mesh_triangles, pinhole};
 use radiometry::rays::SceneRays;
 use render::{Sampling, View};
 use schemas::mesh::{Manifest, Mesh};
@@ -380,7 +380,7 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     params.validate()?;
     let (width, height) = image_size(params, scene.manifest);
     check_image_size(width, height).map_err(|e| Error::invalid(scene.manifest_path, None, format!("{e} (the camera's size, or --width/--height)")))?;
-    let camera = Pinhole::new(&scene.manifest.camera, width, height).ok_or_else(|| {
+    let camera = pinhole(&scene.manifest.camera, width, height).ok_or_else(|| {
         Error::invalid(
             scene.manifest_path,
             None,
@@ -515,7 +515,7 @@ fn full_gather(
     }
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
     let lights = if scene.manifest.effects.goniometric_lights {
-        radiometry::photometry::Luminaire::all(&scene.manifest.goniometric_lights).map_err(|m| Error::invalid(scene.manifest_path, None, m))?
+        luminaires(&scene.manifest.goniometric_lights).map_err(|m| Error::invalid(scene.manifest_path, None, m))?
     } else {
         Vec::new()
     };

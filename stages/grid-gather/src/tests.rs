@@ -4,7 +4,8 @@ use crate::gouraud::{Gouraud, Smoothing};
 use crate::render::pixel_offset;
 use crate::{gather, Mode, Params, Rendered, Scene};
 use glam::{dvec3, DVec3};
-use radiometry::geometry::{mesh_triangles, TriangleGeometry};
+use radiometry::geometry::TriangleGeometry;
+use stage_kit::scene::mesh_triangles;
 use radiometry::sampling::Stream;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::header::{Provenance, Schema};
@@ -356,7 +357,7 @@ fn surface_layer_tells_objects_edges_and_emitters_apart() {
     let image = render(&params, &mesh, &manifest, &solution(2, 1, |_, _| 1.0));
     let s = &image.surfaces;
     let size = 64;
-    let camera = radiometry::camera::Pinhole::new(&manifest.camera, size, size).unwrap();
+    let camera = stage_kit::scene::pinhole(&manifest.camera, size, size).unwrap();
     let on_plane = |x: f64, y: f64| {
         let d = camera.direction(x, y);
         camera.eye + d * (-camera.eye.z / d.z)

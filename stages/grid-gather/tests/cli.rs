@@ -140,7 +140,7 @@ impl Schema for GatherDiagnostics {
 fn a_clustered_solution_needs_its_hierarchy_and_full_mode_writes_diagnostics() {
     let dir = workdir("clusters");
     let (mesh, manifest) = mesh_prep::prepare_builtin("box-200", "test").unwrap();
-    let geometry = radiometry::geometry::mesh_triangles(&mesh);
+    let geometry = stage_kit::scene::mesh_triangles(&mesh);
     let reflectances: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.materials[t.material as usize].diffuse).collect();
     let h = cluster::build(&geometry, &reflectances, &cluster::Params::default());
     let clusters = schemas::cluster::Clusters { header: schemas::cluster::Clusters::header(provenance()), nodes: h.nodes, order: h.order };

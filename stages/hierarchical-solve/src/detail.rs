@@ -40,6 +40,7 @@ use radiometry::subdivision::Corners;
 use radiometry::texture::{self, element_uv, Average, Maps};
 use schemas::mesh::Mesh;
 use schemas::surface::{Surface, TextureKind, NONE};
+use stage_kit::scene::{alpha_masks, material_maps, texels};
 
 /// Most alpha texels a sender's footprint may span for its form factor to
 /// be summed over its opaque runs polygon by polygon.
@@ -76,7 +77,7 @@ impl Detail {
         let mut mapped = vec![None; mesh.triangles.len()];
         for &(t, uv) in &surface.uvs {
             let material = mesh.triangles[t as usize].material;
-            if !Maps::of(&surface, material).is_empty() {
+            if !material_maps(&surface, material).is_empty() {
                 mapped[t as usize] = Some((uv, material));
             }
         }
@@ -103,7 +104,7 @@ impl Detail {
     pub fn normal_at(&self, triangle: u32, uv: [f64; 2], n: DVec3) -> DVec3 {
         let Some((corner_uv, map, tangent)) = &self.normal_mapped[triangle as usize] else { return n };
         let texture = &self.surface.textures[*map as usize];
-        let c = texture::bilinear(texture, element_uv(corner_uv, &[uv; 3])[0]);
+        let c = texture::bilinear(texels(texture), element_uv(corner_uv, &[uv; 3])[0]);
         let strength = f64::from(texture.strength);
         let local = DVec3::new(strength * (2.0 * c[0] - 1.0), strength * (2.0 * c[1] - 1.0), 2.0 * c[2] - 1.0);
         let t = DVec3::new(f64::from(tangent[0]), f64::from(tangent[1]), f64::from(tangent[2]));
@@ -112,7 +113,7 @@ impl Detail {
     }
 
     fn maps(&self, triangle: u32) -> Option<(Maps<'_>, &[[f32; 2]; 3])> {
-        self.mapped[triangle as usize].as_ref().map(|(uv, m)| (Maps::of(&self.surface, *m), uv))
+        self.mapped[triangle as usize].as_ref().map(|(uv, m)| (material_maps(&self.surface, *m), uv))
     }
 
     /// Computes and appends the average of the next element, of `triangle`
@@ -158,6 +159,6 @@ impl Detail {
     /// The alpha masks of `mesh` (the mesh this detail was made for) for
     /// the visibility rays, where some triangle has one.
     pub fn alpha_masks(&self, mesh: &Mesh) -> Option<AlphaMasks> {
-        AlphaMasks::of(&self.surface, mesh)
+        alpha_masks(&self.surface, mesh)
     }
 }

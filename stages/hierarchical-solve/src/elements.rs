@@ -67,7 +67,7 @@ impl Hierarchy {
     /// One root element per input triangle, under `clusters` if given,
     /// with the textures and masks of `surface` if given.
     pub fn new(mesh: &Mesh, manifest: &Manifest, clusters: Option<schemas::cluster::Clusters>, surface: Option<Surface>) -> Self {
-        let triangles = radiometry::geometry::mesh_triangles(mesh);
+        let triangles = stage_kit::scene::mesh_triangles(mesh);
         let elements = triangles
             .iter()
             .enumerate()

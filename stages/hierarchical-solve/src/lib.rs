@@ -83,7 +83,7 @@ use links::{children_links, decide, link, self_link, Allowance, Floors, Link, Li
 pub use links::Criterion;
 use schemas::cluster::Clusters;
 use schemas::solution::Node;
-use radiometry::photometry::{DirectLight, Luminaire};
+use radiometry::photometry::DirectLight;
 use radiometry::rays::SceneRays;
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
@@ -376,7 +376,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     // Luminaires first (crate::luminaires): their direct light on the input
     // triangles, which joins the emission in the scale of the threshold,
     // then the elements refined for it.
-    let lights = if manifest.effects.goniometric_lights { Luminaire::all(&manifest.goniometric_lights)? } else { Vec::new() };
+    let lights = if manifest.effects.goniometric_lights { stage_kit::scene::luminaires(&manifest.goniometric_lights)? } else { Vec::new() };
     let direct = DirectLight { lights: &lights, rays: &scene };
     let started = Instant::now();
     work.luminaire_rays += luminaires::extend(&mut h, &direct, params.quadrature_depth);

@@ -157,7 +157,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     check_outputs(&[args.mesh.as_deref(), args.manifest.as_deref(), args.clusters.as_deref(), args.surface.as_deref()], &[Some(output), args.stage.report.as_deref()])?;
     let mut run = Run::start("hierarchical-solve", env!("CARGO_PKG_VERSION"));
     let (mesh, manifest) = read_prepared(&mut run, mesh_path, manifest_path)?;
-    radiometry::photometry::Luminaire::all(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
+    stage_kit::scene::luminaires(&manifest.goniometric_lights).map_err(|m| schemas::Error::invalid(manifest_path, None, m))?;
     let clusters = match &args.clusters {
         Some(path) => {
             let (clusters, input) = Clusters::read(path, mesh.triangles.len())?;

@@ -10,7 +10,7 @@ use crate::obj::{read_obj, TextSource};
 use crate::text::locate;
 use crate::scene::{Light, MeshFile, Scene};
 use glam::DVec3;
-use radiometry::camera::Pinhole;
+use stage_kit::scene::pinhole;
 use radiometry::geometry::TriangleGeometry;
 use schemas::mesh::{cyclic, reversed, Camera, Effects, GoniometricLight, Material, MeshStatistics, Triangle};
 use schemas::Error;
@@ -258,7 +258,7 @@ pub fn prepare(scene: &Scene, scene_path: &Path, source: &dyn TextSource, params
     let origin = built.origin;
     let to_mesh = |p: [f64; 3]| (DVec3::from(p) - origin).to_array();
     let camera = Camera { eye: to_mesh(scene.camera.eye), target: to_mesh(scene.camera.target), ..scene.camera.clone() };
-    if Pinhole::new(&camera, camera.width, camera.height).is_none() {
+    if pinhole(&camera, camera.width, camera.height).is_none() {
         return Err(Error::invalid(
             scene_path,
             None,

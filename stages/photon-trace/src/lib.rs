@@ -56,7 +56,8 @@ use filter::{Estimates, VertexTree};
 use glam::DVec3;
 use mesh::{Elements, PointKey, Vertices};
 use radiometry::color::luminance;
-use radiometry::geometry::{mesh_triangles, TriangleGeometry};
+use radiometry::geometry::TriangleGeometry;
+use stage_kit::scene::{luminaires, mesh_triangles};
 use radiometry::photometry::{DirectLight, Luminaire};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
@@ -338,7 +339,7 @@ fn radiosity(m: &schemas::mesh::Material, e: [f64; 3]) -> [f64; 3] {
 pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut Observer) -> Result<Solved, String> {
     let started = Instant::now();
     let geometry = mesh_triangles(mesh);
-    let luminaires = Luminaire::all(&manifest.goniometric_lights)?;
+    let luminaires = luminaires(&manifest.goniometric_lights)?;
     let Some(emitters) = Emitters::new(mesh, manifest, &geometry, &luminaires) else {
         return Err("the scene has no emitter: no material emits and no goniometric light has flux; nothing to trace".into());
     };

@@ -220,7 +220,7 @@ impl Vertices {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiometry::geometry::mesh_triangles;
+    use stage_kit::scene::mesh_triangles;
     use schemas::header::{Provenance, Schema};
     use schemas::mesh::Triangle;
 

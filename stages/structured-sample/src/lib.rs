@@ -55,9 +55,8 @@ use display::{DisplayGrid, FilterSample};
 use glam::{DVec2, DVec3};
 use placement::{isolux_levels, light_candidates, Candidate, Thinning};
 use probes::ProbeGrid;
-use radiometry::camera::Pinhole;
 use radiometry::color::luminance;
-use radiometry::geometry::mesh_triangles;
+use stage_kit::scene::{mesh_triangles, pinhole};
 use radiometry::rays::SceneRays;
 use render::Film;
 use schemas::mesh::{Manifest, Mesh};
@@ -266,7 +265,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let direct = DirectLight { emitters, rays: &rays, visibility_rays: params.visibility_rays, seed: params.seed };
     let camera = &manifest.camera;
     let size = (params.width.unwrap_or(camera.width), params.height.unwrap_or(camera.height));
-    let pinhole = Pinhole::new(camera, size.0, size.1).ok_or("the manifest's camera has a zero view direction, one parallel to up, or a field of view outside (0, 180) degrees")?;
+    let pinhole = pinhole(camera, size.0, size.1).ok_or("the manifest's camera has a zero view direction, one parallel to up, or a field of view outside (0, 180) degrees")?;
     let mut work = Work::default();
 
     // 1-2. Probes, candidates, thinning.

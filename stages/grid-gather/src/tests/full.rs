@@ -4,7 +4,7 @@ use crate::final_gather::Diagnostics;
 use crate::grid::{barycentric, Grid};
 use crate::{gather_with, Extras, Mode, Params, Rendered, Scene};
 use glam::{dvec3, DVec3};
-use radiometry::camera::Pinhole;
+use stage_kit::scene::pinhole;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::sampling::Stream;
 use schemas::header::{Provenance, Schema};
@@ -116,7 +116,7 @@ fn without_occluders_every_sender_interpolates_visibility_and_matches_brute_forc
 #[test]
 fn random_points_of_a_perspective_cell_lie_in_exactly_one_tetrahedron_with_linear_weights() {
     let camera = Camera { eye: [0.3, 0.2, 3.0], target: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], vertical_fov_deg: 45.0, width: 64, height: 48 };
-    let pinhole = Pinhole::new(&camera, 64, 48).unwrap();
+    let pinhole = pinhole(&camera, 64, 48).unwrap();
     let grid = Grid::perspective(&pinhole, 64, 48, 0.5, 6.0, [8, 6, 5]);
     let linear = |p: DVec3| 0.7 * p.x - 1.3 * p.y + 2.1 * p.z + 0.4;
     let mut stream = Stream::new(3, 0, 0);
@@ -231,7 +231,7 @@ fn full_gather_images_are_bit_identical_on_one_thread_and_many() {
 /// vertex.
 pub(crate) fn clustered_box(triangles: usize, eps: f64) -> (Mesh, Manifest, Solution, schemas::cluster::Clusters) {
     let (mesh, manifest) = mesh_prep::prepare_builtin(&format!("box-{triangles}"), "test").expect("built-in box");
-    let geometry = radiometry::geometry::mesh_triangles(&mesh);
+    let geometry = stage_kit::scene::mesh_triangles(&mesh);
     let reflectances: Vec<[f64; 3]> = mesh.triangles.iter().map(|t| manifest.materials[t.material as usize].diffuse).collect();
     let h = cluster::build(&geometry, &reflectances, &cluster::Params::default());
     let clusters = schemas::cluster::Clusters { header: schemas::cluster::Clusters::header(Provenance::in_memory("test")), nodes: h.nodes, order: h.order };
@@ -371,7 +371,7 @@ fn front_part_factor(p: DVec3) -> f64 {
 #[test]
 fn the_brute_gather_of_a_straddling_sender_matches_lambert_for_its_front_part_at_every_point() {
     let room = straddled();
-    let triangles = radiometry::geometry::mesh_triangles(&room.mesh);
+    let triangles = stage_kit::scene::mesh_triangles(&room.mesh);
     let senders = crate::senders::Senders::new(&triangles, &room.solution, None, 1);
     let rays = radiometry::rays::SceneRays::new(&triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
     let mut stream = Stream::new(5, 0, 0);
