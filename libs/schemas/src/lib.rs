@@ -29,6 +29,7 @@ pub mod cluster;
 pub mod error;
 pub mod exr_io;
 pub mod header;
+pub mod hierarchy;
 pub mod image;
 pub mod lightmap;
 pub mod mesh;
