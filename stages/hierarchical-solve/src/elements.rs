@@ -4,7 +4,7 @@
 //! not depend on threads.
 
 use crate::detail::Detail;
-use crate::nodes::ClusterTree;
+use crate::cluster_tree::ClusterTree;
 use crate::transmission::Transmission;
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;

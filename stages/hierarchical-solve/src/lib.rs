@@ -66,6 +66,7 @@
 //! 2.3% (walls and ceiling within 1%, short block +2.9%, tall block -4.1%),
 //! for 6.7x the links (122k to 823k) and about 2.5x the solve time.
 
+pub mod cluster_tree;
 pub mod detail;
 pub mod elements;
 pub mod gather;

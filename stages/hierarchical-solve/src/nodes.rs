@@ -4,86 +4,11 @@
 //! whatever its kind: area, bounds, reflectance, children, and random
 //! points on its surfaces.
 
+use crate::cluster_tree::ClusterTree;
 use crate::elements::Hierarchy;
 use glam::DVec3;
 use radiometry::sampling::{square_to_triangle, stratified_point, Stream};
-use schemas::cluster::Clusters;
 use schemas::solution::Node;
-
-/// The cluster hierarchy as the solver uses it: the artifact's nodes with
-/// f64 areas and mean reflectances recomputed from the triangles, the leaf
-/// cluster of each triangle, and prefix sums of triangle areas in cluster
-/// order for area-weighted sampling.
-pub struct ClusterTree {
-    /// The artifact.
-    pub clusters: Clusters,
-    /// Surface area below each cluster, m².
-    pub area: Vec<f64>,
-    /// Area-weighted mean reflectance below each cluster.
-    pub reflectance: Vec<[f64; 3]>,
-    /// Leaf cluster holding each triangle.
-    pub leaf_of_triangle: Vec<u32>,
-    /// `cumulative[i]`: area of the triangles `order[..i]`.
-    cumulative: Vec<f64>,
-}
-
-impl ClusterTree {
-    /// Prepares `clusters` over triangles with these areas and reflectances.
-    /// `clusters` must hold the invariants [`Clusters::read`] checks (a
-    /// tree below the root, every cluster non-empty with its range inside
-    /// `order`, `order` each triangle once): this indexes without checks
-    /// of its own, and the link refinement descends the tree trusting that
-    /// it ends.
-    pub fn new(clusters: Clusters, triangle_area: &[f64], triangle_reflectance: &[[f64; 3]]) -> Self {
-        let mut cumulative = Vec::with_capacity(clusters.order.len() + 1);
-        cumulative.push(0.0);
-        let mut sum = 0.0;
-        for &t in &clusters.order {
-            sum += triangle_area[t as usize];
-            cumulative.push(sum);
-        }
-        let mut leaf_of_triangle = vec![0u32; triangle_area.len()];
-        let mut area = Vec::with_capacity(clusters.nodes.len());
-        let mut reflectance = Vec::with_capacity(clusters.nodes.len());
-        for (c, node) in clusters.nodes.iter().enumerate() {
-            let range = node.first_triangle as usize..(node.first_triangle + node.triangle_count) as usize;
-            let a = cumulative[range.end] - cumulative[range.start];
-            let mut rho = [0.0; 3];
-            for &t in &clusters.order[range.clone()] {
-                for k in 0..3 {
-                    rho[k] += triangle_reflectance[t as usize][k] * triangle_area[t as usize];
-                }
-                if node.is_leaf() {
-                    leaf_of_triangle[t as usize] = c as u32;
-                }
-            }
-            area.push(a);
-            reflectance.push(rho.map(|x| if a > 0.0 { x / a } else { 0.0 }));
-        }
-        ClusterTree { clusters, area, reflectance, leaf_of_triangle, cumulative }
-    }
-
-    /// Number of clusters.
-    pub fn len(&self) -> usize {
-        self.clusters.nodes.len()
-    }
-
-    /// Whether there is no cluster.
-    pub fn is_empty(&self) -> bool {
-        self.clusters.nodes.is_empty()
-    }
-
-    /// An input triangle below cluster `c`, drawn with probability
-    /// proportional to its area.
-    fn sample_triangle(&self, c: u32, stream: &mut Stream) -> u32 {
-        let node = &self.clusters.nodes[c as usize];
-        let (first, last) = (node.first_triangle as usize, (node.first_triangle + node.triangle_count) as usize);
-        let (lo, hi) = (self.cumulative[first], self.cumulative[last]);
-        let target = lo + stream.next_f64() * (hi - lo);
-        let k = self.cumulative[first + 1..last].partition_point(|&x| x <= target);
-        self.clusters.order[first + k]
-    }
-}
 
 /// A point on a node's surfaces with its front normal and input triangle.
 #[derive(Clone, Copy, Debug)]
