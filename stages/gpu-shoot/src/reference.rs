@@ -6,6 +6,7 @@
 
 use crate::atlas::Atlas;
 use glam::DVec3;
+use radiometry::form_factor::point_to_polygon;
 
 /// Residual power of triangle `t`: `sum_k dB_k A_k` over its covered
 /// texels, W, RGB.
@@ -58,39 +59,6 @@ pub fn texel_patch(position: DVec3, half_u: DVec3, half_v: DVec3, hypotenuse: bo
     }
 }
 
-/// Form factor from a differential area at `sender` with normal
-/// `sender_normal` to a planar polygon (Lambert's contour formula, Howell
-/// B-1 / Baum et al. 1989): `F = 1/(2 pi) sum_k angle(r_k, r_k+1) n_s .
-/// unit(r_k x r_k+1)`, `r_k` the corners relative to the sender, after
-/// clipping the polygon to the sender's hemisphere (`n_s . r >= 0`). Exact
-/// for an unoccluded polygon, so the factors of polygons that tile the
-/// sender's hemisphere sum to 1 (004 Eq. 2.3) however near they are.
-pub fn polygon_form_factor(sender: DVec3, sender_normal: DVec3, corners: &[DVec3]) -> f64 {
-    // Sutherland-Hodgman against the plane n_s . r = 0.
-    let r: Vec<DVec3> = corners.iter().map(|&q| q - sender).collect();
-    let mut clipped = Vec::with_capacity(r.len() + 1);
-    for k in 0..r.len() {
-        let (a, b) = (r[k], r[(k + 1) % r.len()]);
-        let (za, zb) = (sender_normal.dot(a), sender_normal.dot(b));
-        if za >= 0.0 {
-            clipped.push(a);
-        }
-        if (za >= 0.0) != (zb >= 0.0) {
-            clipped.push(a + (b - a) * (za / (za - zb)));
-        }
-    }
-    let mut sum = 0.0;
-    for k in 0..clipped.len() {
-        let (a, b) = (clipped[k], clipped[(k + 1) % clipped.len()]);
-        let c = a.cross(b);
-        let s = c.length();
-        if s > 0.0 {
-            sum += s.atan2(a.dot(b)) * sender_normal.dot(c) / s;
-        }
-    }
-    (sum / (2.0 * std::f64::consts::PI)).abs()
-}
-
 /// Near field of the receiver pass: a receiver nearer than
 /// `sqrt(NEAR_FIELD (A_r + A_s))` gets the exact point-to-patch factor.
 /// Beyond it the disc approximation's loss `A_s / (pi d^2 + A_s)` is below
@@ -114,7 +82,10 @@ pub const RECIPROCAL: f64 = 16.0;
 /// `patch`) from the area sample `sender` (area `a_s`), visibility
 /// aside. Far (beyond [`NEAR_FIELD`]) the disc approximation (004 Eq. 2.2
 /// / 4.1 with one disc per sample), [`disc_form_factor`]. Near, the
-/// larger patch is integrated exactly with [`polygon_form_factor`] and the
+/// larger patch is integrated exactly with Lambert's contour formula
+/// ([`point_to_polygon`], Howell B-1 / Baum et al. 1989, the polygon clipped
+/// to the point's hemisphere; exact for an unoccluded polygon, so the factors
+/// of polygons that tile a hemisphere sum to 1, 004 Eq. 2.3) and the
 /// smaller one taken as a point:
 ///
 /// - sample over [`RECIPROCAL`] times the texel (a group of texels):
@@ -144,7 +115,7 @@ pub fn area_transfer(receiver: DVec3, receiver_normal: DVec3, a_r: f64, patch: &
     }
     let reciprocal = d2 < NEAR_FIELD * (a_r + sender.area) && sender.area > RECIPROCAL * a_r;
     // Behind the receiver's plane only a sample taken by reciprocity
-    // counts, for its part in front (the clip in polygon_form_factor).
+    // counts, for its part in front (the clip in point_to_polygon).
     if -receiver_normal.dot(v) / d <= 0.0 && !reciprocal {
         return 0.0;
     }
@@ -152,9 +123,9 @@ pub fn area_transfer(receiver: DVec3, receiver_normal: DVec3, a_r: f64, patch: &
         return disc_form_factor(receiver, receiver_normal, sender.point, sender.normal, sender.area);
     }
     if reciprocal {
-        return polygon_form_factor(receiver, receiver_normal, sender.polygon);
+        return point_to_polygon(receiver, receiver_normal, sender.polygon);
     }
-    sender.area * polygon_form_factor(sender.point, sender.normal, patch) / a_r
+    sender.area * point_to_polygon(sender.point, sender.normal, patch) / a_r
 }
 
 /// An area sample as the receiver pass sees it: a group of the shooter's

@@ -380,7 +380,7 @@ const NEAR_FIELD: f32 = 100.0;
 // Form factor from a differential area at the origin with normal n to the
 // polygon corners[0..count] (relative to that area), clipped to its
 // hemisphere: Lambert's contour formula, mirrors
-// reference::polygon_form_factor.
+// radiometry::form_factor::point_to_polygon.
 fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 5>, count: u32) -> f32 {
     var clipped: array<vec3<f32>, 6>;
     var m = 0u;
