@@ -222,8 +222,8 @@ pub const STEADY_RATIO: f64 = 1e-2;
 /// Stopping at `max_iterations` is reported ([`Convergence::converged`]
 /// `false`, with the bound reached); the caller says so.
 ///
-/// `senders` says what radiosity a link's sender sends: its area mean, or
-/// its parts weighted by the kernel ([`SenderTerms`]).
+/// `senders` says what radiosity each link's sender sends: its area mean,
+/// or its parts weighted by the kernel ([`SenderTerms`]).
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     h: &Hierarchy,
@@ -234,11 +234,10 @@ pub fn solve(
     tolerance: f64,
     max_iterations: usize,
     prior_rate: [f64; 3],
-    senders: Senders,
+    senders: &SenderTerms,
 ) -> Convergence {
     let n = b.len();
     let topology = Topology::new(h, n);
-    let senders = SenderTerms::new(h, links, senders);
     // Each link's visibility-weighted form factor, once per solve.
     let coupling: Vec<f64> = links.iter().map(|l| l.form_factor * f64::from(l.visibility.unwrap_or(1.0))).collect();
     let norm = max_norm(&topology, &coupling, offsets, specular);
@@ -363,10 +362,14 @@ pub enum Senders {
 /// receiver sees keep the sender's mean. The weights are geometric,
 /// computed once per solve, and sum to 1, so `||M||` and the stopping rule
 /// are unchanged.
-struct SenderTerms(Rows<f64>);
+pub struct SenderTerms {
+    terms: Rows<f64>,
+    links: usize,
+}
 
 impl SenderTerms {
-    fn new(h: &Hierarchy, links: &[Link], senders: Senders) -> Self {
+    /// The terms of every link of `links` (in order), resolved or not.
+    pub fn new(h: &Hierarchy, links: &[Link], senders: Senders) -> Self {
         let per_link: Vec<Vec<(usize, f64)>> = links
             .par_iter()
             .map(|l| match senders {
@@ -374,7 +377,7 @@ impl SenderTerms {
                 Senders::Resolved => Self::of_link(h, l),
             })
             .collect();
-        SenderTerms(Rows::from_lists(per_link))
+        SenderTerms { links: per_link.len(), terms: Rows::from_lists(per_link) }
     }
 
     /// The terms `(dense index, w_j)` of link `l`'s sender.
@@ -407,10 +410,18 @@ impl SenderTerms {
         terms.iter().map(|&(node, f)| (node, f / total)).collect()
     }
 
+    /// The radiosity each link sends with radiosity `b`, as the solve
+    /// that used these terms sent it: the links' unoccluded irradiance in
+    /// the solution is `F_rs` times this (with the last pass's resolved
+    /// terms), so that a leaf's radiosity is what its links bring.
+    pub fn sent(&self, b: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        (0..self.links).into_par_iter().map(|l| self.radiosity(l, b)).collect()
+    }
+
     /// The radiosity link `l` sends, `sum_j w_j B_j`.
     fn radiosity(&self, l: usize, b: &[[f64; 3]]) -> [f64; 3] {
         let mut sent = [0.0; 3];
-        for (node, &w) in self.0.row(l) {
+        for (node, &w) in self.terms.row(l) {
             for c in 0..3 {
                 sent[c] += w * b[node][c];
             }
@@ -419,14 +430,6 @@ impl SenderTerms {
     }
 }
 
-/// The radiosity each of `links` sends with its sender resolved by the
-/// kernel ([`SenderTerms`]), as the last pass's solve sent it: the links'
-/// unoccluded irradiance in the solution is `F_rs` times this, so that a
-/// leaf's radiosity is what its links bring.
-pub fn sent_radiosity(h: &Hierarchy, links: &[Link], b: &[[f64; 3]]) -> Vec<[f64; 3]> {
-    let terms = SenderTerms::new(h, links, Senders::Resolved);
-    (0..links.len()).into_par_iter().map(|l| terms.radiosity(l, b)).collect()
-}
 
 /// Changes below this many units of round-off of the largest radiosity say
 /// nothing about the rate: sums over thousands of links jitter by about a

@@ -417,6 +417,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let mut rates = [0.0; 3];
     // The couplings through mirrors and panes, rebuilt each pass (mirrors).
     let mut specular: Option<mirrors::Couplings> = None;
+    // What each link's sender sent in the last solve (gather::SenderTerms).
+    let mut senders = gather::SenderTerms::new(&h, &[], gather::Senders::Means);
     for pass in 1..=passes {
         let started = Instant::now();
         let mut refined_any = false;
@@ -508,8 +510,9 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let offsets = csr_offsets(&h, &all_links, b.len());
         // The passes refine with senders' area means; the last one solves
         // with senders resolved by the kernel (gather::SenderTerms).
-        let senders = if pass == passes || (!refined_any && pass > 1) { gather::Senders::Resolved } else { gather::Senders::Means };
-        let convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, senders);
+        let resolve = if pass == passes || (!refined_any && pass > 1) { gather::Senders::Resolved } else { gather::Senders::Means };
+        senders = gather::SenderTerms::new(&h, &all_links, resolve);
+        let convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders);
         rates = convergence.rates;
         work.iterations += convergence.iterations;
         work.relative_change = convergence.relative_change;
@@ -532,7 +535,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let clusters_out = (0..h.cluster_count())
         .map(|c| solution::ClusterRadiosity { area: h.area(Node::Cluster(c as u32)) as f32, radiosity: f32x3(b[c]) })
         .collect();
-    Ok(Solved { elements: output_elements(&h, &b), clusters: clusters_out, links: output_links(&h, &all_links, &b), work })
+    Ok(Solved { elements: output_elements(&h, &b), clusters: clusters_out, links: output_links(&all_links, &senders.sent(&b)), work })
 }
 
 /// What a refinement may err by, given the absolute `threshold` and, once
@@ -597,13 +600,13 @@ fn output_elements(h: &Hierarchy, b: &[[f64; 3]]) -> Vec<solution::Element> {
         .collect()
 }
 
-fn output_links(h: &Hierarchy, links: &[Link], b: &[[f64; 3]]) -> Vec<solution::Link> {
-    // What each link sent in the last solve (its sender resolved by the
-    // kernel, gather::SenderTerms), not the sender's area mean.
-    let sent = gather::sent_radiosity(h, links, b);
+/// The solution's links; `sent[l]`: the radiosity link `l` sent in the
+/// last solve (its sender resolved by the kernel, gather::SenderTerms), not
+/// the sender's area mean.
+fn output_links(links: &[Link], sent: &[[f64; 3]]) -> Vec<solution::Link> {
     links
         .iter()
-        .zip(&sent)
+        .zip(sent)
         .map(|(l, s)| solution::Link {
             receiver: l.receiver,
             sender: l.sender,
