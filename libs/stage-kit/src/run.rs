@@ -11,22 +11,71 @@ use schemas::header::Schema;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::Path;
+use crate::knobs::{Knobs, NoKnobs};
+use clap::{Arg, ArgAction, ArgMatches};
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// The options every stage binary has, flattened into its clap `Args`.
-#[derive(clap::Args, Debug, Clone, Default)]
-pub struct StageArgs {
-    /// Output: a report of the run (RON: work done, what was skipped, wall time).
-    #[arg(long, value_name = "REPORT.ron")]
-    pub report: Option<std::path::PathBuf>,
-    /// Read parameters from this RON file; flags override its values.
-    #[arg(long, value_name = "PARAMS.ron")]
-    pub params: Option<std::path::PathBuf>,
-    /// Print the effective parameters as RON on stdout and exit.
-    #[arg(long)]
+/// The options every stage binary has, flattened into its clap `Args`
+/// (`#[command(flatten)] stage: StageArgs<Params>`), with one flag per knob
+/// of `P` (see [`crate::knobs`]).
+#[derive(Debug, Clone, Default)]
+pub struct StageArgs<P = NoKnobs> {
+    /// Output: a report of the run.
+    pub report: Option<PathBuf>,
+    /// The `--params` file.
+    pub params: Option<PathBuf>,
+    /// Whether `--print-params` was given.
     pub print_params: bool,
+    /// The parsed command line, from which [`StageArgs::knobs`] reads the
+    /// knobs' flags.
+    given: ArgMatches,
+    knobs: PhantomData<P>,
+}
+
+impl<P: Knobs> StageArgs<P> {
+    /// The effective parameters: the `--params` file (or the defaults),
+    /// with each knob's flag over it where given, every knob checked.
+    pub fn knobs(&self) -> Result<P> {
+        let mut params: P = load_params(self.params.as_deref())?;
+        params.overlay(&self.given, "");
+        params.check("")?;
+        Ok(params)
+    }
+}
+
+impl<P: Knobs> clap::FromArgMatches for StageArgs<P> {
+    fn from_arg_matches(m: &ArgMatches) -> std::result::Result<Self, clap::Error> {
+        Ok(StageArgs {
+            report: m.get_one::<PathBuf>("report").cloned(),
+            params: m.get_one::<PathBuf>("params").cloned(),
+            print_params: m.get_flag("print_params"),
+            given: m.clone(),
+            knobs: PhantomData,
+        })
+    }
+
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> std::result::Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+impl<P: Knobs> clap::Args for StageArgs<P> {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        let path = || Arg::new("").value_parser(clap::value_parser!(PathBuf)).action(ArgAction::Set);
+        let cmd = cmd
+            .arg(path().id("report").long("report").value_name("REPORT.ron").help("Output: a report of the run (RON: work done, what was skipped, wall time)."))
+            .arg(path().id("params").long("params").value_name("PARAMS.ron").help("Read parameters from this RON file; flags override its values."))
+            .arg(Arg::new("print_params").long("print-params").action(ArgAction::SetTrue).help("Print the effective parameters as RON on stdout and exit."));
+        P::flags(cmd, "")
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
 }
 
 /// Exit code of a run that failed.
@@ -34,8 +83,8 @@ pub const EXIT_ERROR: u8 = 2;
 
 /// One run of a stage: collects its inputs, then stamps its outputs.
 pub struct Run {
-    stage: &'static str,
-    version: &'static str,
+    stage: String,
+    version: String,
     started: Instant,
     inputs: Vec<Input>,
 }
@@ -48,14 +97,14 @@ impl Run {
     /// cleanup, gets a handler that does nothing, so the write returns
     /// EFBIG and the run ends in its normal error path), and an interrupt
     /// removes them (see [`schemas::atomic::remove_temporaries_on_interrupt`]).
-    pub fn start(stage: &'static str, version: &'static str) -> Self {
+    pub fn start(stage: impl Into<String>, version: impl Into<String>) -> Self {
         static HANDLERS: std::sync::Once = std::sync::Once::new();
         HANDLERS.call_once(|| {
             // Failing to install the handler only keeps the default action.
             let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, std::sync::Arc::default());
             schemas::atomic::remove_temporaries_on_interrupt();
         });
-        Run { stage, version, started: Instant::now(), inputs: Vec::new() }
+        Run { stage: stage.into(), version: version.into(), started: Instant::now(), inputs: Vec::new() }
     }
 
     /// Records an input file, refusing one that does not belong with the
@@ -76,8 +125,8 @@ impl Run {
     /// parameters.
     pub fn provenance<P: Serialize>(&self, params: &P) -> Provenance {
         Provenance {
-            stage: self.stage.into(),
-            stage_version: self.version.into(),
+            stage: self.stage.clone(),
+            stage_version: self.version.clone(),
             command_line: std::env::args().collect(),
             parameters: ron::value::RawValue::from_rust(params).expect("parameter types serialize to RON"),
             inputs: self.inputs.clone(),
@@ -272,6 +321,12 @@ impl Outputs {
     /// there until [`Outputs::keep`].
     pub fn write(&mut self, path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
         self.staged.push(Staged::written_by(path, write)?);
+        Ok(())
+    }
+
+    /// Writes one output holding `bytes`, kept until [`Outputs::keep`].
+    pub fn write_bytes(&mut self, path: &Path, bytes: &[u8]) -> Result<()> {
+        self.staged.push(Staged::write(path, |w| std::io::Write::write_all(w, bytes).map_err(|e| Error::io(path, e)))?);
         Ok(())
     }
 

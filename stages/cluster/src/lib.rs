@@ -30,23 +30,12 @@ use glam::{DVec3, Vec3};
 use radiometry::geometry::TriangleGeometry;
 use schemas::cluster::ClusterNode;
 use schemas::solution::NONE;
-use serde::{Deserialize, Serialize};
 
-/// Knobs of the hierarchy.
-///
-/// | parameter | meaning | default |
-/// |---|---|---|
-/// | `leaf_size` | most triangles in a leaf cluster (1..=255) | 8 |
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Most triangles in a leaf cluster.
-    pub leaf_size: u32,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params { leaf_size: 8 }
+stage_kit::knobs! {
+    /// Knobs of the hierarchy.
+    pub struct Params {
+        /// Most triangles in a leaf cluster.
+        leaf_size: u32 = 8, "triangles", value(1..=255);
     }
 }
 

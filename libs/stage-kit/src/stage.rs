@@ -1,0 +1,137 @@
+//! The common start and end of a stage's run, so that a stage's `main.rs`
+//! says only what is particular to it: its files ([`Stage::files`]) and
+//! its work ([`Stage::run`]).
+//!
+//! [`main`] parses the command line ([`crate::cli::main_of`]: one-line
+//! errors, exit 2), prints the knob table for `--print-knobs` (hidden, for
+//! the README), settles the effective parameters (`--params`, the knobs'
+//! flags, their ranges, [`Stage::settle`]), prints them for
+//! `--print-params`, checks the outputs against the inputs before any work
+//! ([`crate::cli::check_outputs`], the report included), starts the
+//! [`Run`] (provenance, signal handlers), runs the stage, writes the
+//! report (`--report`) from what it returns ([`Done`]) and puts every
+//! output in place at once ([`Outputs::keep`]).
+
+use crate::cli::{check_outputs, main_of};
+use crate::knobs::{table, Knobs};
+use crate::run::{bad_parameter, print_params, read_prepared, Outputs, Run, StageArgs};
+use schemas::error::Result;
+use schemas::mesh::{Manifest, Mesh};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// The hidden flag that prints a stage's knob table (markdown) and exits.
+pub const PRINT_KNOBS: &str = "--print-knobs";
+
+/// A stage's command line, which the kit runs (see the module).
+pub trait Stage: clap::Parser {
+    /// The stage's knobs, declared with [`knobs!`](crate::knobs!).
+    type Params: Knobs;
+
+    /// The flags every stage has (`#[command(flatten)]`).
+    fn common(&self) -> &StageArgs<Self::Params>;
+
+    /// The files it reads and the files it writes (the report aside),
+    /// `None` for optional ones not given: no output may be an input, and
+    /// each must be writable.
+    fn files(&self) -> (Vec<Option<&Path>>, Vec<Option<&Path>>);
+
+    /// Settles what depends on flags beyond the knobs' own, or on several
+    /// knobs together (default: nothing).
+    fn settle(&self, _params: &mut Self::Params) -> Result<()> {
+        Ok(())
+    }
+
+    /// The work: reads its inputs into `run` (each [`Run::input`]) and
+    /// writes its outputs through `outputs`.
+    fn run(self, params: &Self::Params, run: &mut Run, outputs: &mut Outputs) -> Result<Done>;
+}
+
+/// What a run did, for its report; `negative` for a run whose answer is
+/// "no" (exit 1, e.g. `compare` over its bounds).
+#[derive(Debug, Default)]
+pub struct Done {
+    /// Work counters.
+    pub counters: BTreeMap<String, f64>,
+    /// What was skipped, and why.
+    pub skipped: Vec<String>,
+    /// Anything else worth a line.
+    pub notes: Vec<String>,
+    /// Whether the run's answer is "no".
+    pub negative: bool,
+}
+
+impl Done {
+    /// A run that counted `counters`.
+    pub fn counted<const N: usize>(counters: [(&str, f64); N]) -> Done {
+        Done { counters: counters.into_iter().map(|(k, v)| (k.to_string(), v)).collect(), ..Done::default() }
+    }
+}
+
+/// A stage binary's `main`: `fn main() -> ExitCode { stage_kit::stage::main::<Args>() }`.
+/// The stage's name and version are its clap command's (`#[command(name =
+/// "...", version)]`).
+pub fn main<S: Stage>() -> ExitCode {
+    let command = S::command();
+    let (name, version) = (command.get_name().to_string(), command.get_version().unwrap_or_default().to_string());
+    if std::env::args_os().skip(1).any(|a| a == PRINT_KNOBS) {
+        print!("{}", table::<S::Params>());
+        return ExitCode::SUCCESS;
+    }
+    let label = name.clone();
+    main_of(&label, move |stage: S| run(stage, name, version))
+}
+
+/// The run of `stage`, from its parsed command line to its outputs in place.
+fn run<S: Stage>(stage: S, name: String, version: String) -> Result<ExitCode> {
+    let common = stage.common();
+    let mut params = common.knobs()?;
+    stage.settle(&mut params)?;
+    if common.print_params {
+        print_params(&params);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let report = common.report.clone();
+    let (inputs, mut outputs) = stage.files();
+    outputs.push(report.as_deref());
+    check_outputs(&inputs, &outputs)?;
+    let mut run = Run::start(name, version);
+    let mut outputs = Outputs::new();
+    let done = stage.run(&params, &mut run, &mut outputs)?;
+    if let Some(report) = &report {
+        outputs.write(report, |p| run.write_report(p, &params, done.counters, done.skipped, done.notes))?;
+    }
+    outputs.keep()?;
+    Ok(if done.negative { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// The path of a flag clap requires unless `--print-params` is given.
+pub fn required<'a>(path: &'a Option<PathBuf>, flag: &str) -> Result<&'a Path> {
+    path.as_deref().ok_or_else(|| bad_parameter(format!("{flag} is required")))
+}
+
+/// The prepared scene a stage starts from (`--mesh`, `--manifest`, from
+/// mesh-prep), flattened into its `Args`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SceneArgs {
+    /// Input: mesh.exr from mesh-prep.
+    #[arg(long, value_name = "MESH.exr", required_unless_present = "print_params")]
+    pub mesh: Option<PathBuf>,
+    /// Input: manifest.ron from mesh-prep (materials, camera, effects).
+    #[arg(long, value_name = "MANIFEST.ron", required_unless_present = "print_params")]
+    pub manifest: Option<PathBuf>,
+}
+
+impl SceneArgs {
+    /// The two paths, as inputs for [`Stage::files`].
+    pub fn paths(&self) -> [Option<&Path>; 2] {
+        [self.mesh.as_deref(), self.manifest.as_deref()]
+    }
+
+    /// Reads the mesh and its manifest, checked against each other and
+    /// recorded as inputs of `run` ([`read_prepared`]).
+    pub fn read(&self, run: &mut Run) -> Result<(Mesh, Manifest)> {
+        read_prepared(run, required(&self.mesh, "--mesh")?, required(&self.manifest, "--manifest")?)
+    }
+}
