@@ -19,8 +19,11 @@ gpu: $(GPU_OUT)/image.png
 $(GPU_OUT) $(GPU_OUT)/params:
 	@mkdir -p $@
 
-$(BIN)/gpu-shoot $(BIN)/bench-gpu &: FORCE
+$(BIN)/gpu-shoot: FORCE
 	@cargo build --release --quiet -p gpu-shoot --bins
+
+$(BIN)/bench-gpu: FORCE
+	@cargo build --release --quiet -p bench --bin bench-gpu
 
 $(GPU_OUT)/params/gpu-shoot.ron: $(BIN)/gpu-shoot FORCE | $(GPU_OUT)/params
 	@$(BIN)/gpu-shoot --print-params --texels $(GPU_TEXELS) --visibility $(GPU_VISIBILITY) --convergence-target $(GPU_CONVERGENCE) \

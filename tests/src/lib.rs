@@ -1,14 +1,12 @@
 //! Helpers for the end-to-end tests: where the stage binaries are, scratch
-//! directories, scene files written from code, and the closed-form answers
-//! the tests compare with (written here independently of the stages).
+//! directories, running a stage and reading its refusal, the fuzz harness.
+//! The scenes written from code, the closed forms the tests compare with
+//! and the in-memory artifacts are the shared fixtures of `test-support`.
 //!
 //! The binaries are those of `cargo build --release`, which `make test`
 //! runs before the tests.
 
-pub mod artifacts;
-pub mod closed_form;
 pub mod fuzz;
-pub mod scenes;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

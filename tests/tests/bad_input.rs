@@ -1,9 +1,9 @@
 //! Bad input gets a one-line error naming the file (and the line where
 //! known), exit code 2, and no output file.
 
-use end_to_end::scenes::{closed_box, QuadScene};
 use end_to_end::{assert_refused, run_ok, s, scratch};
 use std::path::{Path, PathBuf};
+use test_support::scenes::{closed_box, QuadScene};
 
 /// A valid little scene in a fresh directory; returns (dir, scene path).
 fn scene(test: &str) -> (PathBuf, PathBuf) {
@@ -60,7 +60,7 @@ fn unknown_material_override_is_refused() {
     let dir = scratch("override_typo");
     let mut scene = QuadScene { camera: ([0.0, -2.0, 0.5], [0.0, 0.0, 0.0]), ..Default::default() };
     scene.material("white", 0.5, 1.0);
-    scene.quad("q", "white", end_to_end::scenes::rectangle(2, 0.0, [0.0, 0.0], [1.0, 1.0]), [0.0, 0.0, 1.0]);
+    scene.quad("q", "white", test_support::scenes::rectangle(2, 0.0, [0.0, 0.0], [1.0, 1.0]), [0.0, 0.0, 1.0]);
     let path = scene.write(&dir);
     let text = std::fs::read_to_string(&path).unwrap().replace("\"white\":", "\"whtie\":");
     std::fs::write(&path, text).unwrap();

@@ -3,10 +3,10 @@
 //! paper 002's one-bounce kind written as files is solved, an occluded one
 //! is refused with one line naming why, and nothing is written.
 
-use end_to_end::scenes::{one_bounce, straddled_receiver};
 use end_to_end::{assert_refused, run, run_ok, s, scratch};
 use schemas::exr_io::read_exr;
 use schemas::image::HdrImage;
+use test_support::scenes::{one_bounce, straddled_receiver};
 
 /// mesh-prep of the built-in simple environment, then exact at 32 x 32
 /// (one bounce): tonemap and compare read the image; compare of it with

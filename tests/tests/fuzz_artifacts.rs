@@ -8,7 +8,6 @@
 //! `end_to_end::fuzz`). The cluster hierarchy is fuzzed with the solver
 //! walking it in hierarchical-solve's tests.
 
-use end_to_end::artifacts::{closed_box, clusters_over, image, lightmap, solution, surface, table_words, with_layer_words};
 use end_to_end::fuzz::{fuzz, Kind};
 use schemas::cluster::Clusters;
 use schemas::exr_io::{read_exr, write_exr};
@@ -21,6 +20,7 @@ use schemas::solution::Solution;
 use schemas::surface::Surface;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use test_support::artifacts::{closed_box, clusters_over, image, lightmap, solution, surface, table_words, with_layer_words};
 
 /// A fresh path for one case's file (cases run on threads of their own).
 fn case_path(extension: &str) -> PathBuf {

@@ -3,20 +3,20 @@
 //! Howell C-11 (parallel rectangles) and C-14 (perpendicular rectangles
 //! sharing an edge) at two aspect ratios each, a sliver before a large
 //! wall, and the flux of an open scene. The references are the closed
-//! forms of `end_to_end::closed_form`, evaluated on the mesh gpu-shoot
+//! forms of `test_support::closed_form`, evaluated on the mesh gpu-shoot
 //! read, averaged over each element by a quadrature of their own; only the
 //! emitter's triangles shoot (`--max-shots`, every other surface black or
 //! its light leaving the scene), so each receiver's radiosity is `rho B F(point ->
 //! emitter)`. gpu-shoot needs a Vulkan adapter (lavapipe is enough):
 //! without one each test skips loudly, but fails when CI is set.
 
-use end_to_end::closed_form::{clip_to_front, lambert_polygon, parallel_rectangles, perpendicular_rectangles};
 use end_to_end::{run, run_ok, s, scratch, skipped_without_gpu};
 use schemas::lightmap::{Lightmap, COVERED};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use test_support::closed_form::{clip_to_front, lambert_polygon, parallel_rectangles, perpendicular_rectangles};
 
 /// Emitted radiosity of every emitter, W/m².
 const EMISSION: f64 = 10.0;

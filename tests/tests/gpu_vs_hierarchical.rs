@@ -73,7 +73,7 @@ fn flux(mesh: &std::path::Path, manifest: &std::path::Path, solution: &std::path
 #[test]
 fn gpu_shoot_adds_no_ambient_light_to_an_open_scene_by_default() {
     let dir = scratch("gpu_open_scene");
-    let scene = end_to_end::scenes::one_bounce(0.5, 0.05, 1.0).write(&dir);
+    let scene = test_support::scenes::one_bounce(0.5, 0.05, 1.0).write(&dir);
     let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
     run_ok("mesh-prep", &[s(&scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
     let hierarchical = dir.join("hierarchical.exr");

@@ -10,7 +10,6 @@
 //! `solver_closed_forms.rs` (`luminaire_*`).
 
 use end_to_end::fuzz::{fuzz, Kind};
-use end_to_end::scenes::{closed_box, rotational_ldt, QuadScene};
 use end_to_end::{refused, run, run_ok, s, scratch, skipped_without_gpu, solve_prepared};
 use schemas::image::HdrImage;
 use schemas::mesh::{Manifest, Mesh};
@@ -18,6 +17,7 @@ use schemas::report::Report;
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
 use std::path::{Path, PathBuf};
+use test_support::scenes::{closed_box, rotational_ldt, QuadScene};
 
 /// The EULUMDAT file of the luminaire the room uses: `I_v = 500 (1 + cos
 /// gamma)` cd (flux `2000 pi` lm), a downlight with light upwards too.

@@ -17,16 +17,16 @@
 //! ([`SOLVER_MIRRORS`]); the floor sees its own mirror image edge-on (the
 //! same plane), so no light goes floor-mirror-floor.
 
-use end_to_end::artifacts::leaf_world_corners;
-use end_to_end::closed_form::{clip_to_front, lambert_polygon, mean_over_triangle};
-use end_to_end::scenes::closed_box;
 use end_to_end::{assert_refused, run_ok, s, scratch, solve_prepared};
 use schemas::image::HdrImage;
 use schemas::mesh::{Manifest, Mesh};
-use schemas::solution::{Element, Solution, NONE};
 use schemas::ron_io::read_ron;
+use schemas::solution::{Element, Solution, NONE};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
+use test_support::artifacts::leaf_world_corners;
+use test_support::closed_form::{clip_to_front, lambert_polygon, mean_over_triangle};
+use test_support::scenes::closed_box;
 
 /// Image side, pixels.
 const SIZE: u32 = 48;

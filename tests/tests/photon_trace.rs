@@ -9,8 +9,6 @@
 //! vertices' (photon-trace writes the mean of the linear interpolant), so
 //! per-leaf checks are per-vertex checks averaged over three vertices.
 
-use end_to_end::closed_form::{lambert_polygon, point_to_rectangle};
-use end_to_end::scenes::{closed_box, rectangle, rotational_ldt, QuadScene};
 use end_to_end::{bin, refused, run_ok, s, scratch};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::report::Report;
@@ -18,6 +16,8 @@ use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use test_support::closed_form::{lambert_polygon, point_to_rectangle};
+use test_support::scenes::{closed_box, rectangle, rotational_ldt, QuadScene};
 
 /// One leaf: triangle, level, world corners, area, radiosity (red).
 struct Leaf {

@@ -21,16 +21,16 @@
 //! radiosity, and the preview's interpolation). The solver now resolves
 //! senders by the kernel in its last pass (`gather::SenderTerms`).
 
-use end_to_end::artifacts::leaf_world_corners;
-use end_to_end::closed_form::{lambert_polygon, mean_over_triangle};
-use end_to_end::scenes::closed_box;
 use end_to_end::{run_ok, s, scratch, solve_prepared};
+use schemas::image::HdrImage;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::{Node, Solution, NONE};
-use schemas::image::HdrImage;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use test_support::artifacts::leaf_world_corners;
+use test_support::closed_form::{lambert_polygon, mean_over_triangle};
+use test_support::scenes::closed_box;
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]

@@ -4,15 +4,15 @@
 //! clustering (clusters of one triangle, so that cluster nodes really sit
 //! between the triangles and the root).
 
-use end_to_end::artifacts::leaf_world_corners;
-use end_to_end::closed_form::{clip_to_front, lambert_polygon, mean_over_triangle, parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
-use end_to_end::scenes::{closed_box, one_bounce, rectangle, straddled_receiver, QuadScene};
 use end_to_end::{run_ok, s, scratch, solve_prepared};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::report::Report;
 use schemas::ron_io::read_ron;
 use schemas::solution::{Node, Solution};
 use std::path::Path;
+use test_support::artifacts::leaf_world_corners;
+use test_support::closed_form::{clip_to_front, lambert_polygon, mean_over_triangle, parallel_rectangles, perpendicular_rectangles, point_to_rectangle};
+use test_support::scenes::{closed_box, one_bounce, rectangle, straddled_receiver, QuadScene};
 
 /// The solved scene, with each element's object name.
 struct Solved {

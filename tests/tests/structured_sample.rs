@@ -4,7 +4,6 @@
 //! (`closed_form::lambert_polygon`) and, for B's one-bounce light (002 Eq.
 //! 4), a Gauss-Legendre quadrature over A of A's exact radiosity.
 
-use end_to_end::closed_form::lambert_polygon;
 use end_to_end::{refused, run_ok, s, scratch};
 use schemas::image::{HdrImage, SINGLE_SURFACE};
 use schemas::mesh::{Manifest, Mesh};
@@ -12,6 +11,7 @@ use schemas::ron_io::read_ron;
 use schemas::samples::{Samples, Tag};
 use std::f64::consts::PI;
 use std::path::PathBuf;
+use test_support::closed_form::lambert_polygon;
 
 /// The prepared simple environment and the stage's outputs.
 struct Run {
@@ -363,11 +363,11 @@ fn a_bad_parameter_is_refused_naming_it() {
 #[test]
 fn shadow_samples_lie_across_the_exact_penumbra_and_umbra() {
     let dir = scratch("structured_shadow");
-    let mut scene = end_to_end::scenes::QuadScene { camera: ([2.0, -2.5, 3.0], [2.0, 2.0, 0.0]), ..Default::default() };
+    let mut scene = test_support::scenes::QuadScene { camera: ([2.0, -2.5, 3.0], [2.0, 2.0, 0.0]), ..Default::default() };
     scene.material("floor", 0.5, 0.0).material("black", 0.0, 0.0).material("lamp", 0.0, 10.0);
-    scene.quad("floor", "floor", end_to_end::scenes::rectangle(2, 0.0, [0.0, 0.0], [4.0, 4.0]), [0.0, 0.0, 1.0]);
-    scene.quad("plate", "black", end_to_end::scenes::rectangle(2, 0.3, [1.6, 1.6], [2.4, 2.4]), [0.0, 0.0, 1.0]);
-    scene.quad("lamp", "lamp", end_to_end::scenes::rectangle(2, 2.0, [1.5, 1.5], [2.5, 2.5]), [0.0, 0.0, -1.0]);
+    scene.quad("floor", "floor", test_support::scenes::rectangle(2, 0.0, [0.0, 0.0], [4.0, 4.0]), [0.0, 0.0, 1.0]);
+    scene.quad("plate", "black", test_support::scenes::rectangle(2, 0.3, [1.6, 1.6], [2.4, 2.4]), [0.0, 0.0, 1.0]);
+    scene.quad("lamp", "lamp", test_support::scenes::rectangle(2, 2.0, [1.5, 1.5], [2.5, 2.5]), [0.0, 0.0, -1.0]);
     let scene_path = scene.write(&dir);
     let (mesh_path, manifest_path, samples_path, image) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("samples.exr"), dir.join("image.exr"));
     run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh_path), "--manifest", s(&manifest_path)]);

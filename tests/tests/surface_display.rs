@@ -20,13 +20,13 @@
 //! records; a material that would scatter more than it receives is one line
 //! naming the file, the material and the fields, exit 2, no output.
 
-use end_to_end::closed_form::{clip_to_front, lambert_polygon};
-use end_to_end::scenes::closed_box;
 use end_to_end::{assert_refused, run_ok, s, scratch, solve_prepared};
 use schemas::image::HdrImage;
 use schemas::mesh::Manifest;
 use schemas::ron_io::read_ron;
 use std::path::{Path, PathBuf};
+use test_support::closed_form::{clip_to_front, lambert_polygon};
+use test_support::scenes::closed_box;
 
 /// Image side, pixels.
 const SIZE: u32 = 48;
@@ -290,7 +290,7 @@ fn a_normal_map_tilts_the_full_gathers_cosines() {
 fn box_with_sheet(test: &str, mtl: &str, overrides: &str) -> (PathBuf, PathBuf) {
     let dir = scratch(test);
     let mut scene = closed_box(1.0, 0.5, 1.0);
-    scene.quad("sheet", "sheet", end_to_end::scenes::rectangle(2, 0.5, [0.25, 0.25], [0.75, 0.75]), [0.0, 0.0, 1.0]);
+    scene.quad("sheet", "sheet", test_support::scenes::rectangle(2, 0.5, [0.25, 0.25], [0.75, 0.75]), [0.0, 0.0, 1.0]);
     let path = scene.write(&dir);
     let library = dir.join("scene.mtl");
     let text = std::fs::read_to_string(&library).unwrap();

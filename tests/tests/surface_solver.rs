@@ -4,8 +4,6 @@
 //! read back from `surface.exr` with a bilinear lookup written here, apart
 //! from the stages' (`radiometry::texture`).
 
-use end_to_end::artifacts::leaf_world_corners;
-use end_to_end::closed_form::{lambert_polygon, mean_over_triangle};
 use end_to_end::{run_ok, s, scratch};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
@@ -13,6 +11,8 @@ use schemas::solution::{Element, Solution, NONE};
 use schemas::surface::{Surface, Texture};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use test_support::artifacts::leaf_world_corners;
+use test_support::closed_form::{lambert_polygon, mean_over_triangle};
 
 /// A quad of the test scenes: object name, material, corners (wound so
 /// that the right-hand rule gives the front) and, where textured, corner
@@ -191,7 +191,7 @@ fn a_checkerboard_floor_under_a_square_emitter_has_each_elements_radiosity_rho_t
 fn a_closed_box_with_a_textured_wall_keeps_its_energy_balance_with_the_texture_averaged_reflectance() {
     let dir = scratch("surface_solver_box");
     checks_png(&dir);
-    let scene = end_to_end::scenes::closed_box(1.0, 0.5, 1.0).write(&dir);
+    let scene = test_support::scenes::closed_box(1.0, 0.5, 1.0).write(&dir);
     // The x = 0 wall gets the checks and texture coordinates.
     let obj = std::fs::read_to_string(dir.join("scene.obj")).unwrap();
     let mut lines: Vec<String> = obj.lines().map(String::from).collect();
@@ -414,9 +414,9 @@ fn a_translucent_sheet_between_a_lamp_and_a_floor_transmits_tau_times_its_irradi
 #[test]
 fn a_closed_box_with_a_translucent_internal_wall_conserves_energy() {
     let dir = scratch("surface_solver_translucent_box");
-    let mut scene = end_to_end::scenes::closed_box(1.0, 0.5, 10.0);
+    let mut scene = test_support::scenes::closed_box(1.0, 0.5, 10.0);
     scene.material("sheet", 0.3, 0.0).two_sided.push("sheet".into());
-    scene.quad("sheet", "sheet", end_to_end::scenes::rectangle(0, 0.5, [0.0, 0.0], [1.0, 1.0]), [1.0, 0.0, 0.0]);
+    scene.quad("sheet", "sheet", test_support::scenes::rectangle(0, 0.5, [0.0, 0.0], [1.0, 1.0]), [1.0, 0.0, 0.0]);
     let path = scene.write(&dir);
     let mtl = std::fs::read_to_string(dir.join("scene.mtl")).unwrap();
     std::fs::write(dir.join("scene.mtl"), format!("{mtl}illum 2\nd 0.5\nTf 1 1 1\n")).unwrap();

@@ -8,15 +8,15 @@
 //! underside receives Lambert's irradiance of the lamp, `E(x)`, and
 //! reflects `B = rho E`; its top sees only empty space: `B = 0`.
 
-use end_to_end::artifacts::leaf_world_corners;
-use end_to_end::closed_form::{lambert_polygon, mean_over_triangle};
-use end_to_end::scenes::{rectangle, QuadScene};
 use end_to_end::{refused, run_ok, s, scratch, solve_prepared};
 use schemas::image::HdrImage;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
 use std::path::{Path, PathBuf};
+use test_support::artifacts::leaf_world_corners;
+use test_support::closed_form::{lambert_polygon, mean_over_triangle};
+use test_support::scenes::{rectangle, QuadScene};
 
 const RHO: f64 = 0.5;
 const LAMP: [[f64; 3]; 4] = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.2, 0.2, 0.0], [-0.2, 0.2, 0.0]];

@@ -316,6 +316,7 @@ fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &OneSided, coarse: Are
 mod tests {
     use super::*;
     use glam::dvec3;
+    use test_support::closed_form::point_to_corner_rectangle;
 
     /// The kernel integrates to Lambert's factor: a unit square 1 m above a
     /// point facing it, by a 200 x 200 midpoint rule; and it is 0 for a
@@ -340,20 +341,12 @@ mod tests {
         assert_eq!(point_kernel(x, nx, x, ny), 0.0);
     }
 
-    /// Differential area at the corner of, and parallel to, an a x b
-    /// rectangle at distance c (Howell catalogue B-3).
-    fn corner_parallel_rectangle(a: f64, b: f64, c: f64) -> f64 {
-        let (x, y) = (a / c, b / c);
-        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
-        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
-    }
-
     #[test]
     fn matches_the_corner_factor_of_a_parallel_rectangle() {
         for (a, b, c) in [(1.0, 1.0, 1.0), (2.0, 0.5, 0.3), (0.1, 5.0, 2.0)] {
             let rect = [dvec3(0.0, 0.0, c), dvec3(a, 0.0, c), dvec3(a, b, c), dvec3(0.0, b, c)];
             let f = point_to_polygon(DVec3::ZERO, DVec3::Z, &rect);
-            let exact = corner_parallel_rectangle(a, b, c);
+            let exact = point_to_corner_rectangle(a, b, c);
             assert!((f - exact).abs() < 1e-12 * exact.max(1.0), "{a} {b} {c}: {f} vs {exact}");
         }
     }

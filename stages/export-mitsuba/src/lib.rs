@@ -13,9 +13,11 @@
 //! | diffuse reflectance rho | `<bsdf type="diffuse">`, `<rgb name="reflectance">` | yes (RGB variants: no spectral upsampling) |
 //! | emission (exitance M, W/m², front face) | `<emitter type="area">` nested in the shape, `radiance` = M / pi | yes: Lambertian, one-sided |
 //! | ideal mirror ks (no diffuse part) | `<bsdf type="conductor">`, `material` `none`, `specular_reflectance` ks | yes: `none` disables Fresnel |
-//! | diffuse rho + mirror ks | `<bsdf type="blendbsdf">`, weight w = max ks: diffuse rho/(1-w), conductor ks/w | yes where max rho <= 1 - max ks, else the mirror part is not exported |
+//! | thin glass pane tau_s (no other part) | `<bsdf type="thindielectric">`, `int_ior` = `ext_ior` = 1, `specular_transmittance` tau_s | yes ([`Bsdf::Pane`]) |
+//! | diffuse rho + mirror ks + pane tau_s, two or three of them | nested `<bsdf type="blendbsdf">`: each specular part weighs its largest channel a and is written divided by it, the diffuse part takes the remaining weight 1 - sum a ([`blend`]) | yes where max rho <= 1 - sum a, else the specular parts that do not fit are not exported |
 //! | two-sided material (a triangle and its reversed twin) | the triangle once, its BSDF inside `<bsdf type="twosided">` | yes: both faces reflect alike, as the twins do |
-//! | specular or diffuse transmission, texture, alpha and normal maps, goniometric lights | nothing | not exported: listed in the report's `skipped` and on stderr |
+//! | two-sided pane | the pane alone, not wrapped (`thindielectric` transmits alike from both faces; Mitsuba's `twosided` refuses a transmitting BSDF) | the pane yes; a diffuse or mirror part beside it is not exported |
+//! | diffuse transmission, texture, alpha and normal maps, goniometric lights | nothing | not exported: listed in the report's `skipped` and on stderr |
 //! | manifest camera | `perspective`, `fov_axis` y, `<lookat origin target up>`, `hdrfilm` rgb float32, box filter | yes |
 //!
 //! Frames: the PLY positions and the camera are both in the mesh frame
@@ -43,8 +45,11 @@
 //! | `seed` | the sampler's seed | 0 |
 //! | `width`, `height` | film size, pixels | the manifest camera's |
 //!
-//! ```
-//! let (mesh, manifest) = mesh_prep::prepare_builtin("cornell-box", "doc").unwrap();
+//! ```no_run
+//! use std::path::Path;
+//! // The prepared Cornell box of `make` (mesh-prep's outputs).
+//! let (mesh, _) = schemas::mesh::Mesh::read(Path::new("out/cornell/mesh.exr")).unwrap();
+//! let manifest = schemas::ron_io::read_ron(Path::new("out/cornell/manifest.ron")).unwrap().value;
 //! let export = export_mitsuba::export(&mesh, &manifest, &export_mitsuba::Params::default(), "scene", "");
 //! assert!(export.xml.contains(r#"<scene version="3.0.0">"#));
 //! assert_eq!(export.meshes.iter().map(|m| m.triangles).sum::<usize>(), mesh.triangles.len());
@@ -143,14 +148,25 @@ pub enum Bsdf {
     Diffuse([f64; 3]),
     /// Ideal mirror (Fresnel off), reflectance ks.
     Mirror([f64; 3]),
-    /// `(1 - w) diffuse(rho / (1 - w)) + w mirror(ks / w)`.
+    /// Thin glass pane, transmittance tau_s: light goes straight through,
+    /// scaled by tau_s, whatever its angle and side, and nothing is
+    /// reflected. This pipeline's pane (paper 004 Sec. 4.3.3: a thin plate,
+    /// refraction neglected; README "Mirrors and glass") is exactly that,
+    /// and so is Mitsuba's `thindielectric` with equal interior and
+    /// exterior indices: its Fresnel reflectance is then 0, its
+    /// transmission 1 times `specular_transmittance`, and a thin slab does
+    /// not bend the ray. A `dielectric` would bend it (and reflect by
+    /// Fresnel); `null` cannot scale what it lets through. The pane's
+    /// reflectance, if any, is a [`Bsdf::Mirror`] part beside it.
+    Pane([f64; 3]),
+    /// `(1 - weight) first + weight second`.
     Blend {
-        /// Blend weight w of the mirror.
+        /// Weight of `second`.
         weight: f64,
-        /// The diffuse part's reflectance rho / (1 - w).
-        diffuse: [f64; 3],
-        /// The mirror part's reflectance ks / w.
-        mirror: [f64; 3],
+        /// The part weighted `1 - weight`.
+        first: Box<Bsdf>,
+        /// The part weighted `weight`.
+        second: Box<Bsdf>,
     },
 }
 
@@ -158,35 +174,70 @@ fn scaled(v: [f64; 3], s: f64) -> [f64; 3] {
     [v[0] * s, v[1] * s, v[2] * s]
 }
 
+/// `sum_i w_i part_i` as nested two-part blends, for parts `(w_i,
+/// part_i)` whose weights sum to 1 (the first part's weight is what the
+/// others leave): the blend of the first `k` parts takes part `k + 1` with
+/// weight `w_{k+1} / (w_1 + ... + w_{k+1})`.
+pub fn blend(parts: Vec<(f64, Bsdf)>) -> Bsdf {
+    let mut parts = parts.into_iter();
+    let (mut total, mut bsdf) = parts.next().expect("a blend of at least one part");
+    for (w, part) in parts {
+        total += w;
+        bsdf = Bsdf::Blend { weight: w / total, first: Box::new(bsdf), second: Box::new(part) };
+    }
+    bsdf
+}
+
 /// The Mitsuba BSDF of `material`, and a line for each part of it that has
-/// no exact Mitsuba equivalent (those parts are left out).
+/// no exact Mitsuba equivalent (those parts are left out). A specular part
+/// of largest channel `a` is written as `a x part(coefficient / a)`, the
+/// diffuse part as `(1 - sum a) x diffuse(rho / (1 - sum a))` ([`blend`]);
+/// a part alone keeps its coefficients.
 pub fn material_bsdf(material: &Material) -> (Bsdf, Vec<String>) {
     let name = &material.name;
     let mut skipped = Vec::new();
     let rho = material.diffuse;
-    let ks = material.specular_reflectance;
-    let (w, rho_max) = (max_channel(ks), max_channel(rho));
-    let bsdf = if w <= 0.0 {
-        Bsdf::Diffuse(rho)
-    } else if rho_max <= 0.0 {
-        Bsdf::Mirror(ks)
-    } else if rho_max <= 1.0 - w {
-        Bsdf::Blend { weight: w, diffuse: scaled(rho, 1.0 / (1.0 - w)), mirror: scaled(ks, 1.0 / w) }
-    } else {
-        skipped.push(format!(
-            "material '{name}': specular reflectance {ks:?} not exported (no blend weight fits beside diffuse {rho:?}); written as diffuse only"
-        ));
-        Bsdf::Diffuse(rho)
-    };
-    if max_channel(material.specular_transmittance) > 0.0 {
-        skipped.push(format!(
-            "material '{name}': specular transmittance {:?} not exported (Mitsuba's dielectrics add Fresnel reflection); surface written opaque",
-            material.specular_transmittance
-        ));
+    let (ks, tau) = (material.specular_reflectance, material.specular_transmittance);
+    let rho_max = max_channel(rho);
+    // A two-sided pane: Mitsuba's `twosided` cannot hold it, and the pane
+    // alone is symmetric, so it is written alone.
+    let pane_alone = material.two_sided && max_channel(tau) > 0.0;
+    let rho_fit = if pane_alone { 0.0 } else { rho_max };
+    let mut specular: Vec<(f64, Bsdf)> = Vec::new();
+    for (coefficients, what, part) in [(ks, "specular reflectance", Bsdf::Mirror as fn([f64; 3]) -> Bsdf), (tau, "specular transmittance", Bsdf::Pane)] {
+        let a = max_channel(coefficients);
+        if a <= 0.0 {
+            continue;
+        }
+        let taken: f64 = specular.iter().map(|(w, _)| w).sum();
+        if pane_alone && what == "specular reflectance" {
+            skipped.push(format!("material '{name}': specular reflectance {ks:?} not exported (a two-sided pane is written alone: Mitsuba's twosided cannot hold a transmitting BSDF)"));
+        } else if rho_fit <= 1.0 - taken - a {
+            specular.push((a, part(scaled(coefficients, 1.0 / a))));
+        } else {
+            skipped.push(format!(
+                "material '{name}': {what} {coefficients:?} not exported (no blend weight fits beside diffuse {rho:?}); written without it"
+            ));
+        }
     }
+    if pane_alone && rho_max > 0.0 {
+        skipped.push(format!("material '{name}': diffuse reflectance {rho:?} not exported (a two-sided pane is written alone: Mitsuba's twosided cannot hold a transmitting BSDF)"));
+    }
+    let rest = 1.0 - specular.iter().map(|(w, _)| w).sum::<f64>();
+    let bsdf = match specular.len() {
+        0 => Bsdf::Diffuse(rho),
+        1 if pane_alone || rho_max <= 0.0 => match specular.remove(0).1 {
+            Bsdf::Mirror(_) => Bsdf::Mirror(ks),
+            _ => Bsdf::Pane(tau),
+        },
+        _ => {
+            let diffuse = if rest > 0.0 { vec![(rest, Bsdf::Diffuse(scaled(rho, 1.0 / rest)))] } else { Vec::new() };
+            blend(diffuse.into_iter().chain(specular).collect())
+        }
+    };
     if max_channel(material.diffuse_transmittance) > 0.0 {
         skipped.push(format!(
-            "material '{name}': diffuse transmittance {:?} not exported (Mitsuba 3 has no diffuse transmitter); surface written opaque",
+            "material '{name}': diffuse transmittance {:?} not exported (Mitsuba 3 has no diffuse transmitter); written without it",
             material.diffuse_transmittance
         ));
     }
@@ -213,32 +264,35 @@ fn triple(v: [f64; 3]) -> String {
     format!("{}, {}, {}", v[0], v[1], v[2])
 }
 
-fn write_bsdf(out: &mut String, bsdf: &Bsdf, indent: &str) {
+/// Writes `bsdf` at `indent`, with `name` (a blend's `bsdf_0`, `bsdf_1`)
+/// where given.
+fn write_bsdf(out: &mut String, bsdf: &Bsdf, indent: &str, name: &str) {
+    let open = |kind: &str| format!("{indent}<bsdf type=\"{kind}\"{name}>");
     match bsdf {
         Bsdf::Diffuse(rho) => {
-            let _ = writeln!(out, "{indent}<bsdf type=\"diffuse\">");
+            let _ = writeln!(out, "{}", open("diffuse"));
             let _ = writeln!(out, "{indent}    <rgb name=\"reflectance\" value=\"{}\"/>", triple(*rho));
-            let _ = writeln!(out, "{indent}</bsdf>");
         }
         Bsdf::Mirror(ks) => {
-            let _ = writeln!(out, "{indent}<bsdf type=\"conductor\">");
+            let _ = writeln!(out, "{}", open("conductor"));
             let _ = writeln!(out, "{indent}    <string name=\"material\" value=\"none\"/>");
             let _ = writeln!(out, "{indent}    <rgb name=\"specular_reflectance\" value=\"{}\"/>", triple(*ks));
-            let _ = writeln!(out, "{indent}</bsdf>");
         }
-        Bsdf::Blend { weight, diffuse, mirror } => {
-            let _ = writeln!(out, "{indent}<bsdf type=\"blendbsdf\">");
+        Bsdf::Pane(tau) => {
+            let _ = writeln!(out, "{}", open("thindielectric"));
+            let _ = writeln!(out, "{indent}    <float name=\"int_ior\" value=\"1\"/>");
+            let _ = writeln!(out, "{indent}    <float name=\"ext_ior\" value=\"1\"/>");
+            let _ = writeln!(out, "{indent}    <rgb name=\"specular_transmittance\" value=\"{}\"/>", triple(*tau));
+        }
+        Bsdf::Blend { weight, first, second } => {
+            let _ = writeln!(out, "{}", open("blendbsdf"));
             let _ = writeln!(out, "{indent}    <float name=\"weight\" value=\"{weight}\"/>");
-            let _ = writeln!(out, "{indent}    <bsdf type=\"diffuse\" name=\"bsdf_0\">");
-            let _ = writeln!(out, "{indent}        <rgb name=\"reflectance\" value=\"{}\"/>", triple(*diffuse));
-            let _ = writeln!(out, "{indent}    </bsdf>");
-            let _ = writeln!(out, "{indent}    <bsdf type=\"conductor\" name=\"bsdf_1\">");
-            let _ = writeln!(out, "{indent}        <string name=\"material\" value=\"none\"/>");
-            let _ = writeln!(out, "{indent}        <rgb name=\"specular_reflectance\" value=\"{}\"/>", triple(*mirror));
-            let _ = writeln!(out, "{indent}    </bsdf>");
-            let _ = writeln!(out, "{indent}</bsdf>");
+            let inner = format!("{indent}    ");
+            write_bsdf(out, first, &inner, " name=\"bsdf_0\"");
+            write_bsdf(out, second, &inner, " name=\"bsdf_1\"");
         }
     }
+    let _ = writeln!(out, "{indent}</bsdf>");
 }
 
 /// Clip distances that keep every point of the scene visible: Mitsuba
@@ -310,12 +364,12 @@ pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &s
         let _ = writeln!(shapes, "    <shape type=\"ply\" id={}>", attribute(&format!("m{m:03}-{}", safe_name(&material.name))));
         let _ = writeln!(shapes, "        <string name=\"filename\" value={}/>", attribute(&format!("{mesh_folder}/{file_name}")));
         let _ = writeln!(shapes, "        <boolean name=\"face_normals\" value=\"true\"/>");
-        if material.two_sided {
+        if material.two_sided && !matches!(bsdf, Bsdf::Pane(_)) {
             let _ = writeln!(shapes, "        <bsdf type=\"twosided\">");
-            write_bsdf(&mut shapes, &bsdf, "            ");
+            write_bsdf(&mut shapes, &bsdf, "            ", "");
             let _ = writeln!(shapes, "        </bsdf>");
         } else {
-            write_bsdf(&mut shapes, &bsdf, "        ");
+            write_bsdf(&mut shapes, &bsdf, "        ", "");
         }
         if max_channel(material.emission) > 0.0 {
             let radiance = scaled(material.emission, 1.0 / std::f64::consts::PI);

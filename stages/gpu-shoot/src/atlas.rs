@@ -309,7 +309,7 @@ mod tests {
             Triangle { vertices: [3, 4, 5], material: 0, object: 1, area: 0.005, normal: [0.0, 0.0, 1.0] },
         ];
         let mesh = Mesh { header: Mesh::header(Provenance::in_memory("test")), positions, triangles };
-        let manifest = crate::testing::manifest(2, vec![crate::testing::material([0.5; 3], [0.0; 3])]);
+        let manifest = test_support::meshes::manifest(2, vec![test_support::meshes::material([0.5; 3], [0.0; 3])]);
         (mesh, manifest)
     }
 

@@ -49,7 +49,6 @@ pub mod detail;
 pub mod gpu;
 pub mod output;
 pub mod reference;
-pub mod testing;
 pub mod tiling;
 pub mod transmission;
 

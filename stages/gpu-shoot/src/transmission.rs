@@ -68,7 +68,7 @@ pub fn table(atlas: &Atlas, tiles: &[Tile], mesh: &Mesh, manifest: &Manifest, tw
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::{manifest, material};
+    use test_support::meshes::{manifest, material};
     use schemas::mesh::{Material, Triangle};
 
     /// A translucent two-sided quad (triangles 0, 1 and their twins 2, 3),
@@ -89,7 +89,7 @@ mod tests {
             triangle([4, 5, 6], 1, 1.0),
             triangle([4, 6, 5], 2, -1.0),
         ];
-        let mut mesh = crate::testing::triangles(&[]);
+        let mut mesh = test_support::meshes::triangles(&[]);
         mesh.positions = positions;
         mesh.triangles = triangles;
         let tau = [0.5, 0.4, 0.3];

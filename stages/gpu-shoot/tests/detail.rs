@@ -8,14 +8,15 @@
 //! skip loudly, but fail under CI.
 
 use glam::DVec3;
-use gpu_shoot::testing::{device, manifest, material, triangles};
-use gpu_shoot::{output, solve, Params, Solved, Visibility};
+use gpu_shoot::{gpu, output, solve, Params, Solved, Visibility};
 use radiometry::form_factor::point_to_polygon;
 use schemas::header::{Provenance, Schema};
 use schemas::lightmap::Lightmap;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
 use schemas::surface::{Surface, Texture, TextureKind, NONE};
+use test_support::gpu::device_or_skip;
+use test_support::meshes::{manifest, material, triangles};
 
 /// Emitted radiosity of the emitter, W/m².
 const E: f64 = 10.0;
@@ -76,7 +77,7 @@ fn params(n: u32) -> Params {
 }
 
 fn run(mesh: &Mesh, m: &Manifest, surface: Option<&Surface>, params: &Params) -> Option<Solved> {
-    let (device, queue) = device()?;
+    let (device, queue) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire)?;
     Some(solve(&device, &queue, mesh, m, surface, &[], params, &mut |_| {}).unwrap())
 }
 
@@ -331,7 +332,7 @@ fn a_normal_map_tilts_the_receivers_cosine() {
 #[test]
 fn a_closed_box_with_textured_walls_balances_with_the_textures_reflectance() {
     let (rho, kd) = (0.6, 0.2);
-    let mesh = gpu_shoot::testing::closed_box(1.0, 0.3);
+    let mesh = test_support::meshes::closed_box(1.0, 0.3);
     let m = manifest(2, vec![material([kd; 3], [0.0; 3]), material([rho; 3], [E; 3])]);
     let walls: Vec<(u32, [[f32; 2]; 3])> = (0..mesh.triangles.len())
         .filter(|&t| mesh.triangles[t].material == 0)

@@ -6,12 +6,12 @@
 //! panicked it; now the reader refuses both, and every hierarchy it
 //! accepts must solve without a panic or a hang.
 
-use end_to_end::artifacts::{closed_box, clusters_over, table_words, with_layer_words};
 use end_to_end::fuzz::{fuzz, Kind};
 use hierarchical_solve::{solve, Criterion, Params};
 use schemas::cluster::Clusters;
 use schemas::exr_io::{read_exr, write_exr};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use test_support::artifacts::{closed_box, clusters_over, table_words, with_layer_words};
 
 #[test]
 fn fuzz_cluster_hierarchy_walk() {

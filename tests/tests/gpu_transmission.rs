@@ -7,11 +7,12 @@
 //! under CI.
 
 use glam::DVec3;
-use gpu_shoot::testing::{closed_box, device, manifest, material};
-use gpu_shoot::{solve, Params, Solved};
+use gpu_shoot::{gpu, solve, Params, Solved};
 use radiometry::form_factor::point_to_polygon;
 use schemas::mesh::{Manifest, Material, Mesh, Triangle};
 use std::f64::consts::PI;
+use test_support::gpu::device_or_skip;
+use test_support::meshes::{closed_box, manifest, material};
 
 /// Emitted radiosity of the lamp, W/m².
 const E: f64 = 10.0;
@@ -64,7 +65,7 @@ fn polygon(x0: f64, x1: f64, z0: f64, z1: f64, y: f64) -> Vec<DVec3> {
 /// down; `RHO`, `TAU`), and a black lamp `[0.25, 0.75]^2` at height 1
 /// facing down (triangles 6, 7, emitting `E`).
 fn sheet_scene() -> (Mesh, Manifest) {
-    let mut mesh = gpu_shoot::testing::triangles(&[]);
+    let mut mesh = test_support::meshes::triangles(&[]);
     add_square(&mut mesh, 0.0, 1.0, 0.0, 1.0, 0.0, true, false, 0, 0);
     add_square(&mut mesh, 0.0, 1.0, 0.0, 1.0, SHEET, true, true, 1, 1);
     add_square(&mut mesh, 0.25, 0.75, 0.25, 0.75, LAMP, false, false, 2, 2);
@@ -74,7 +75,7 @@ fn sheet_scene() -> (Mesh, Manifest) {
 }
 
 fn run(mesh: &Mesh, m: &Manifest, params: &Params) -> Option<Solved> {
-    let (device, queue) = device()?;
+    let (device, queue) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire)?;
     Some(solve(&device, &queue, mesh, m, None, &[], params, &mut |_| {}).unwrap())
 }
 

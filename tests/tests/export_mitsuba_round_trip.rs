@@ -294,7 +294,7 @@ fn what_mitsuba_cannot_render_exactly_is_listed() {
 }
 
 fn binary() -> PathBuf {
-    PathBuf::from(env!("CARGO_BIN_EXE_export-mitsuba"))
+    end_to_end::bin("export-mitsuba")
 }
 
 fn temp_dir(name: &str) -> PathBuf {

@@ -12,28 +12,17 @@ use exact::transport::{Accuracy, Transport};
 use exact::{Exact, Params};
 use glam::{dvec3, DVec3};
 use std::f64::consts::PI;
+use test_support::closed_form::point_to_rectangle;
 
 fn simple() -> (schemas::mesh::Mesh, schemas::mesh::Manifest) {
     mesh_prep::prepare_builtin("simple-environment", "exact test").expect("the built-in scene prepares")
 }
 
-/// Howell's factor from a plane element to a parallel rectangle whose
-/// corner lies over it, sides `a`, `b` at distance `c`, written with signed
-/// sides (odd in each): `1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) +
-/// Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))]`, `X = a/c`, `Y = b/c`.
-fn howell_corner(a: f64, b: f64, c: f64) -> f64 {
-    let (x, y) = (a / c, b / c);
-    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
-    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
-}
-
 /// The factor from `p` (normal along -z or +z, facing the rectangle) to the
-/// axis-aligned rectangle `[x0, x1] x [y0, y1]` in the plane `z`, by four
-/// signed corner rectangles.
+/// axis-aligned rectangle `[x0, x1] x [y0, y1]` in the plane `z`: Howell's
+/// B-3 by four signed corner rectangles ([`point_to_rectangle`]).
 fn howell_rectangle(p: DVec3, (x0, x1, y0, y1): (f64, f64, f64, f64), z: f64) -> f64 {
-    let c = (p.z - z).abs();
-    howell_corner(x1 - p.x, y1 - p.y, c) - howell_corner(x0 - p.x, y1 - p.y, c) - howell_corner(x1 - p.x, y0 - p.y, c)
-        + howell_corner(x0 - p.x, y0 - p.y, c)
+    point_to_rectangle(p.x, p.y, [x0, x1, y0, y1], (p.z - z).abs())
 }
 
 /// The axis-aligned bounds and plane of a surface named `object`.

@@ -3,35 +3,22 @@
 //! references. Without an adapter they skip loudly, but fail under CI.
 
 use glam::DVec3;
+use gpu_shoot::{gpu, reference, solve, Params, Solved, Visibility};
 use radiometry::photometry::{Distribution, Luminaire, K_M};
-use gpu_shoot::testing::{closed_box, device, manifest, material, quads};
-use gpu_shoot::{reference, solve, Params, Solved, Visibility};
 use schemas::mesh::{Manifest, Mesh};
-use std::f64::consts::PI;
+use test_support::closed_form::point_to_rectangle;
+use test_support::gpu::device_or_skip;
+use test_support::meshes::{closed_box, manifest, material, quads};
 
 
 fn run(mesh: &Mesh, manifest: &Manifest, lights: &[Luminaire], params: &Params) -> Option<Solved> {
-    let (device, queue) = device()?;
+    let (device, queue) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire)?;
     Some(solve(&device, &queue, mesh, manifest, None, lights, params, &mut |_| {}).unwrap())
 }
 
 /// A light of table `d` (cd, scale 1) at `position`, nadir down, C0 along x.
 fn point_light(d: Distribution, position: [f64; 3]) -> Luminaire {
     Luminaire { distribution: d, position: DVec3::from(position), frame: [DVec3::X, DVec3::Z, -DVec3::Y], w_per_sr_per_cd: 1.0 / K_M }
-}
-
-/// Howell B-3 point to a parallel rectangle with one corner above it.
-fn corner_factor(a: f64, b: f64, h: f64) -> f64 {
-    let (x, y) = (a / h, b / h);
-    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
-    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
-}
-
-/// Point (px, pz) under the rectangle [x0, x1] x [z0, z1] at height h, by
-/// superposition of corner rectangles (signed).
-fn rect_factor(px: f64, pz: f64, x0: f64, x1: f64, z0: f64, z1: f64, h: f64) -> f64 {
-    let f = |dx: f64, dz: f64| dx.signum() * dz.signum() * corner_factor(dx.abs(), dz.abs(), h);
-    f(x1 - px, z1 - pz) - f(x0 - px, z1 - pz) - f(x1 - px, z0 - pz) + f(x0 - px, z0 - pz)
 }
 
 /// The CPU reference of the receiver pass: the irradiance per unit
@@ -100,7 +87,7 @@ fn floor_irradiance_under_a_square_emitter_matches_lambert_and_the_cpu_kernel() 
         if near_edge {
             continue;
         }
-        let exact = rho * e * rect_factor(p.x, p.z, 0.25, 0.75, 0.25, 0.75, h);
+        let exact = rho * e * point_to_rectangle(p.x, p.z, [0.25, 0.75, 0.25, 0.75], h);
         worst = worst.max((b - exact).abs() / exact);
         count += 1;
     }
@@ -189,7 +176,7 @@ fn constant_intensity_light_gives_i_cos_over_d_squared() {
 #[test]
 fn asymmetric_ldt_and_ies_lights_match_the_cpu_lookup_on_the_gpu() {
     for file in ["lidrs_example_prolicht_E30-0019.ldt", "lidrs_iesna2002_example_typec_tilt_include.ies"] {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mesh-prep/tests/data/photometry").join(file);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../stages/mesh-prep/tests/data/photometry").join(file);
     let d = mesh_prep::photometry::parse(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
     let rho = 0.5;
     let mesh = quads(&[(DVec3::new(-1.0, 0.0, -1.0), DVec3::Z * 2.0, DVec3::X * 2.0, 0, 0)]);
@@ -220,7 +207,7 @@ fn asymmetric_ldt_and_ies_lights_match_the_cpu_lookup_on_the_gpu() {
 #[test]
 fn every_shot_in_a_closed_box_delivers_its_power() {
     let base = closed_box(1.0, 0.3);
-    let Some((device, queue)) = device() else { return };
+    let Some((device, queue)) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire) else { return };
     for (visibility, limit) in [(Visibility::Hemicube, 1e-3), (Visibility::Stereographic, 5e-3)] {
     let mut worst = 0.0f64;
     for shooter in 0..base.triangles.len() {
@@ -270,7 +257,7 @@ fn a_small_lamp_over_a_large_floor_is_shot_with_overshooting_on() {
         (DVec3::new(a, h, a), DVec3::X * l, DVec3::Z * l, 1, 1),
     ]);
     let m = manifest(2, vec![material([rho; 3], [0.0; 3]), material([0.0; 3], [e; 3])]);
-    let Some((device, queue)) = device() else { return };
+    let Some((device, queue)) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire) else { return };
     let solve_with = |overshoot: bool, max_shots: usize| {
         let params = Params { texels: 4000.0, shoot_level: 0, convergence_target: 0.999, overshoot, max_shots, ..Params::default() };
         solve(&device, &queue, &mesh, &m, None, &[], &params, &mut |_| {}).unwrap()
@@ -281,7 +268,7 @@ fn a_small_lamp_over_a_large_floor_is_shot_with_overshooting_on() {
     let (mut worst_exact, mut worst_plain) = (0.0f64, 0.0f64);
     for (k, t) in over.atlas.texels.iter().enumerate().filter(|(_, t)| t.triangle < 2) {
         let p = DVec3::from(t.position.map(f64::from));
-        let exact = rho * e * rect_factor(p.x, p.z, a, b, a, b, h);
+        let exact = rho * e * point_to_rectangle(p.x, p.z, [a, b, a, b], h);
         let got = over.radiosity[k][0] as f64;
         worst_exact = worst_exact.max((got - exact).abs() / exact);
         worst_plain = worst_plain.max((got - plain.radiosity[k][0] as f64).abs() / exact);

@@ -1,24 +1,11 @@
-//! In-memory scenes for tests and the benchmark: meshes built from quads,
-//! a manifest with given materials. Not used by the stage itself.
+//! In-memory scenes: meshes built from triangles or quads, a closed box
+//! with a light patch, a manifest with given materials (written for
+//! gpu-shoot's tests and benchmark, used by any test that solves in
+//! memory).
 
 use glam::DVec3;
 use schemas::header::{Provenance, Schema};
 use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
-
-/// A device for a GPU test, or `None` (the test skips, loudly) where no
-/// Vulkan adapter exists; under CI (the variable `CI` set) a missing
-/// adapter fails the test.
-pub fn device() -> Option<(wgpu::Device, wgpu::Queue)> {
-    crate::gpu::quiet_device_select_layer();
-    match crate::gpu::acquire() {
-        Ok((d, q, _)) => Some((d, q)),
-        Err(e) if std::env::var_os("CI").is_some() => panic!("CI has no GPU adapter: {e}"),
-        Err(e) => {
-            eprintln!("\n*** SKIPPED: gpu-shoot GPU test: {e} ***\n");
-            None
-        }
-    }
-}
 
 /// A material with reflectance `rho` and emitted exitance `emission` W/m².
 pub fn material(rho: [f64; 3], emission: [f64; 3]) -> Material {

@@ -8,10 +8,11 @@
 //! Without an adapter the test skips loudly, but fails under CI.
 
 use glam::DVec3;
-use gpu_shoot::testing::{device, manifest, material, triangles};
-use gpu_shoot::{solve, Adaptive, Params, Solved};
+use gpu_shoot::{gpu, solve, Adaptive, Params, Solved};
 use radiometry::form_factor::point_to_polygon;
 use schemas::mesh::{Manifest, Mesh};
+use test_support::gpu::device_or_skip;
+use test_support::meshes::{manifest, material, triangles};
 
 /// Emitted radiosity of the lamp, W/m²; the floor's reflectance.
 const E: f64 = 10.0;
@@ -81,7 +82,7 @@ fn exact(p: DVec3) -> f64 {
 /// below the finest texel, 2 mm).
 fn run(adaptive: Option<Adaptive>) -> Option<(Solved, Mesh, Manifest)> {
     let (mesh, m) = scene();
-    let (device, queue) = device()?;
+    let (device, queue) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire)?;
     let params = Params { min_size: 2, max_size: 2, shoot_level: 3, max_shots: 1, convergence_target: 1.0, resolution: 2048, overshoot: false, adaptive, ..Params::default() };
     let solved = solve(&device, &queue, &mesh, &m, None, &[], &params, &mut |_| {}).unwrap();
     assert_eq!(solved.shots.len(), 1);
@@ -169,7 +170,7 @@ fn a_sharp_shadow_on_a_coarse_floor_is_refined_along_its_edge() {
 #[test]
 fn the_cornell_box_keeps_its_surfaces_power_under_subdivision() {
     let (mesh, m) = mesh_prep::prepare_builtin("cornell-box", "test").unwrap();
-    let Some((device, queue)) = device() else { return };
+    let Some((device, queue)) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire) else { return };
     let power = |texels: f64, adaptive: Option<Adaptive>| {
         let params = Params { texels, convergence_target: 0.995, adaptive, ..Params::default() };
         let solved = solve(&device, &queue, &mesh, &m, None, &[], &params, &mut |_| {}).unwrap();

@@ -9,13 +9,14 @@
 
 use clap::Parser;
 use glam::DVec3;
-use gpu_shoot::{gpu, solve, testing, Adaptive, Params, Visibility};
+use gpu_shoot::{gpu, solve, Adaptive, Params, Visibility};
 use schemas::header::{Provenance, Schema};
 use schemas::mesh::Mesh;
 use schemas::surface::{Surface, Texture, TextureKind, NONE};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use test_support::meshes;
 
 /// Benchmark arguments.
 #[derive(Parser, Debug)]
@@ -81,8 +82,8 @@ fn normal_mapped(mesh: &Mesh, materials: usize) -> Surface {
 /// The surface detail table: time, texels (the paper's elements), shots
 /// and the time spent subdividing.
 fn detail(device: &wgpu::Device, queue: &wgpu::Queue, texels: f64, convergence: f64) -> Result<Vec<DetailRow>, String> {
-    let mesh = testing::closed_box(1.0, 0.3);
-    let m = testing::manifest(2, vec![testing::material([0.7; 3], [0.0; 3]), testing::material([0.7; 3], [10.0; 3])]);
+    let mesh = meshes::closed_box(1.0, 0.3);
+    let m = meshes::manifest(2, vec![meshes::material([0.7; 3], [0.0; 3]), meshes::material([0.7; 3], [10.0; 3])]);
     let bumpy = normal_mapped(&mesh, 2);
     let (cornell, cornell_manifest) = mesh_prep::prepare_builtin("cornell-box", "bench-gpu").map_err(|e| e.to_string())?;
     let base = Params { texels, convergence_target: convergence, ..Params::default() };
