@@ -150,7 +150,7 @@ impl Spec {
     fn help(&self) -> String {
         let about: Vec<&str> = [self.unit, self.range.as_str()].into_iter().filter(|s| !s.is_empty()).collect();
         let about = if about.is_empty() { String::new() } else { format!(" ({})", about.join("; ")) };
-        format!("{}{about} [default: {}]", self.doc, self.default)
+        format!("{}{about} [default: {}]", self.doc.trim_end_matches('.'), self.default)
     }
 
     /// The flag of a knob that takes a value parsed by `parser`.
@@ -472,7 +472,7 @@ pub mod switch {
     pub fn flags(cmd: Command, spec: Spec) -> Command {
         let no = spec.no_id();
         let on = Arg::new(spec.name.clone()).long(spec.flag.clone()).help(spec.help()).action(ArgAction::SetTrue).overrides_with(no.clone());
-        let off = Arg::new(no).long(format!("no-{}", spec.flag)).help(format!("Clears --{}.", spec.flag)).action(ArgAction::SetTrue).overrides_with(spec.name);
+        let off = Arg::new(no).long(format!("no-{}", spec.flag)).help(format!("Clears --{}", spec.flag)).action(ArgAction::SetTrue).overrides_with(spec.name);
         cmd.arg(on).arg(off)
     }
 
@@ -798,7 +798,7 @@ mod tests {
     #[test]
     fn the_help_shows_each_default_from_the_declaration() {
         let help = StageArgs::<Toy>::augment_args(Command::new("toy")).render_long_help().to_string();
-        for line in ["Most triangles in a leaf. (triangles; in 1..=255) [default: 8]", "Seams. [default: true]", "Clears --seams.", "Lower bound. (in (0, 1)) [default: 0.05]"] {
+        for line in ["Most triangles in a leaf (triangles; in 1..=255) [default: 8]", "Seams [default: true]", "Clears --seams", "Lower bound (in (0, 1)) [default: 0.05]"] {
             assert!(help.contains(line), "{line} missing from\n{help}");
         }
         assert!(help.contains("--leaf-size <LEAF_SIZE>") && help.contains("--adaptive-lower <LOWER>"), "{help}");

@@ -67,9 +67,9 @@ impl<P: Knobs> clap::Args for StageArgs<P> {
     fn augment_args(cmd: clap::Command) -> clap::Command {
         let path = || Arg::new("").value_parser(clap::value_parser!(PathBuf)).action(ArgAction::Set);
         let cmd = cmd
-            .arg(path().id("report").long("report").value_name("REPORT.ron").help("Output: a report of the run (RON: work done, what was skipped, wall time)."))
-            .arg(path().id("params").long("params").value_name("PARAMS.ron").help("Read parameters from this RON file; flags override its values."))
-            .arg(Arg::new("print_params").long("print-params").action(ArgAction::SetTrue).help("Print the effective parameters as RON on stdout and exit."));
+            .arg(path().id("report").long("report").value_name("REPORT.ron").help("Output: a report of the run (RON: work done, what was skipped, wall time)"))
+            .arg(path().id("params").long("params").value_name("PARAMS.ron").help("Read parameters from this RON file; flags override its values"))
+            .arg(Arg::new("print_params").long("print-params").action(ArgAction::SetTrue).help("Print the effective parameters as RON on stdout and exit"));
         P::flags(cmd, "")
     }
 

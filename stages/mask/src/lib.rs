@@ -43,13 +43,9 @@
 //!
 //! ## Parameters
 //!
-//! | name | type | meaning | default |
-//! |---|---|---|---|
-//! | `display_max_cd_m2` | cd/m² | luminance of display white (sRGB 255) | 100 |
-//! | `display_black` | fraction of white | darkest luminance the display shows; floors `L_d` and `L_a` | 0.005 |
-//! | `pixels_per_degree` | pixels | image pixels per degree of visual angle (a 512-pixel image 16 degrees wide: 32) | 32 |
-//! | `levels` | count | band-pass levels of the contrast pyramid | 6 |
-//! | `masking_slope` | exponent | `s` of the masking function `max(1, C^s)` | 0.7 |
+//! [`Params`] (`mask --print-knobs`, the README's "Stage knobs"): the
+//! display (white and black luminance), the viewing distance (pixels per
+//! degree), the pyramid's depth and the masking slope.
 //!
 //! Everything here takes data, not paths, and never prints.
 
@@ -60,54 +56,27 @@ use schemas::error::Result;
 use schemas::header::Header;
 use stage_kit::run::bad_parameter;
 use schemas::threshold::ThresholdImage;
-use serde::{Deserialize, Serialize};
+use stage_kit::knobs::Knobs;
 use std::collections::BTreeMap;
 
 pub use model::elevation;
 
-/// The stage's parameters (`--params file.ron`, overridden by flags).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Luminance of display white, cd/m².
-    pub display_max_cd_m2: f64,
-    /// Darkest displayed luminance, as a fraction of white, in (0, 1).
-    pub display_black: f64,
-    /// Image pixels per degree of visual angle, > 0.
-    pub pixels_per_degree: f64,
-    /// Band-pass levels of the contrast pyramid, 1..=12.
-    pub levels: u32,
-    /// Exponent of the masking function, in (0, 1].
-    pub masking_slope: f64,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params { display_max_cd_m2: 100.0, display_black: 0.005, pixels_per_degree: 32.0, levels: 6, masking_slope: 0.7 }
+stage_kit::knobs! {
+    /// The stage's parameters (`--params file.ron`, overridden by flags).
+    pub struct Params {
+        /// Luminance of display white (sRGB 255).
+        display_max_cd_m2: f64 = 100.0, "cd/m²", value(positive());
+        /// Darkest luminance the display shows, as a fraction of white; floors `L_d` and `L_a`.
+        display_black: f64 = 0.005, "fraction of white", value(open(0.0, 1.0));
+        /// Image pixels per degree of visual angle (a 512-pixel image 16 degrees wide: 32).
+        pixels_per_degree: f64 = 32.0, "pixels", value(positive());
+        /// Band-pass levels of the contrast pyramid.
+        levels: u32 = 6, "", value(1..=12);
+        /// Exponent `s` of the masking function `max(1, C^s)`.
+        masking_slope: f64 = 0.7, "", value(left_open(0.0, 1.0));
     }
 }
 
-impl Params {
-    /// Checks every value's range; the error names the parameter.
-    pub fn validate(&self) -> Result<()> {
-        if !(self.display_max_cd_m2.is_finite() && self.display_max_cd_m2 > 0.0) {
-            return Err(bad_parameter(format!("display_max_cd_m2 must be > 0, got {}", self.display_max_cd_m2)));
-        }
-        if !(self.display_black > 0.0 && self.display_black < 1.0) {
-            return Err(bad_parameter(format!("display_black must be in (0, 1), got {}", self.display_black)));
-        }
-        if !(self.pixels_per_degree.is_finite() && self.pixels_per_degree > 0.0) {
-            return Err(bad_parameter(format!("pixels_per_degree must be > 0, got {}", self.pixels_per_degree)));
-        }
-        if !(1..=12).contains(&self.levels) {
-            return Err(bad_parameter(format!("levels must be in 1..=12, got {}", self.levels)));
-        }
-        if !(self.masking_slope > 0.0 && self.masking_slope <= 1.0) {
-            return Err(bad_parameter(format!("masking_slope must be in (0, 1], got {}", self.masking_slope)));
-        }
-        Ok(())
-    }
-}
 
 /// The per-pixel threshold, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -152,7 +121,7 @@ pub fn display_luminance(pixels: &[[u8; 3]], display_max_cd_m2: f64) -> Vec<f64>
 /// Runs the model over a `width` x `height` image of display luminances
 /// (cd/m², row-major).
 pub fn thresholds(params: &Params, width: usize, height: usize, luminance: &[f64]) -> Result<Thresholds> {
-    params.validate()?;
+    params.check("")?;
     if width == 0 || height == 0 || luminance.len() != width * height {
         return Err(bad_parameter(format!("image of {width}x{height} pixels with {} values", luminance.len())));
     }

@@ -80,5 +80,11 @@ fn params_round_trip_and_refuse_typos() {
     let text = ron::to_string(&p).unwrap();
     assert_eq!(ron::from_str::<Params>(&text).unwrap(), p);
     assert!(ron::from_str::<Params>("(pixels_per_degre: 3.0)").is_err());
-    assert!(Params { levels: 0, ..Params::default() }.validate().is_err());
+    use stage_kit::knobs::Knobs;
+    let refused = |p: Params| p.check("").unwrap_err().to_string();
+    assert_eq!(refused(Params { levels: 0, ..Params::default() }), "parameters: levels must be in 1..=12, not 0");
+    assert_eq!(refused(Params { display_black: 1.0, ..Params::default() }), "parameters: display_black must be in (0, 1), not 1");
+    assert_eq!(refused(Params { display_max_cd_m2: f64::INFINITY, ..Params::default() }), "parameters: display_max_cd_m2 must be a positive number, not inf");
+    assert_eq!(refused(Params { masking_slope: 1.5, ..Params::default() }), "parameters: masking_slope must be in (0, 1], not 1.5");
+    assert!(Params { masking_slope: 1.0, ..Params::default() }.check("").is_ok(), "(0, 1] holds 1");
 }

@@ -5,11 +5,9 @@
 //! coverage) to display values, applies the sRGB transfer function and
 //! quantises to 8 bits. Pixels no camera ray hit (coverage 0) stay black.
 //!
-//! | parameter | type | meaning | default |
-//! |---|---|---|---|
-//! | `operator` | `Reinhard` / `Exposure` | the tone curve | `Reinhard` |
-//! | `key` | `Auto` / `Fixed(a)` | Reinhard's key `a` (middle grey) | `Auto` |
-//! | `exposure` | `Auto` / `Fixed(k)` | exposure `k`, 1/(W/(m² sr)) | `Auto` |
+//! The knobs are [`Params`] (`tonemap --print-knobs`, the README's
+//! "Stage knobs"): the operator, and its key or exposure, each estimated
+//! from the image (`auto`) or given.
 //!
 //! Operators (see [`operators`] for each equation):
 //! - `Reinhard`: the global operator of Reinhard, Stark, Shirley and
@@ -52,7 +50,7 @@ use std::fmt;
 use std::str::FromStr;
 
 /// Which tone curve maps radiance to display values.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Operator {
     /// Reinhard et al. 2002 global photographic operator, on luminance.
     #[default]
@@ -61,16 +59,7 @@ pub enum Operator {
     Exposure,
 }
 
-impl FromStr for Operator {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "reinhard" => Ok(Operator::Reinhard),
-            "exposure" => Ok(Operator::Exposure),
-            _ => Err(format!("unknown operator '{s}'; expected 'reinhard' or 'exposure'")),
-        }
-    }
-}
+stage_kit::show_by_name!(Operator);
 
 /// A scale estimated from the image, or given.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Default)]
@@ -92,32 +81,35 @@ impl FromStr for Setting {
     }
 }
 
-/// The stage's parameters (see the table in the crate documentation).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Default)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// The tone curve.
-    pub operator: Operator,
-    /// Reinhard's key `a`, the display value of the log-average luminance;
-    /// used by `Reinhard` only.
-    pub key: Setting,
-    /// Exposure `k`, in 1/(W/(m² sr)); used by `Exposure` only.
-    pub exposure: Setting,
+impl stage_kit::knobs::Show for Setting {
+    fn show(&self) -> String {
+        match self {
+            Setting::Auto => "auto".to_string(),
+            Setting::Fixed(v) => v.to_string(),
+        }
+    }
 }
 
-impl Params {
-    /// Refuses a fixed key or exposure that is not a positive finite number.
-    pub fn validate(&self) -> schemas::Result<()> {
-        for (name, setting) in [("key", self.key), ("exposure", self.exposure)] {
-            if let Setting::Fixed(v) = setting {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(stage_kit::run::bad_parameter(format!(
-                        "{name} must be a positive number or 'auto', got {v}"
-                    )));
-                }
-            }
+impl Setting {
+    /// Whether the setting is `auto` or a positive finite number.
+    fn valid(&self) -> bool {
+        match *self {
+            Setting::Auto => true,
+            Setting::Fixed(v) => v.is_finite() && v > 0.0,
         }
-        Ok(())
+    }
+}
+
+stage_kit::knobs! {
+    /// The stage's parameters.
+    pub struct Params {
+        /// The tone curve.
+        operator: Operator = Operator::Reinhard, "", value;
+        /// Reinhard's key `a`, the display value of the log-average luminance
+        /// (middle grey); used by `reinhard` only.
+        key: Setting = Setting::Auto, "", value(custom("a positive number or 'auto'", Setting::valid));
+        /// Exposure `k` (`auto`: 1 / log-average luminance); used by `exposure` only.
+        exposure: Setting = Setting::Auto, "1/(W/(m² sr))", value(custom("a positive number or 'auto'", Setting::valid));
     }
 }
 
@@ -258,7 +250,7 @@ fn check(image: &HdrImage) -> Result<(), InputError> {
     Ok(())
 }
 
-/// Tone maps `image` with `params` (assumed [validated](Params::validate)).
+/// Tone maps `image` with `params` (assumed [checked](stage_kit::knobs::Knobs::check)).
 ///
 /// Statistics (log-average, percentiles, white point) are taken over the
 /// covered pixels only, so the background does not darken the key. Pixel
@@ -448,8 +440,11 @@ mod tests {
         assert_eq!("auto".parse::<Setting>(), Ok(Setting::Auto));
         assert_eq!("0.5".parse::<Setting>(), Ok(Setting::Fixed(0.5)));
         assert!("bright".parse::<Setting>().is_err());
-        assert!("filmic".parse::<Operator>().is_err());
-        assert!(Params { key: Setting::Fixed(-1.0), ..Params::default() }.validate().is_err());
+        use stage_kit::knobs::Knobs;
+        let refused = |params: Params| params.check("").unwrap_err().to_string();
+        assert_eq!(refused(Params { key: Setting::Fixed(-1.0), ..Params::default() }), "parameters: key must be a positive number or 'auto', not -1");
+        assert_eq!(refused(Params { exposure: Setting::Fixed(f64::NAN), ..Params::default() }), "parameters: exposure must be a positive number or 'auto', not NaN");
+        assert!(Params { key: Setting::Fixed(0.18), exposure: Setting::Auto, ..Params::default() }.check("").is_ok());
         let text = "(operator: Exposure, exposure: Fixed(2.0))";
         let params: Params = ron::from_str(text).unwrap();
         assert_eq!(params.exposure, Setting::Fixed(2.0));
