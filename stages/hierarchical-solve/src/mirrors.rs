@@ -43,9 +43,15 @@
 //! allows is stopped there. Couplings whose coefficients times `F`
 //! (largest channel) fall under `specular_min_factor` are dropped, and
 //! their chains not followed further (the energy bound). Goniometric point
-//! lights are not mirrored. The couplings are rebuilt on the leaves of
-//! every pass and join the gather ([`crate::gather::solve`]) as extra terms
-//! of the receiving leaves' irradiance. The links' refinement oracle does
+//! lights are not mirrored. The couplings join the gather
+//! ([`crate::gather::solve`]) as extra terms of the receiving leaves'
+//! irradiance. They depend only on the two elements they join (their
+//! corners, the windows, the scene's triangles and the seed), not on the
+//! radiosity, so each leaf-sender pair's images are traced once per solve:
+//! a pass traces only the pairs of the leaves and senders that refinement
+//! made since the last one and takes the others as they were built
+//! ([`Windows::couplings`]); the weights, and so the solution, are those a
+//! rebuild would give, bit for bit. The links' refinement oracle does
 //! not see this light, so a leaf whose couplings' light varies over it
 //! (the spread of `F` at its quadrature points) by more than the allowance
 //! is split before the next pass ([`Couplings::to_split`]).
@@ -60,10 +66,39 @@ use radiometry::sampling::{stratified_point, Stream};
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Node;
+use std::collections::HashMap;
+use std::sync::Mutex;
 
-/// A leaf's couplings as built: the leaf, `(sender, weight)` pairs, their
-/// spread, the rays cast and the truncated irradiance.
-type LeafCouplings = (u32, Vec<(usize, [f64; 3])>, f64, u64, f64);
+/// A leaf's couplings as assembled: `(sender, weight)` pairs, their spread,
+/// the rays cast, the truncated irradiance, and its traced pairs to keep.
+type LeafCouplings = (Vec<(usize, [f64; 3])>, f64, u64, f64, Vec<(u32, Pair)>);
+
+/// What the images of one sender element bring one leaf
+/// ([`Windows::images`]): each coupling's weight `coefficients x F x V'`
+/// with its factor `F`, and the coefficients times the unoccluded factors
+/// of the images one window past the depth bound.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Pair {
+    found: Vec<([f64; 3], AreaFactor)>,
+    truncated: [f64; 3],
+}
+
+impl Pair {
+    /// Whether the sender brings the leaf nothing, even past the depth.
+    fn is_empty(&self) -> bool {
+        self.found.is_empty() && self.truncated == [0.0; 3]
+    }
+}
+
+/// The pairs traced so far: the senders they were traced for (sorted) and,
+/// per leaf they were traced for, those of its pairs that are not empty,
+/// by sender (sorted). A pair of a leaf and a sender both listed and
+/// absent from the leaf's list is empty.
+#[derive(Debug, Default)]
+struct Traced {
+    senders: Vec<u32>,
+    leaves: HashMap<u32, Vec<(u32, Pair)>>,
+}
 
 /// One window: the specular triangles of one material in one plane.
 #[derive(Clone, Debug, PartialEq)]
@@ -135,6 +170,8 @@ pub struct Windows {
     seed: u64,
     /// Levels below each input triangle its senders are taken at.
     sender_level: u32,
+    /// The pairs traced in earlier passes, reused by the next.
+    traced: Mutex<Traced>,
 }
 
 /// The virtual senders' couplings into the leaves, by receiver (dense node
@@ -313,51 +350,76 @@ impl Windows {
             windows[index].1.corners.extend(g.corners);
         }
         let Knobs { rays, min_factor, quadrature, seed, sender_level, max_events } = knobs;
-        Some(Windows { windows: windows.into_iter().map(|(_, w)| w).collect(), of_triangle, rays, min_factor, quadrature, max_events, seed, sender_level })
+        Some(Windows {
+            windows: windows.into_iter().map(|(_, w)| w).collect(),
+            of_triangle,
+            rays,
+            min_factor,
+            quadrature,
+            max_events,
+            seed,
+            sender_level,
+            traced: Mutex::new(Traced::default()),
+        })
     }
 
     /// The couplings into the current leaves of `h` (module docs), with
     /// the spread of their light from radiosity `b` (one entry per dense
-    /// node index).
+    /// node index). A pair of a leaf and a sender traced by an earlier call
+    /// (both were a leaf and a sender then) is taken as traced; only the
+    /// others cast rays. Every leaf's couplings are in sender order, as a
+    /// rebuild would list them.
     pub fn couplings(&self, h: &Hierarchy, scene: &SceneRays, b: &[[f64; 3]]) -> Couplings {
         let nodes = b.len();
         let senders: Vec<u32> = (0..h.triangles.len() as u32).filter(|&t| self.of_triangle[t as usize].is_none()).flat_map(|t| self.senders_below(h, t)).collect();
         let leaves: Vec<u32> =
             (0..h.elements.len() as u32).filter(|&e| h.elements[e as usize].is_leaf() && self.of_triangle[h.elements[e as usize].triangle as usize].is_none()).collect();
-        let per_leaf: Vec<LeafCouplings> = leaves
-            .par_iter()
-            .map(|&r| {
-                let (mut found, mut spread, mut rays, mut tail) = (Vec::new(), 0.0, 0, [0.0; 3]);
+        let mut traced = self.traced.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let before = std::mem::take(&mut traced.senders);
+        let mut lists = std::mem::take(&mut traced.leaves);
+        let previous: Vec<(u32, Option<Vec<(u32, Pair)>>)> = leaves.iter().map(|&r| (r, lists.remove(&r))).collect();
+        let per_leaf: Vec<LeafCouplings> = previous
+            .into_par_iter()
+            .map(|(r, mut old)| {
+                let (mut found, mut spread, mut rays, mut tail, mut kept) = (Vec::new(), 0.0, 0, [0.0; 3], Vec::new());
                 for &s in &senders {
                     let sender = h.flat(Node::Element(s));
-                    let mut truncated = [0.0; 3];
-                    rays += self.images(
-                        h,
-                        scene,
-                        r,
-                        s,
-                        &mut |weight, f| {
-                            // weight / F_mean x (F_max - F_min), per channel.
-                            spread += (0..3).map(|c| weight[c] * b[sender][c] * (f.max - f.min) / f.mean).fold(0.0, f64::max);
-                            found.push((sender, weight));
-                        },
-                        &mut truncated,
-                    );
-                    (0..3).for_each(|c| tail[c] += truncated[c] * b[sender][c]);
+                    let pair = match old.as_mut().filter(|_| before.binary_search(&s).is_ok()) {
+                        Some(list) => list.binary_search_by_key(&s, |(t, _)| *t).map_or_else(|_| Pair::default(), |k| std::mem::take(&mut list[k].1)),
+                        None => {
+                            let (pair, cast) = self.images(h, scene, r, s);
+                            rays += cast;
+                            pair
+                        }
+                    };
+                    for &(weight, f) in &pair.found {
+                        // weight / F_mean x (F_max - F_min), per channel.
+                        spread += (0..3).map(|c| weight[c] * b[sender][c] * (f.max - f.min) / f.mean).fold(0.0, f64::max);
+                        found.push((sender, weight));
+                    }
+                    (0..3).for_each(|c| tail[c] += pair.truncated[c] * b[sender][c]);
+                    if !pair.is_empty() {
+                        kept.push((s, pair));
+                    }
                 }
-                (r, found, spread, rays, tail.into_iter().fold(0.0, f64::max))
+                kept.sort_unstable_by_key(|(s, _)| *s);
+                (found, spread, rays, tail.into_iter().fold(0.0, f64::max), kept)
             })
             .collect();
         let mut rows: Vec<Vec<(usize, [f64; 3])>> = vec![Vec::new(); nodes];
         let mut couplings = Couplings { spread: vec![0.0; nodes], ..Couplings::default() };
         let largest = self.windows.iter().flat_map(|w| w.reflectance.into_iter().chain(w.transmittance)).fold(0.0, f64::max);
-        for (r, found, spread, rays, tail) in per_leaf {
+        let mut now = Traced { senders: senders.clone(), leaves: HashMap::with_capacity(leaves.len()) };
+        now.senders.sort_unstable();
+        for (&r, (found, spread, rays, tail, kept)) in leaves.iter().zip(per_leaf) {
             couplings.truncation = couplings.truncation.max(if largest < 1.0 { tail / (1.0 - largest) } else { f64::INFINITY });
             let i = h.flat(Node::Element(r));
             rows[i] = found;
             couplings.spread[i] = spread;
             couplings.rays += rays;
+            now.leaves.insert(r, kept);
         }
+        *traced = now;
         couplings.rows = Rows::from_lists(rows);
         couplings
     }
@@ -379,15 +441,14 @@ impl Windows {
     }
 
     /// The images of sender element `s` that leaf `r` sees through chains
-    /// of up to `max_events` windows (module docs): `found(weight, F)` for
-    /// each, `weight = coefficients x F x V'`, `F` the unclipped factor to
-    /// the image. Returns the rays cast.
-    /// `truncated` receives the coefficients times unoccluded factors of
-    /// the images one window past the depth bound.
-    fn images(&self, h: &Hierarchy, scene: &SceneRays, r: u32, s: u32, found: &mut dyn FnMut([f64; 3], AreaFactor), truncated: &mut [f64; 3]) -> u64 {
+    /// of up to `max_events` windows (module docs): for each, `weight =
+    /// coefficients x F x V'` and `F`, the unclipped factor to the image;
+    /// and the coefficients times unoccluded factors of the images one
+    /// window past the depth bound. Returns them and the rays cast.
+    fn images(&self, h: &Hierarchy, scene: &SceneRays, r: u32, s: u32) -> (Pair, u64) {
         let (re, se) = (&h.elements[r as usize], &h.elements[s as usize]);
         let nr = h.normal(r);
-        let mut cast = 0;
+        let (mut pair, mut cast) = (Pair::default(), 0);
         let mut stack = vec![Image { corners: vec![se.points], normal: h.normal(s), path: Vec::new(), coefficient: [1.0; 3] }];
         while let Some(image) = stack.pop() {
             let past = image.path.len() >= self.max_events as usize;
@@ -399,7 +460,7 @@ impl Windows {
                 let last = next.corners[next.corners.len() - 1];
                 let f = triangle_to_polygon(&re.points, nr, &last, next.normal, self.quadrature);
                 if past {
-                    (0..3).for_each(|c| truncated[c] += next.coefficient[c] * f.mean);
+                    (0..3).for_each(|c| pair.truncated[c] += next.coefficient[c] * f.mean);
                     continue;
                 }
                 if f.mean <= 0.0 || next.coefficient.iter().fold(0.0f64, |a, &c| a.max(c)) * f.mean < self.min_factor {
@@ -408,12 +469,12 @@ impl Windows {
                 let (v, rays) = self.visible(h, scene, r, s, &next);
                 cast += rays;
                 if v > 0.0 {
-                    found(next.coefficient.map(|c| c * f.mean * v), f);
+                    pair.found.push((next.coefficient.map(|c| c * f.mean * v), f));
                 }
                 stack.push(next);
             }
         }
-        cast
+        (pair, cast)
     }
 
     /// Kernel-weighted fraction of stratified pairs `(x on r, y on the
