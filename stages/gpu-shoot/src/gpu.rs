@@ -87,8 +87,11 @@ pub struct GpuParams {
     pub overshoot: u32,
     /// Groups (samples) of the shooter.
     pub group_count: u32,
-    /// Padding to the WGSL layout.
-    pub _pad0: [u32; 2],
+    /// Reflection tree ([`crate::mirrors`]): 1 + the level of the node
+    /// whose virtual samples shoot (0: the real samples).
+    pub level: u32,
+    /// Reflection tree: the first virtual sample.
+    pub virtual_base: u32,
     /// Relative depth tolerance of the visibility test.
     pub tolerance: f32,
     /// Near plane of the cube faces, m.
@@ -227,6 +230,8 @@ pub struct Gpu {
     /// irradiance) and its pass adding `rho_d H + tau_d H_twin`.
     transmit: Option<[wgpu::ComputePipeline; 2]>,
     render: wgpu::RenderPipeline,
+    /// The reflection tree's, where a material is specular.
+    mirrors: Option<Mirrors>,
     layer_views: Vec<wgpu::TextureView>,
     depth_view: wgpu::TextureView,
     /// Visibility map side, pixels.
@@ -286,6 +291,56 @@ pub struct Setup<'a> {
     /// Per texel, its diffuse transmittance (xyz) and the bits of its
     /// twin texel (w, `u32::MAX` for none), where a material transmits.
     pub transmission: Option<&'a [[f32; 4]]>,
+    /// The reflection tree's tables, where a material is specular.
+    pub mirrors: Option<MirrorSetup<'a>>,
+}
+
+/// What the reflection tree ([`crate::mirrors`]) needs on the device.
+pub struct MirrorSetup<'a> {
+    /// Per triangle: 1 where its material reflects or transmits specularly.
+    pub specular: &'a [u32],
+    /// Levels of a branch (the depth bound, plus one to find what it cuts).
+    pub levels: usize,
+    /// Window entries per level: the specular triangles.
+    pub windows_per_level: usize,
+    /// Virtual samples per level: the batch.
+    pub views_per_level: usize,
+}
+
+/// Host mirror of `Level` in mirrors_common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLevel {
+    /// xyz: the window's unit normal, w: offset; the node's virtual
+    /// shooter lies on the negative side.
+    pub plane: [f32; 4],
+    /// x: first window entry, y: entries, z: first layer of its maps.
+    pub window: [u32; 4],
+}
+
+/// Host mirror of `View` in mirrors_common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuView {
+    /// xyz: the frustum's right axis times k.
+    pub right: [f32; 4],
+    /// xyz: its up axis times k.
+    pub up: [f32; 4],
+    /// xyz: its axis; w: k = 1 / tan(half the field of view).
+    pub axis: [f32; 4],
+}
+
+/// The reflection tree's buffers and passes on the device.
+struct Mirrors {
+    levels: wgpu::Buffer,
+    windows: wgpu::Buffer,
+    views: wgpu::Buffer,
+    hits: wgpu::Buffer,
+    specular: Vec<u32>,
+    windows_per_level: usize,
+    render: wgpu::RenderPipeline,
+    receive: Vec<wgpu::ComputePipeline>,
+    mark: wgpu::ComputePipeline,
 }
 
 const SAMPLE_SIZE: u64 = std::mem::size_of::<GpuSample>() as u64;
@@ -354,8 +409,14 @@ impl Gpu {
         let depth_view = depth.create_view(&Default::default());
 
         let common = include_str!("shaders/common.wgsl");
-        let solver_source = format!("{common}\n{}", include_str!("shaders/solver.wgsl"));
-        let render_source = format!("{common}\n{}", include_str!("shaders/visibility.wgsl"));
+        let mut solver_source = format!("{common}\n{}", include_str!("shaders/solver.wgsl"));
+        let mut render_source = format!("{common}\n{}", include_str!("shaders/visibility.wgsl"));
+        // The reflection tree's code only for a scene that needs it.
+        if setup.mirrors.is_some() {
+            let tree = include_str!("shaders/mirrors_common.wgsl");
+            solver_source += &format!("\n{tree}\n{}", include_str!("shaders/mirrors.wgsl"));
+            render_source += &format!("\n{tree}\n{}", include_str!("shaders/visibility_mirrors.wgsl"));
+        }
         let solver_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("solver.wgsl"),
             source: wgpu::ShaderSource::Wgsl(solver_source.into()),
@@ -391,6 +452,19 @@ impl Gpu {
         if transmission.is_some() {
             entries.extend([storage(13, c, true), storage(14, c, false)]);
         }
+        // The reflection tree: its branch, window entries, frustums and hits.
+        let mirror_buffers = setup.mirrors.as_ref().map(|m| {
+            let copy = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+            [
+                init("levels", &vec![0u8; m.levels * std::mem::size_of::<GpuLevel>()], copy),
+                init("windows", &vec![0u8; m.levels * m.windows_per_level.max(1) * 16], copy),
+                init("views", &vec![0u8; m.levels * m.views_per_level.max(1) * std::mem::size_of::<GpuView>()], copy),
+                init("hits", bytemuck::cast_slice(m.specular), rw),
+            ]
+        });
+        if mirror_buffers.is_some() {
+            entries.extend([storage(15, c, true), storage(16, c, true), storage(17, c, true), storage(18, c, false)]);
+        }
         let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("solver"), entries: &entries });
         let buffers = [&params, &texels, &radiosity, &residual, &tris, &groups, &tri_power, &selection, &samples, &ldt];
         let mut bind: Vec<wgpu::BindGroupEntry> =
@@ -402,6 +476,9 @@ impl Gpu {
         }
         for (k, buffer) in transmission.iter().flatten().enumerate() {
             bind.push(wgpu::BindGroupEntry { binding: 13 + k as u32, resource: buffer.as_entire_binding() });
+        }
+        for (k, buffer) in mirror_buffers.iter().flatten().enumerate() {
+            bind.push(wgpu::BindGroupEntry { binding: 15 + k as u32, resource: buffer.as_entire_binding() });
         }
         let compute_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("solver"), layout: &compute_layout, entries: &bind });
         let compute_pipeline_layout =
@@ -419,7 +496,7 @@ impl Gpu {
 
         // The masked fragment stage reads the samples and the corners too.
         let v = wgpu::ShaderStages::VERTEX;
-        let vf = if setup.masks.is_some() { v | wgpu::ShaderStages::FRAGMENT } else { v };
+        let vf = if setup.masks.is_some() || setup.mirrors.is_some() { v | wgpu::ShaderStages::FRAGMENT } else { v };
         let mut render_entries = vec![uniform(0, vf), storage(1, vf, true), storage(2, vf, true)];
         let mut render_bind = vec![
             wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
@@ -437,31 +514,52 @@ impl Gpu {
                 render_bind.push(wgpu::BindGroupEntry { binding: 3 + k as u32, resource: buffer.as_entire_binding() });
             }
         }
+        // The frustum maps read the views and the branch's planes.
+        if let Some([levels, _, views, _]) = &mirror_buffers {
+            for (binding, buffer) in [(5, views), (6, levels)] {
+                render_entries.push(storage(binding, v, true));
+                render_bind.push(wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() });
+            }
+        }
         let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("visibility"), entries: &render_entries });
         let render_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("visibility"), layout: &render_layout, entries: &render_bind });
         let render_pipeline_layout =
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("visibility"), bind_group_layouts: &[Some(&render_layout)], immediate_size: 0 });
-        let render = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("visibility"),
-            layout: Some(&render_pipeline_layout),
-            vertex: wgpu::VertexState { module: &render_module, entry_point: Some("vs"), compilation_options: Default::default(), buffers: &[] },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &render_module,
-                entry_point: Some(if mask_buffers.is_some() { "fs_masked" } else { "fs" }),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format: wgpu::TextureFormat::R32Float, blend: None, write_mask: wgpu::ColorWrites::ALL })],
-            }),
-            multiview_mask: None,
-            cache: None,
+        let render_pipeline = |vertex: &str, fragment: &str| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(fragment),
+                layout: Some(&render_pipeline_layout),
+                vertex: wgpu::VertexState { module: &render_module, entry_point: Some(vertex), compilation_options: Default::default(), buffers: &[] },
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: wgpu::TextureFormat::Depth32Float,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &render_module,
+                    entry_point: Some(fragment),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState { format: wgpu::TextureFormat::R32Float, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let render = render_pipeline("vs", if mask_buffers.is_some() { "fs_masked" } else { "fs" });
+        let mirrors = setup.mirrors.as_ref().zip(mirror_buffers).map(|(m, [levels, windows, views, hits])| Mirrors {
+            levels,
+            windows,
+            views,
+            hits,
+            specular: m.specular.to_vec(),
+            windows_per_level: m.windows_per_level.max(1),
+            render: render_pipeline("vs_virtual", "fs_virtual"),
+            receive: if transmission.is_some() { vec![pipeline("receive_mirrored_translucent"), pipeline("transmit")] } else { vec![pipeline("receive_mirrored")] },
+            mark: pipeline("mark_specular"),
         });
         Gpu {
             texel_count: setup.texels.len() as u32,
@@ -484,6 +582,7 @@ impl Gpu {
             count: counts.map(|buffer| (pipeline("count_visible"), buffer)),
             transmit: transmission.map(|_| [pipeline("receive_translucent"), pipeline("transmit")]),
             render,
+            mirrors,
             layer_views,
             depth_view,
             res: setup.res,
@@ -566,37 +665,101 @@ impl Gpu {
                     continue;
                 }
                 let layer = sample * params.layers_per_sample + face;
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: None,
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &self.layer_views[layer as usize],
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r: 1e30, g: 0.0, b: 0.0, a: 0.0 }), store: wgpu::StoreOp::Store },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &self.depth_view,
-                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.render);
-                pass.set_bind_group(0, &self.render_group, &[]);
-                if hemicube && face > 0 && params.mode == 0 {
-                    pass.set_scissor_rect(0, 0, self.res, self.res.div_ceil(2));
-                }
-                pass.draw(0..self.vertex_count, layer..layer + 1);
+                self.render_layer(&mut encoder, &self.render, layer, layer, hemicube && face > 0 && params.mode == 0);
             }
         }
+        self.dispatch_texels(&mut encoder, passes);
+        queue.submit([encoder.finish()]);
+    }
+
+    /// Renders instance `instance` of the scene with `pipeline` into
+    /// visibility layer `layer` (its top half only where `half`).
+    fn render_layer(&self, encoder: &mut wgpu::CommandEncoder, pipeline: &wgpu::RenderPipeline, layer: u32, instance: u32, half: bool) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: None,
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.layer_views[layer as usize],
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r: 1e30, g: 0.0, b: 0.0, a: 0.0 }), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.render_group, &[]);
+        if half {
+            pass.set_scissor_rect(0, 0, self.res, self.res.div_ceil(2));
+        }
+        pass.draw(0..self.vertex_count, instance..instance + 1);
+    }
+
+    /// Runs `passes` over every texel, in order.
+    fn dispatch_texels(&self, encoder: &mut wgpu::CommandEncoder, passes: &[wgpu::ComputePipeline]) {
         let groups = self.texel_count.div_ceil(64);
         let (x, y) = if groups <= 65535 { (groups.max(1), 1) } else { (65535, groups.div_ceil(65535)) };
         for pass in passes {
-            self.dispatch(&mut encoder, pass, x, y);
+            self.dispatch(encoder, pass, x, y);
         }
+    }
+
+    /// Reads back the first `count` samples (their powers as `prepare`
+    /// filled them), for the reflection tree's virtual samples.
+    pub fn read_samples(&self, device: &wgpu::Device, queue: &wgpu::Queue, count: u32) -> Vec<GpuSample> {
+        bytemuck::pod_collect_to_vec(&read_buffer(device, queue, &self.samples, count as u64 * SAMPLE_SIZE))
+    }
+
+    /// The reflection tree's state, for a solver built with `mirrors`.
+    fn tree(&self) -> &Mirrors {
+        self.mirrors.as_ref().expect("a solver built for specular materials")
+    }
+
+    /// Writes node `level` (0-based) of the branch: its plane and layers,
+    /// its window entries (rgb coefficient, triangle bits), and its
+    /// virtual samples (at `virtual_base + level count + i`) with their
+    /// frustums.
+    pub fn write_node(&self, queue: &wgpu::Queue, level: u32, virtual_base: u32, node: GpuLevel, windows: &[[f32; 4]], samples: &[GpuSample], views: &[GpuView]) {
+        let tree = self.tree();
+        let first = level as usize * tree.windows_per_level;
+        let node = GpuLevel { window: [first as u32, windows.len() as u32, node.window[2], 0], ..node };
+        queue.write_buffer(&tree.levels, level as u64 * std::mem::size_of::<GpuLevel>() as u64, bytemuck::bytes_of(&node));
+        queue.write_buffer(&tree.windows, first as u64 * 16, bytemuck::cast_slice(windows));
+        let count = samples.len() as u64;
+        queue.write_buffer(&self.samples, (virtual_base as u64 + level as u64 * count) * SAMPLE_SIZE, bytemuck::cast_slice(samples));
+        queue.write_buffer(&tree.views, level as u64 * count * std::mem::size_of::<GpuView>() as u64, bytemuck::cast_slice(views));
+    }
+
+    /// Renders the frustum maps of the node at `params.level` (its
+    /// virtual samples, into layers `first_layer ..`) and runs its
+    /// receiver pass over every texel (004 Eq. 4.7-4.8).
+    pub fn shoot_node(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, first_layer: u32) {
+        let tree = self.tree();
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        for i in 0..params.sample_count {
+            self.render_layer(&mut encoder, &tree.render, first_layer + i, i, false);
+        }
+        self.dispatch_texels(&mut encoder, &tree.receive);
         queue.submit([encoder.finish()]);
+    }
+
+    /// The specular triangles that the pass at `params.level` lit (their
+    /// texels gather light from the batch's samples at that level).
+    pub fn lit_specular(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams) -> Vec<u32> {
+        let tree = self.tree();
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.dispatch_texels(&mut encoder, std::slice::from_ref(&tree.mark));
+        queue.submit([encoder.finish()]);
+        let hits: Vec<u32> = bytemuck::pod_collect_to_vec(&read_buffer(device, queue, &tree.hits, self.tri_count as u64 * 4));
+        queue.write_buffer(&tree.hits, 0, bytemuck::cast_slice(&tree.specular));
+        hits.iter().enumerate().filter(|(_, &h)| h & 2 != 0).map(|(t, _)| t as u32).collect()
     }
 
     /// Sets the shooter's residual to -dB' (0 without overshooting).

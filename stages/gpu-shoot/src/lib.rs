@@ -18,7 +18,9 @@
 //! Surface detail from `mesh-prep --surface` ([`detail`]): per-texel
 //! reflectance from diffuse textures (004 Sec. 4.2), alpha masks that
 //! remove texels and discard their fragments in the visibility maps (Sec.
-//! 4.3.4), normal maps for the cosines (Sec. 2.3.3). Diffuse transmission
+//! 4.3.4), normal maps for the cosines (Sec. 2.3.3). Planar mirrors and
+//! thin glass by the reflection tree of virtual shooters built during each
+//! shot ([`mirrors`], Sec. 4.3.2-4.3.3). Diffuse transmission
 //! through the twin faces of two-sided translucent materials
 //! ([`transmission`], Sec. 4.3.1, Eq. 4.4). Adaptive subdivision
 //! at shadow boundaries ([`tiling`], Sec. 2.4) splits receivers into tiles
@@ -42,11 +44,14 @@
 //! | `max_shots` | stop after this many shots | 100000 |
 //! | `ambient` | add `rho x ambient` (Eq. 2.4) to the solution's radiosity: a display aid for an unconverged solution, off by default because it adds light that an open scene does not have | false |
 //! | `texels_per_leaf` | solution leaves: about this many texels each | 4 |
+//! | `reflection_depth` | planar mirrors and thin panes ([`mirrors`], 004 Sec. 4.3.2-4.3.3): most windows on a light path of the reflection tree | 4 |
+//! | `reflection_threshold` | a node of the reflection tree whose power bound (Eq. 4.6) is under this fraction of the emitted power is not rendered | 1e-4 |
 //! | `adaptive` | subdivision at shadow boundaries (004 Sec. 2.4): `lower`, `upper` (the bounds `b_l`, `b_u` of the visible fraction `n_v / n_r` that splits a receiver), `levels` (most splits of an input triangle) | off; on: 0.05, 0.95, 3 |
 
 pub mod atlas;
 pub mod detail;
 pub mod gpu;
+pub mod mirrors;
 pub mod output;
 pub mod reference;
 pub mod tiling;
@@ -115,6 +120,16 @@ pub struct Params {
     pub ambient: bool,
     /// Texels per solution leaf, about.
     pub texels_per_leaf: f64,
+    /// Most windows (mirrors and panes) on a light path of the reflection
+    /// tree ([`mirrors`]); written only where not the default, so the
+    /// artifacts of a run without it keep their bits.
+    #[serde(skip_serializing_if = "is_default_depth")]
+    pub reflection_depth: u32,
+    /// A node of the reflection tree whose power bound (004 Eq. 4.6, made
+    /// a bound) is under this fraction of the emitted power is cut
+    /// (written only where not the default).
+    #[serde(skip_serializing_if = "is_default_threshold")]
+    pub reflection_threshold: f64,
     /// Adaptive subdivision at shadow boundaries (off: `None`, and then
     /// not written, so the artifacts of a run without it keep their bits).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -152,6 +167,19 @@ impl Adaptive {
     }
 }
 
+/// The default `reflection_depth`.
+const REFLECTION_DEPTH: u32 = 4;
+/// The default `reflection_threshold`.
+const REFLECTION_THRESHOLD: f64 = 1e-4;
+
+fn is_default_depth(depth: &u32) -> bool {
+    *depth == REFLECTION_DEPTH
+}
+
+fn is_default_threshold(threshold: &f64) -> bool {
+    *threshold == REFLECTION_THRESHOLD
+}
+
 impl Default for Params {
     fn default() -> Self {
         Params {
@@ -167,6 +195,8 @@ impl Default for Params {
             max_shots: 100_000,
             ambient: false,
             texels_per_leaf: 4.0,
+            reflection_depth: REFLECTION_DEPTH,
+            reflection_threshold: REFLECTION_THRESHOLD,
             adaptive: None,
         }
     }
@@ -195,6 +225,12 @@ impl Params {
         }
         if !(self.texels_per_leaf.is_finite() && self.texels_per_leaf >= 1.0) {
             return Some(format!("texels_per_leaf must be at least 1, got {}", self.texels_per_leaf));
+        }
+        if !(1..=16).contains(&self.reflection_depth) {
+            return Some(format!("reflection_depth must be in 1..=16, got {}", self.reflection_depth));
+        }
+        if !(self.reflection_threshold.is_finite() && (0.0..1.0).contains(&self.reflection_threshold)) {
+            return Some(format!("reflection_threshold must be in [0, 1), got {}", self.reflection_threshold));
         }
         if let Some(a) = &self.adaptive {
             if !(0.0 <= a.lower && a.lower <= a.upper && a.upper <= 1.0) {
@@ -250,6 +286,9 @@ pub struct Work {
     /// Triangles of translucent materials that are not two-sided: they
     /// transmit nothing ([`transmission`]).
     pub one_sided_translucent: u64,
+    /// The reflection tree's nodes, depth, power bounds and time
+    /// ([`mirrors`]; zero for a scene without specular materials).
+    pub reflection: mirrors::TreeWork,
 }
 
 /// The result of a solve.
@@ -316,6 +355,10 @@ struct Context<'a> {
     twins: Vec<Option<u32>>,
     layers: u32,
     ldt_capacity: usize,
+    /// The specular coefficients, where a material is specular.
+    specular: Option<&'a mirrors::Specular>,
+    /// Samples per batch (the virtual samples of a level).
+    batch: u32,
 }
 
 /// The solver's state for one set of tiles.
@@ -329,6 +372,9 @@ struct Built {
     mask_texels: u64,
     /// Translucent input triangles that transmit nothing (not two-sided).
     one_sided: u64,
+    /// The first virtual sample of the reflection tree (after the
+    /// largest shooter's samples).
+    virtual_base: u32,
 }
 
 /// Initial radiosity and residual per covered texel of a new atlas.
@@ -440,6 +486,15 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
         Some(init) => init(&atlas),
         None => (emission.clone(), emission),
     };
+    // Per tile, whether its input triangle is specular; the virtual
+    // samples follow the shooters' in the samples buffer.
+    let specular_flags: Vec<u32> = c.specular.map_or(Vec::new(), |s| {
+        let flags = s.flags();
+        tiles.iter().map(|t| flags[t.root as usize]).collect()
+    });
+    let windows_per_level = specular_flags.iter().filter(|&&f| f != 0).count();
+    let virtual_base = max_groups.max(1);
+    let virtual_samples = if c.specular.is_some() { c.params.reflection_depth * c.batch } else { 0 };
     let gpu = Gpu::new(
         c.device,
         &Setup {
@@ -451,17 +506,23 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
             vertices: &vertices,
             res: c.params.resolution,
             layers: c.layers,
-            sample_capacity: max_groups.max(1),
+            sample_capacity: max_groups.max(1) + virtual_samples,
             ldt_capacity: c.ldt_capacity,
             masks: masks.as_ref().map(|(t, m)| (t.as_slice(), m.as_slice())),
             adaptive: c.params.adaptive.is_some(),
             transmission: transmission.as_ref().map(|(table, _)| table.as_slice()),
+            mirrors: c.specular.map(|_| gpu::MirrorSetup {
+                specular: &specular_flags,
+                levels: c.params.reflection_depth as usize,
+                windows_per_level,
+                views_per_level: c.batch as usize,
+            }),
         },
     );
     let normal_mapped = (0..tiles.len()).map(|t| detail.as_ref().is_some_and(|d| d.normal_mapped(mesh, t))).collect();
     let mask_texels = masks.as_ref().map_or(0, |(_, m)| m.len() as u64);
     let one_sided = transmission.map_or(0, |(_, n)| n as u64);
-    Built { atlas, texels, tris, gpu, normal_mapped, mask_texels, one_sided }
+    Built { atlas, texels, tris, gpu, normal_mapped, mask_texels, one_sided, virtual_base }
 }
 
 /// The samples of tile `shooter` (positions, frames, polygons; the GPU
@@ -542,6 +603,18 @@ pub fn solve(
     let batch = (layer_budget / 6).max(1);
     let layers = if hemicube { batch * 6 } else { (layer_budget / 6 * 6).max(6) };
     let batch_area = if hemicube { batch } else { layers };
+    // With specular materials each sample also needs one frustum map per
+    // level of the reflection tree's branch, kept while its children are
+    // shot (004 Sec. 4.3.2: one map per recursion depth); lights use 6.
+    let specular = mirrors::Specular::of(mesh, manifest);
+    let (layers, batch_area) = match &specular {
+        None => (layers, batch_area),
+        Some(_) => {
+            let per_sample = layers_per_sample + params.reflection_depth;
+            let batch = (layer_budget / per_sample).max(1);
+            ((batch * per_sample).max(6 + params.reflection_depth), batch)
+        }
+    };
     let context = Context {
         device,
         mesh,
@@ -552,6 +625,8 @@ pub fn solve(
         twins: mesh.twins(),
         layers,
         ldt_capacity: lights.iter().map(|l| light_table(l).len()).max().unwrap_or(4),
+        specular: specular.as_ref(),
+        batch: batch_area,
     };
     let mut tiles = tiling::identity(mesh);
     let mut built = build(&context, &tiles, None);
@@ -607,6 +682,12 @@ pub fn solve(
     let mut selection = built.gpu.select(device, queue, &base);
     let initial_unshot = magnitude_of(&selection, unshot_lights);
     let offset = 1e-6 * diagonal;
+    // The reflection tree's mesh and coefficients: the tiles' (rebuilt
+    // when adaptive subdivision splits them).
+    let mut tree_mesh = std::borrow::Cow::Borrowed(mesh);
+    let mut tree_specular = specular.clone();
+    let cut = params.reflection_threshold * emitted_total;
+    let knobs = mirrors::Knobs { depth: params.reflection_depth, cut, diagonal };
     // Lights first: all their power is unshot, and a point source shoots
     // once (6 full cube faces; the stereographic map covers a hemisphere
     // only, so lights always use the cube).
@@ -629,6 +710,9 @@ pub fn solve(
         built.gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
         let p = GpuParams { shooter: u32::MAX, sample_first: 0, sample_count: 1, layers_per_sample: 6, mode: 0, ..base };
         built.gpu.shoot_batch(device, queue, &p, false);
+        if let Some(s) = &tree_specular {
+            mirrors::Tree { mesh: &tree_mesh, specular: s, knobs, virtual_base: built.virtual_base }.shoot(&built.gpu, device, queue, &p, &[sample], &mut work.reflection);
+        }
         work.layers += 6;
         work.samples += 1;
         work.receiver_evaluations += built.texels.len() as u64;
@@ -680,6 +764,10 @@ pub fn solve(
                 // A split tile is new: its children have not shot.
                 tested = origin.iter().zip(&next).map(|(&o, tile)| tested[o] && tiles[o] == *tile).collect();
                 tiles = next;
+                if specular.is_some() {
+                    tree_mesh = std::borrow::Cow::Owned(tiling::mesh_of(mesh, &tiles));
+                    tree_specular = mirrors::Specular::of(&tree_mesh, manifest);
+                }
                 // The shooter counts again: the new tiles its boundaries
                 // cross split further, up to the level limit.
                 if let Some(t) = tiles.iter().position(|x| *x == shooter_tile) {
@@ -695,8 +783,14 @@ pub fn solve(
         }
         built.gpu.upload_samples(queue, &samples_of(&built, mesh, &tiles, shooter as usize, offset), None);
         built.gpu.prepare(device, queue, &shot_params);
+        // The reflection tree mirrors the samples with their powers.
+        let root = if tree_specular.is_some() { built.gpu.read_samples(device, queue, range.group_count) } else { Vec::new() };
         for &(first, count) in &batches {
-            built.gpu.shoot_batch(device, queue, &GpuParams { sample_first: first, sample_count: count, ..shot_params }, hemicube);
+            let batch_params = GpuParams { sample_first: first, sample_count: count, ..shot_params };
+            built.gpu.shoot_batch(device, queue, &batch_params, hemicube);
+            if let Some(s) = &tree_specular {
+                mirrors::Tree { mesh: &tree_mesh, specular: s, knobs, virtual_base: built.virtual_base }.shoot(&built.gpu, device, queue, &batch_params, &root[first as usize..(first + count) as usize], &mut work.reflection);
+            }
             work.layers += count as u64 * if hemicube { 5 } else { 1 };
         }
         built.gpu.finish(device, queue, &shot_params, range.count);

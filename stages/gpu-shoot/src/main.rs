@@ -90,6 +90,14 @@ struct Args {
     #[arg(long)]
     texels_per_leaf: Option<f64>,
     /// Adaptive subdivision at shadow boundaries (004 Sec. 2.4); not with --lightmap.
+    /// Most mirrors and panes on a light path of the reflection tree (004
+    /// Sec. 4.3.2).
+    #[arg(long)]
+    reflection_depth: Option<u32>,
+    /// Cut a reflection-tree node whose power bound (Eq. 4.6) is under
+    /// this fraction of the emitted power.
+    #[arg(long)]
+    reflection_threshold: Option<f64>,
     #[arg(long)]
     adaptive: bool,
     /// Adaptive subdivision: split a receiver whose visible fraction is at least this (b_l) [default: 0.05].
@@ -127,6 +135,8 @@ fn params_of(args: &Args) -> schemas::Result<Params> {
         p.ambient = false;
     }
     p.texels_per_leaf = args.texels_per_leaf.unwrap_or(p.texels_per_leaf);
+    p.reflection_depth = args.reflection_depth.unwrap_or(p.reflection_depth);
+    p.reflection_threshold = args.reflection_threshold.unwrap_or(p.reflection_threshold);
     if args.adaptive || args.adaptive_lower.is_some() || args.adaptive_upper.is_some() || args.adaptive_levels.is_some() {
         let a = p.adaptive.get_or_insert_with(Adaptive::default);
         a.lower = args.adaptive_lower.unwrap_or(a.lower);
@@ -151,8 +161,8 @@ fn skipped(effects: &Effects, surface: bool, one_sided: u64) -> Vec<String> {
     let transmits = format!("diffuse transmission: {one_sided} triangles of translucent materials that are not two-sided transmit nothing (their back face has no texels; make the material two_sided)");
     Effects::skipped(&[
         (one_sided > 0, transmits.as_str()),
-        (effects.specular_reflection, "specular reflection: not simulated by gpu-shoot yet (004 Sec. 4.3.2); mirrors keep their diffuse part"),
-        (effects.specular_transmission, "specular transmission: not simulated by gpu-shoot yet (004 Sec. 4.3.3)"),
+        (effects.specular_reflection, "specular reflection: planar mirrors by the reflection tree (004 Sec. 4.3.2), up to --reflection-depth windows per path, nodes under --reflection-threshold cut (their bound in reflection_truncated_fraction); no glossy reflection (a curved mirror is its facets), alpha masks opaque in the frustum maps"),
+        (effects.specular_transmission, "specular transmission: thin panes in the reflection tree (004 Sec. 4.3.3); no refraction bending by thick glass"),
         (effects.alpha_masks && without, "alpha masks: surfaces are treated as opaque (no --surface given)"),
         (effects.normal_maps && without, "normal maps: texels use the geometric normal (no --surface given)"),
         (effects.textures && without, "textures: radiosity uses each material's diffuse reflectance (no --surface given)"),
@@ -254,7 +264,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     }
     if let Some(report) = &args.stage.report {
         let w = &solved.work;
-        let counters = BTreeMap::from([
+        let mut counters = BTreeMap::from([
             ("shots".to_string(), w.shots as f64),
             ("samples".to_string(), w.samples as f64),
             ("visibility_layers".to_string(), w.layers as f64),
@@ -270,6 +280,18 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             ("shoot_seconds".to_string(), w.shoot_seconds),
             ("seconds_per_shot".to_string(), w.shoot_seconds / (w.shots.max(1) as f64)),
         ]);
+        if manifest.effects.specular_reflection || manifest.effects.specular_transmission {
+            let r = &w.reflection;
+            let emitted: f64 = solved.emitted_power.iter().sum();
+            counters.extend([
+                ("reflection_nodes".to_string(), r.nodes as f64),
+                ("reflection_depth".to_string(), r.depth as f64),
+                ("reflection_layers".to_string(), r.layers as f64),
+                ("reflection_bound_fraction".to_string(), r.bound / emitted),
+                ("reflection_truncated_fraction".to_string(), r.truncated / emitted),
+                ("reflection_seconds".to_string(), r.seconds),
+            ]);
+        }
         let mut notes = vec![format!("adapter: {adapter}")];
         if args.surface.is_some() && !manifest.effects.surface_detail() {
             notes.push("surface.exr not read: the scene has no texture, alpha mask or normal map".into());

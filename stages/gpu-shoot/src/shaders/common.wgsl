@@ -13,8 +13,8 @@ struct Params {
     mode: u32,             // 0 cube faces, 1 stereographic
     overshoot: u32,        // 1: ambient overshooting (004 Eq. 4.9)
     group_count: u32,      // groups of the shooter
-    _pad0: u32,
-    _pad1: u32,
+    level: u32,            // reflection tree: 1 + the level of the node shot (0: the real samples)
+    virtual_base: u32,     // reflection tree: the first virtual sample
     tolerance: f32,        // relative depth tolerance of the visibility test
     near: f32,             // near plane of the cube faces, m
     far: f32,              // far distance, m
