@@ -75,6 +75,7 @@ pub mod luminaires;
 pub mod mirrors;
 pub mod nodes;
 pub mod rows;
+pub mod shaft;
 pub mod transfer;
 pub mod transmission;
 pub mod visibility;
@@ -364,6 +365,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     if let Some(masks) = h.detail.as_ref().and_then(|d| d.alpha_masks(mesh)) {
         scene = scene.with_alpha_masks(masks);
     }
+    let occluders = shaft::Occluders::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>(), &scene);
     let mut work = Work::default();
     let knobs = mirrors::Knobs {
         rays: params.specular_rays,
@@ -486,12 +488,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let rays: usize = all_links
             .par_iter_mut()
             .filter(|l| l.visibility.is_none())
-            .map(|l| {
-                let (v, d, cast) = visibility::of_link(&h, &scene, l, params.visibility_rays, linking);
-                l.visibility = Some(v);
-                l.occluder_distance = d;
-                cast
-            })
+            .map(|l| visibility::settle(&h, &scene, &occluders, l, params.visibility_rays, linking))
             .sum();
         work.rays += rays as u64;
         work.visibility_seconds += started.elapsed().as_secs_f64();

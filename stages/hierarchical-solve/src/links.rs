@@ -32,6 +32,10 @@ pub struct Link {
     pub visibility: Option<f32>,
     /// Distance from the receiver to the nearest occluder, +inf if none.
     pub occluder_distance: f32,
+    /// Proven unoccluded: no other triangle meets the shaft between its two
+    /// elements ([`crate::shaft`]), nor, then, those of the links that
+    /// refine it.
+    pub clear: bool,
 }
 
 /// What to do with a link.
@@ -144,14 +148,14 @@ pub fn link(h: &Hierarchy, receiver: Node, sender: Node, linking: Linking) -> Op
                 return None;
             }
             let e = transfer::estimate(h, None, receiver, sender, linking.cluster_samples, linking.seed);
-            Some(Link { receiver, sender, form_factor: e.form_factor, spread: e.spread, visibility: None, occluder_distance: f32::INFINITY })
+            Some(Link { receiver, sender, form_factor: e.form_factor, spread: e.spread, visibility: None, occluder_distance: f32::INFINITY, clear: false })
         }
     }
 }
 
 /// A cluster's self-link: it carries no light itself and is always split.
 pub fn self_link(cluster: Node) -> Link {
-    Link { receiver: cluster, sender: cluster, form_factor: 0.0, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY }
+    Link { receiver: cluster, sender: cluster, form_factor: 0.0, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: false }
 }
 
 /// Whether `other` lies wholly behind the plane of `node`'s surfaces (the
@@ -230,6 +234,7 @@ fn element_link(h: &Hierarchy, receiver: u32, sender: u32, quadrature_depth: u32
         spread: f.max - f.min,
         visibility: None,
         occluder_distance: f32::INFINITY,
+        clear: false,
     })
 }
 
@@ -467,12 +472,14 @@ pub fn leaf_deviation(h: &Hierarchy, radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
         .collect()
 }
 
-/// The links replacing `link` after `split` (children already exist).
+/// The links replacing `link` after `split` (children already exist); they
+/// inherit its proof of being unoccluded ([`Link::clear`]).
 pub fn children_links(h: &Hierarchy, link: &Link, split: Split, linking: Linking) -> Vec<Link> {
+    let inherit = |l: Link| Link { clear: link.clear, ..l };
     match split {
         Split::Keep | Split::Larger => vec![*link],
-        Split::Sender => h.children(link.sender).into_iter().filter_map(|s| self::link(h, link.receiver, s, linking)).collect(),
-        Split::Receiver => h.children(link.receiver).into_iter().filter_map(|r| self::link(h, r, link.sender, linking)).collect(),
+        Split::Sender => h.children(link.sender).into_iter().filter_map(|s| self::link(h, link.receiver, s, linking)).map(inherit).collect(),
+        Split::Receiver => h.children(link.receiver).into_iter().filter_map(|r| self::link(h, r, link.sender, linking)).map(inherit).collect(),
         Split::Both => {
             let children = h.children(link.receiver);
             let mut links = Vec::new();

@@ -43,6 +43,7 @@
 
 use crate::elements::Hierarchy;
 use crate::links::{Link, Linking};
+use crate::shaft::Occluders;
 use crate::transfer;
 use radiometry::form_factor::{point_kernel, WeightedVisibility};
 use radiometry::rays::SceneRays;
@@ -65,6 +66,21 @@ pub fn of_link(h: &Hierarchy, scene: &SceneRays, link: &Link, rays: usize, linki
             (v, d, e.rays)
         }
     }
+}
+
+/// Sets `link`'s visibility and nearest occluder, and returns the rays cast:
+/// none where it is proven unoccluded (its own shaft, or its parent's,
+/// holds no other triangle: [`crate::shaft`]), which is `V = 1` with no
+/// occluder, exactly what the rays would give; else [`of_link`].
+pub fn settle(h: &Hierarchy, scene: &SceneRays, occluders: &Occluders, link: &mut Link, rays: usize, linking: Linking) -> usize {
+    if let (Node::Element(r), Node::Element(s)) = (link.receiver, link.sender) {
+        let (r, s) = (&h.elements[r as usize], &h.elements[s as usize]);
+        link.clear = link.clear || occluders.clear(&r.points, &s.points, [r.triangle, s.triangle]);
+    }
+    let (v, d, cast) = if link.clear { (1.0, f32::INFINITY, 0) } else { of_link(h, scene, link, rays, linking) };
+    link.visibility = Some(v);
+    link.occluder_distance = d;
+    cast
 }
 
 /// Whether `point` of `triangle` exists: not on a transparent texel of
