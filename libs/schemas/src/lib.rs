@@ -17,6 +17,7 @@
 //! | [`lightmap::Convergence`] | `convergence.ron` | `convergence` 1 | gpu-shoot |
 //! | [`image::HdrImage`] | `*.exr` | `image` 2 | grid-gather (read also from foreign EXRs) |
 //! | [`threshold::ThresholdImage`] | `threshold.exr` | `threshold` 1 | mask |
+//! | [`diagnostics::Diagnostics`] | `*.diagnostics.exr` | `gather-diagnostics` 1 | grid-gather (full, brute) |
 //! | [`report::Report`] | `*.report.ron` | `report` 1 | every stage |
 //!
 //! ```
@@ -26,6 +27,7 @@
 
 pub mod atomic;
 pub mod cluster;
+pub mod diagnostics;
 pub mod error;
 pub mod exr_io;
 pub mod header;

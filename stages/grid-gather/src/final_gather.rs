@@ -1,85 +1,31 @@
 //! Driving the full and brute-force gathers over the image: the pre-pass
-//! that sizes the grid and averages the mask's threshold per vertex, the
-//! camera rays, the per-pixel diagnostics.
+//! that sizes the grid and averages the mask's threshold per vertex, and
+//! the shader ([`crate::film::Shader`]) that shades the surface points the
+//! camera rays reach, directly or through mirrors and glass.
 
+use crate::brute::brute_irradiance;
+use crate::contrast::{vertex_contrast, ContrastImage};
 use crate::detail::Detail;
-use crate::full::{brute_irradiance, FullGather, Surface, Work, CLASS_NAMES};
+use crate::diagnostics::{record, Tally, Work};
+use crate::film::{expose, CameraHit, Lens, Sampling, Shader};
+use crate::gather::{FullGather, Surface};
 use crate::grid::Grid;
-use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
-use crate::render::pixel_offset;
+use crate::pixel_surfaces::SurfaceId;
 use crate::senders::Senders;
-use radiometry::bounds::Aabb;
 use crate::specular::{Followed, Seen, Specular};
-use crate::{GridKind, Mode, Params};
+use crate::{Mode, Params};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
-use radiometry::rays::SceneRays;
 use radiometry::photometry::{DirectLight, Luminaire};
+use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use rayon::prelude::*;
 use schemas::cluster::Clusters;
+use schemas::diagnostics::Diagnostics;
 use schemas::solution::Solution;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
-
-/// Diagnostics channel names of the four classes (000 Sec. 4.3).
-pub const CLASS_NAMES_PIXEL: [&str; 4] = ["class.rv_rf", "class.rv_if", "class.iv_rf", "class.iv_if"];
-
-/// A per-pixel contrast threshold image (the mask stage's `contrast`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ContrastImage {
-    /// Pixels per row.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// Smallest visible contrast per pixel, row-major.
-    pub contrast: Vec<f32>,
-}
-
-/// Per-pixel and per-vertex records of a full or brute-force gather, for
-/// redrawing paper 000's Figs. 4 and 6.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Diagnostics {
-    /// Pixels per row.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// Visibility rays per camera sample, per pixel.
-    pub visibility_rays: Vec<f32>,
-    /// Form-factor evaluations per camera sample, per pixel.
-    pub form_factors: Vec<f32>,
-    /// Senders per camera sample in each class ([`CLASS_NAMES`]), per pixel.
-    pub classes: [Vec<f32>; 4],
-    /// Fraction of camera samples shaded by the surface-based gather.
-    pub surface: Vec<f32>,
-    /// Built vertices: `(i, j, k)`, position, class counts, skipped
-    /// senders, contrast threshold, classification rays and factors.
-    pub vertices: Vec<VertexRecord>,
-}
-
-/// One built grid vertex.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct VertexRecord {
-    /// Grid coordinates.
-    pub ijk: [u32; 3],
-    /// Position, mesh frame, m.
-    pub position: [f32; 3],
-    /// Senders per class ([`CLASS_NAMES`]).
-    pub classes: [u32; 4],
-    /// Senders skipped as fully occluded.
-    pub skipped: u32,
-    /// Contrast threshold used.
-    pub contrast: f32,
-    /// Visibility rays cast to classify.
-    pub rays: u32,
-    /// Form-factor evaluations to classify.
-    pub factors: u32,
-}
-
-/// One image row of the full gather: per pixel radiance, coverage, work
-/// and surface; the row's hits and specular rays.
-type Row = (Vec<([f32; 3], f32, Work, [u32; 3])>, u64, Followed);
 
 /// Everything the full gather reads.
 pub struct FullScene<'a> {
@@ -127,6 +73,46 @@ struct Shading<'a> {
     gather: &'a FullGather<'a>,
     grid: &'a Grid,
     luminaires: &'a DirectLight<'a>,
+}
+
+/// A pixel's state in the full and brute gathers.
+struct GatherPixel {
+    /// The brute gather's random stream, keyed by the brute sample count
+    /// too, so a high-sample reference shares the camera jitter of a
+    /// cheaper run but not its gather noise.
+    stream: Stream,
+    /// The work of the pixel's camera samples.
+    work: Work,
+    /// The links arriving at a hit point and at its twin face (scratch).
+    links: (Vec<usize>, Vec<usize>),
+}
+
+impl Shader for Shading<'_> {
+    type Pixel = GatherPixel;
+
+    fn pixel(&self, index: u64) -> GatherPixel {
+        GatherPixel { stream: Stream::new(self.params.seed, index, 1 + u64::from(self.params.brute_samples)), work: Work::default(), links: (Vec::new(), Vec::new()) }
+    }
+
+    /// Shades the front face seen directly, or what the ray reaches through
+    /// a specular surface (from either side); a back face is black.
+    fn shade(&self, pixel: &mut GatherPixel, camera: &CameraHit, sum: &mut [f64; 3], followed: &mut Followed) -> bool {
+        let (scene, hit, eye) = (self.scene, camera.hit, self.scene.camera.eye);
+        let front = camera.direction.dot(scene.triangles[hit.triangle as usize].normal) <= 0.0;
+        let mut sample = Work::default();
+        let GatherPixel { stream, links: (links, back_links), .. } = pixel;
+        let mut shade = |seen: &Seen| {
+            let radiance = self.radiance(seen, camera.k, (&mut *links, &mut *back_links), stream, &mut sample);
+            (0..3).for_each(|c| sum[c] += seen.weight[c] * radiance[c]);
+        };
+        match scene.specular.filter(|s| s.is_specular(hit.triangle)) {
+            Some(specular) => followed.add(specular.follow(self.rays, scene.triangles, eye, camera.direction, hit, &mut shade)),
+            None if front => shade(&Seen { hit, origin: eye, direction: camera.direction, weight: [1.0; 3], depth: 0 }),
+            None => {}
+        }
+        pixel.work.add(&sample);
+        front
+    }
 }
 
 impl Shading<'_> {
@@ -210,195 +196,15 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
             rays.closest_hit(camera.eye, d, 0.0, f32::INFINITY, [u32::MAX; 2]).map(|hit| camera.eye + d * f64::from(hit.t))
         })
         .collect();
-    let forward = camera.direction(0.5 * f64::from(width), 0.5 * f64::from(height));
-    let depths = centres.iter().flatten().map(|p| (*p - camera.eye).dot(forward));
-    let (near, far) = depths.fold((f64::INFINITY, 0.0f64), |(a, b), d| (a.min(d), b.max(d)));
-    let scene_box = Aabb::around(scene.triangles.iter().flat_map(|t| t.corners));
-    let nx = (width as usize).div_ceil(params.grid_pixels as usize).max(1);
-    let ny = (height as usize).div_ceil(params.grid_pixels as usize).max(1);
-    let grid = match params.grid {
-        GridKind::Perspective => {
-            let (near, far) = if near.is_finite() && far > near { (0.98 * near, 1.02 * far) } else { (1.0, 2.0) };
-            Grid::perspective(camera, width, height, near.max(1e-6), far, [nx, ny, params.grid_depth as usize])
-        }
-        GridKind::Regular => {
-            let extent = (scene_box.max - scene_box.min).max(DVec3::splat(1e-9));
-            let size = extent.max_element() / nx.max(ny) as f64;
-            let n = (extent / size).to_array().map(|e| (e.ceil() as usize).max(1));
-            Grid::regular(scene_box.min, size, n)
-        }
-    };
-    let vertex_contrast = vertex_contrast(params, &grid, &centres, w, h, scene.threshold);
+    let grid = Grid::fit(params, camera, (width, height), &centres, scene.triangles);
+    let vertex_contrast = vertex_contrast(params.contrast, &grid, &centres, w, h, scene.threshold);
     let gather = FullGather::new(&senders, &grid, &rays, scene.surfaces, params, vertex_contrast, width);
-    let spp = params.spp;
     let luminaires = DirectLight { lights: scene.lights, rays: &rays };
     let shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires };
-    let rows: Vec<Row> = (0..height)
-        .into_par_iter()
-        .map(|y| {
-            let (mut links, mut back_links) = (Vec::new(), Vec::new());
-            let (mut hits, mut followed) = (0u64, Followed::default());
-            let row = (0..width)
-                .map(|x| {
-                    let pixel = u64::from(y) * u64::from(width) + u64::from(x);
-                    let mut stream = Stream::new(params.seed, pixel, 0);
-                    // Keyed by the brute sample count too, so a high-sample reference
-                    // shares the camera jitter of a cheaper run but not its gather noise.
-                    let mut gather_stream = Stream::new(params.seed, pixel, 1 + u64::from(params.brute_samples));
-                    let (mut sum, mut covered, mut work, mut tally) = ([0.0f64; 3], 0u32, Work::default(), PixelTally::new(params.crease_angle_deg));
-                    for k in 0..spp {
-                        let (jx, jy) = pixel_offset(k, spp, &mut stream);
-                        let d = camera.direction(f64::from(x) + jx, f64::from(y) + jy);
-                        let Some(hit) = rays.closest_hit(camera.eye, d, 0.0, f32::INFINITY, [u32::MAX; 2]) else {
-                            tally.other();
-                            continue;
-                        };
-                        covered += 1;
-                        hits += 1;
-                        let tri = &scene.triangles[hit.triangle as usize];
-                        let front = d.dot(tri.normal) <= 0.0;
-                        let specular = scene.specular.filter(|s| s.is_specular(hit.triangle));
-                        if front {
-                            tally.front(scene.ids[hit.triangle as usize], tri.normal);
-                        } else {
-                            tally.other();
-                        }
-                        let mut sample = Work::default();
-                        let mut shade = |seen: &Seen| {
-                            let radiance = shading.radiance(seen, k, (&mut links, &mut back_links), &mut gather_stream, &mut sample);
-                            (0..3).for_each(|c| sum[c] += seen.weight[c] * radiance[c]);
-                        };
-                        match specular {
-                            Some(specular) => followed.add(specular.follow(&rays, scene.triangles, camera.eye, d, hit, &mut shade)),
-                            None if front => shade(&Seen { hit, origin: camera.eye, direction: d, weight: [1.0; 3], depth: 0 }),
-                            None => {}
-                        }
-                        work.add(&sample);
-                    }
-                    let n = f64::from(spp);
-                    (sum.map(|s| (s / n) as f32), (f64::from(covered) / n) as f32, work, tally.finish())
-                })
-                .collect();
-            rows_done(1);
-            (row, hits, followed)
-        })
-        .collect();
-
-    let mut image = FullImage {
-        rgb: Vec::with_capacity(w * h),
-        coverage: Vec::with_capacity(w * h),
-        surfaces: Default::default(),
-        diagnostics: Diagnostics { width: w, height: h, ..Diagnostics::default() },
-        counters: BTreeMap::new(),
-    };
-    let (mut total, mut hits, mut specular) = (Work::default(), 0u64, Followed::default());
-    let per = 1.0 / f64::from(spp);
-    let mut seen = Vec::with_capacity(w * h);
-    for (row, row_hits, followed) in rows {
-        hits += row_hits;
-        specular.add(followed);
-        for (rgb, coverage, work, surface) in row {
-            image.rgb.push(rgb);
-            image.coverage.push(coverage);
-            seen.push(surface);
-            let d = &mut image.diagnostics;
-            d.visibility_rays.push((work.visibility_rays as f64 * per) as f32);
-            d.form_factors.push((work.form_factors as f64 * per) as f32);
-            for c in 0..4 {
-                d.classes[c].push((work.classes[c] as f64 * per) as f32);
-            }
-            d.surface.push((work.surface as f64 * per) as f32);
-            total.add(&work);
-        }
-    }
-    image.surfaces = pixel_surfaces::collect(seen);
-    let (mut class_rays, mut class_factors, mut vertex_classes, mut skipped) = (0u64, 0u64, [0u64; 4], 0u64);
-    for (index, data) in gather.built() {
-        class_rays += data.rays;
-        class_factors += data.factors;
-        let counts = data.class_counts();
-        (0..4).for_each(|c| vertex_classes[c] += u64::from(counts[c]));
-        skipped += u64::from(data.skipped);
-        let ijk = grid.vertex_of(index);
-        image.diagnostics.vertices.push(VertexRecord {
-            ijk: ijk.map(|x| x as u32),
-            position: grid.vertex(ijk).as_vec3().to_array(),
-            classes: counts,
-            skipped: data.skipped,
-            contrast: data.contrast as f32,
-            rays: data.rays as u32,
-            factors: data.factors as u32,
-        });
-    }
-    for check in gather.checked_leaves() {
-        class_rays += check.rays;
-        class_factors += check.factors;
-    }
-    let pixels = f64::from(width) * f64::from(height);
-    let c = &mut image.counters;
-    c.insert("pixels".into(), pixels);
-    c.insert("samples_per_pixel".into(), f64::from(spp));
-    c.insert("rays_cast".into(), pixels * f64::from(spp) + pixels);
-    c.insert("ray_hits".into(), hits as f64);
-    c.insert("visibility_rays".into(), total.visibility_rays as f64);
-    c.insert("form_factor_evaluations".into(), total.form_factors as f64);
-    c.insert("visibility_rays_per_hit".into(), total.visibility_rays as f64 / hits.max(1) as f64);
-    c.insert("form_factors_per_hit".into(), total.form_factors as f64 / hits.max(1) as f64);
-    c.insert("surface_gather_hits".into(), total.surface as f64);
-    c.insert("classification_visibility_rays".into(), class_rays as f64);
-    c.insert("classification_form_factors".into(), class_factors as f64);
-    c.insert("grid_vertices".into(), grid.vertex_count() as f64);
-    c.insert("grid_vertices_built".into(), image.diagnostics.vertices.len() as f64);
-    c.insert("senders_skipped_occluded".into(), skipped as f64);
-    if scene.specular.is_some() {
-        crate::specular::count(c, specular);
-    }
-    for k in 0..4 {
-        c.insert(format!("vertex_senders_{}", CLASS_NAMES[k]), vertex_classes[k] as f64);
-        c.insert(format!("pixel_senders_{}", CLASS_NAMES[k]), total.classes[k] as f64);
-    }
-    image
-}
-
-/// Per grid vertex, the contrast threshold: the mask's contrast averaged
-/// over the pixels whose centre ray hits one of the (up to eight) cells
-/// around the vertex (000 Sec. 5.2, "the average masking values in the
-/// adjacent grid cells"); the `contrast` parameter where no mask is given
-/// or no pixel sees those cells.
-fn vertex_contrast(params: &Params, grid: &Grid, centres: &[Option<DVec3>], w: usize, h: usize, threshold: Option<&ContrastImage>) -> Vec<f64> {
-    let mut out = vec![params.contrast; grid.vertex_count()];
-    let Some(t) = threshold else { return out };
-    let cells = grid.n[0] * grid.n[1] * grid.n[2];
-    let mut sum = vec![(0.0f64, 0u64); cells];
-    for (i, p) in centres.iter().enumerate() {
-        let Some(p) = p else { continue };
-        let Some(g) = grid.coordinates(*p) else { continue };
-        let cell: [usize; 3] = std::array::from_fn(|a| (g[a].floor().max(0.0) as usize).min(grid.n[a] - 1));
-        let (x, y) = (i % w, i / w);
-        let (tx, ty) = ((x * t.width / w).min(t.width - 1), (y * t.height / h).min(t.height - 1));
-        let c = f64::from(t.contrast[ty * t.width + tx]);
-        if !c.is_finite() {
-            continue;
-        }
-        let s = &mut sum[(cell[2] * grid.n[1] + cell[1]) * grid.n[0] + cell[0]];
-        s.0 += c;
-        s.1 += 1;
-    }
-    for (index, value) in out.iter_mut().enumerate() {
-        let v = grid.vertex_of(index);
-        let (mut total, mut count) = (0.0, 0u64);
-        for m in 0..8 {
-            let c: [i64; 3] = std::array::from_fn(|a| v[a] as i64 - 1 + ((m >> a) & 1) as i64);
-            if (0..3).any(|a| c[a] < 0 || c[a] >= grid.n[a] as i64) {
-                continue;
-            }
-            let s = sum[(c[2] as usize * grid.n[1] + c[1] as usize) * grid.n[0] + c[0] as usize];
-            total += s.0;
-            count += s.1;
-        }
-        if count > 0 {
-            *value = total / count as f64;
-        }
-    }
-    out
+    let lens = Lens { camera, triangles: scene.triangles, rays: Some(&rays), surfaces: scene.ids, crease_angle_deg: params.crease_angle_deg };
+    let film = expose(&lens, Sampling { width, height, spp: params.spp, seed: params.seed }, &shading, rows_done);
+    let work: Vec<Work> = film.pixels.iter().map(|p| p.work).collect();
+    let tally = Tally { width, height, spp: params.spp, pixels: &work, hits: film.hits, specular: scene.specular.map(|_| film.specular) };
+    let (diagnostics, counters) = record(&tally, &gather);
+    FullImage { rgb: film.rgb, coverage: film.coverage, surfaces: film.surfaces, diagnostics, counters }
 }

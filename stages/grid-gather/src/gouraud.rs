@@ -70,18 +70,6 @@ pub struct Smoothing {
     pub material_seams: bool,
 }
 
-/// One leaf element with what shading needs of it.
-struct Leaf {
-    /// Element index in the solution.
-    element: u32,
-    /// Mesh triangle.
-    triangle: u32,
-    /// Subdivision depth.
-    level: u32,
-    /// Barycentric corners in the triangle, from the 1:4 rule.
-    corners: Corners,
-}
-
 /// Gouraud-interpolated radiosity over the solution's leaf elements.
 #[derive(Clone, Debug)]
 pub struct Gouraud {
@@ -121,7 +109,7 @@ impl Gouraud {
         smoothing: Smoothing,
         value: &(dyn Fn(&Corners, &schemas::solution::Element) -> [f64; 3] + Sync),
     ) -> Result<Self> {
-        let leaves = leaves(triangles.len(), solution).map_err(|why| {
+        let leaves = solution.leaves(triangles.len(), ROOT, children).map_err(|why| {
             Error::invalid(solution_path, None, format!("solution does not belong to this mesh: {why}"))
         })?;
         let elements = &solution.elements;
@@ -241,87 +229,4 @@ fn weld_cell(triangles: &[TriangleGeometry], tolerance: f64) -> f64 {
     } else {
         tolerance
     }
-}
-
-/// The leaves of the hierarchy below every input triangle, triangle by
-/// triangle in depth-first order, with their corners from the 1:4 rule;
-/// checks on the way that the hierarchy is the one the rule and the mesh
-/// with `triangle_count` triangles give. The error says what does not fit.
-fn leaves(triangle_count: usize, solution: &Solution) -> std::result::Result<Vec<Leaf>, String> {
-    let elements = &solution.elements;
-    let n = elements.len();
-    if n < triangle_count {
-        return Err(format!("it has {n} elements, fewer than the mesh's {triangle_count} triangles"));
-    }
-    for (i, e) in elements.iter().enumerate() {
-        if e.triangle as usize >= triangle_count {
-            return Err(format!("element {i} lies on triangle {}, but the mesh has {triangle_count} triangles", e.triangle));
-        }
-        let root = i < triangle_count;
-        if root && (e.triangle as usize != i || e.parent != NONE || e.level != 0) {
-            return Err(format!(
-                "element {i} should be input triangle {i} (level 0, no parent), found triangle {} level {}",
-                e.triangle, e.level
-            ));
-        }
-        if !root && e.parent == NONE {
-            return Err(format!("element {i} has no parent but is not one of the mesh's {triangle_count} triangles"));
-        }
-    }
-    let per_root: Vec<std::result::Result<(Vec<Leaf>, usize), String>> =
-        (0..triangle_count).into_par_iter().map(|t| leaves_below(solution, t as u32)).collect();
-    let mut all = Vec::new();
-    let mut reached = 0;
-    for result in per_root {
-        let (leaves, visited) = result?;
-        all.extend(leaves);
-        reached += visited;
-    }
-    if reached != n {
-        return Err(format!("{} of its {n} elements lie below no input triangle", n - reached));
-    }
-    Ok(all)
-}
-
-/// Largest difference allowed between a stored corner and the 1:4 rule's.
-const CORNER_TOLERANCE: f64 = 1e-6;
-
-/// Leaves below root element `t` and the number of elements visited.
-fn leaves_below(solution: &Solution, t: u32) -> std::result::Result<(Vec<Leaf>, usize), String> {
-    let elements = &solution.elements;
-    let mut stack = vec![(t, ROOT)];
-    let (mut leaves, mut visited) = (Vec::new(), 0);
-    while let Some((i, corners)) = stack.pop() {
-        visited += 1;
-        let e = &elements[i as usize];
-        let stored_fits = e.corners.iter().zip(&corners).all(|(s, c)| {
-            (f64::from(s[0]) - c[0]).abs() <= CORNER_TOLERANCE && (f64::from(s[1]) - c[1]).abs() <= CORNER_TOLERANCE
-        });
-        if !stored_fits {
-            return Err(format!("element {i} has corners {:?}, but the 1:4 rule gives {corners:?}", e.corners));
-        }
-        if e.is_leaf() {
-            leaves.push(Leaf { element: i, triangle: t, level: e.level, corners });
-            continue;
-        }
-        let first = e.first_child as usize;
-        if first + 4 > elements.len() {
-            return Err(format!("element {i} has children beyond the element table"));
-        }
-        // Pushed in reverse so that children are visited in order.
-        for (k, child_corners) in children(&corners).into_iter().enumerate().rev() {
-            let c = &elements[first + k];
-            if c.parent != i || c.triangle != t || c.level != e.level + 1 {
-                return Err(format!(
-                    "element {} is listed as child {k} of element {i} but names parent {}, triangle {}, level {}",
-                    first + k,
-                    c.parent,
-                    c.triangle,
-                    c.level
-                ));
-            }
-            stack.push(((first + k) as u32, child_corners));
-        }
-    }
-    Ok((leaves, visited))
 }

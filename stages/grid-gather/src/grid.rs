@@ -34,8 +34,11 @@
 //! common face along the same diagonal, so the piecewise-linear
 //! interpolation is continuous across cells.
 
+use crate::{GridKind, Params};
 use glam::{DMat3, DVec3};
+use radiometry::bounds::Aabb;
 use radiometry::camera::Pinhole;
+use radiometry::geometry::TriangleGeometry;
 
 /// Tetrahedra of an even cell, as cell corner numbers.
 const EVEN: [[usize; 4]; 5] = [[0, 3, 5, 6], [1, 0, 3, 5], [2, 0, 3, 6], [4, 0, 5, 6], [7, 3, 5, 6]];
@@ -68,7 +71,46 @@ pub struct Location {
     pub cell: [usize; 3],
 }
 
+impl Location {
+    /// The weights clamped at 0 and scaled to sum 1 (a point just outside
+    /// its tetrahedron, by round-off or clamping, takes the nearest face's
+    /// blend instead of extrapolating); 1/4 each where none is positive.
+    pub fn interpolation_weights(&self) -> [f64; 4] {
+        let w = self.weights.map(|x| x.max(0.0));
+        let sum: f64 = w.iter().sum();
+        if sum > 0.0 { w.map(|x| x / sum) } else { [0.25; 4] }
+    }
+}
+
 impl Grid {
+    /// The grid `params` ask for over a `width` x `height` image through
+    /// `camera` of `triangles`, whose pixel centres' hits are `centres`:
+    /// `ceil(width / grid_pixels)` x `ceil(height / grid_pixels)` cells on
+    /// screen; the perspective grid's `grid_depth` cells span the hits'
+    /// depths 2% beyond each end (depths 1 to 2 where nothing is hit); the
+    /// regular grid's cubes cover the scene's box, as many along its
+    /// longest side as the screen has cells along its longer one.
+    pub fn fit(params: &Params, camera: &Pinhole, (width, height): (u32, u32), centres: &[Option<DVec3>], triangles: &[TriangleGeometry]) -> Grid {
+        let forward = camera.direction(0.5 * f64::from(width), 0.5 * f64::from(height));
+        let depths = centres.iter().flatten().map(|p| (*p - camera.eye).dot(forward));
+        let (near, far) = depths.fold((f64::INFINITY, 0.0f64), |(a, b), d| (a.min(d), b.max(d)));
+        let nx = (width as usize).div_ceil(params.grid_pixels as usize).max(1);
+        let ny = (height as usize).div_ceil(params.grid_pixels as usize).max(1);
+        match params.grid {
+            GridKind::Perspective => {
+                let (near, far) = if near.is_finite() && far > near { (0.98 * near, 1.02 * far) } else { (1.0, 2.0) };
+                Grid::perspective(camera, width, height, near.max(1e-6), far, [nx, ny, params.grid_depth as usize])
+            }
+            GridKind::Regular => {
+                let scene_box = Aabb::around(triangles.iter().flat_map(|t| t.corners));
+                let extent = (scene_box.max - scene_box.min).max(DVec3::splat(1e-9));
+                let size = extent.max_element() / nx.max(ny) as f64;
+                let n = (extent / size).to_array().map(|e| (e.ceil() as usize).max(1));
+                Grid::regular(scene_box.min, size, n)
+            }
+        }
+    }
+
     /// A perspective grid over the view of `camera` (rendering `width` x
     /// `height`) between depths `near` and `far` (m, along the view axis,
     /// `0 < near < far`), with `nx x ny x nz` cells.

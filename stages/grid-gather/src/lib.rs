@@ -12,10 +12,10 @@
 //!   resampling of critical senders, interpolation of the rest, the
 //!   surface-based gather where the solution is finer than the grid,
 //!   view-dependent shadow samples), optionally steered by the mask
-//!   stage's threshold image. See [`full`].
+//!   stage's threshold image. See [`gather`], which lists the sections' files.
 //! - **brute**: the classic final gather it is measured against: every
 //!   link of the hit point's element chain resampled at every camera
-//!   sample ([`full::brute_irradiance`]).
+//!   sample ([`brute`]).
 //!
 //! With mesh-prep's surface artifact (`--surface`), every mode shows
 //! textures (`B = E + rho(x) H` per hit) and lets rays through alpha-masked
@@ -61,21 +61,29 @@
 //! Same inputs and parameters give bit-identical images, whatever the
 //! number of threads.
 
+pub mod brute;
+pub mod classification;
+pub mod contrast;
 pub mod detail;
+pub mod diagnostics;
+pub mod film;
 pub mod final_gather;
-pub mod full;
+pub mod gather;
 pub mod gouraud;
 pub mod grid;
+pub mod interpolation;
 pub mod pixel_surfaces;
-pub mod render;
+pub mod preview;
 pub mod senders;
+pub mod shadow_samples;
 pub mod specular;
+pub mod surface_gather;
 
 use gouraud::{Gouraud, Smoothing};
 use radiometry::camera::Pinhole;
 use stage_kit::scene::{luminaires, mesh_triangles, pinhole};
 use radiometry::rays::SceneRays;
-use render::{Sampling, View};
+use schemas::diagnostics::Diagnostics;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
 use stage_kit::run::bad_parameter;
@@ -295,7 +303,7 @@ pub struct Extras<'a> {
     /// The cluster hierarchy the solution was solved with.
     pub clusters: Option<&'a schemas::cluster::Clusters>,
     /// The mask stage's contrast threshold per pixel.
-    pub threshold: Option<&'a final_gather::ContrastImage>,
+    pub threshold: Option<&'a contrast::ContrastImage>,
     /// Surface detail (textures, alpha masks, normal maps) from mesh-prep's
     /// surface artifact, for a scene that has some.
     pub detail: Option<&'a detail::Detail<'a>>,
@@ -376,7 +384,7 @@ pub fn gather(params: &Params, scene: &Scene, rows_done: &(dyn Fn(u64) + Sync)) 
 
 /// [`gather`] with the full gather's extra inputs; also returns the full
 /// and brute gathers' diagnostics.
-pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(dyn Fn(u64) + Sync)) -> Result<(Rendered, Option<final_gather::Diagnostics>)> {
+pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(dyn Fn(u64) + Sync)) -> Result<(Rendered, Option<Diagnostics>)> {
     params.validate()?;
     let (width, height) = image_size(params, scene.manifest);
     check_image_size(width, height).map_err(|e| Error::invalid(scene.manifest_path, None, format!("{e} (the camera's size, or --width/--height)")))?;
@@ -388,71 +396,11 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
         )
     })?;
     let triangles = mesh_triangles(scene.mesh);
+    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams };
     if params.mode != Mode::Preview {
-        return full_gather(params, scene, extras, &camera, &triangles, (width, height), rows_done).map(|(r, d)| (r, Some(d)));
+        return full_gather(params, scene, extras, &camera, &triangles, (width, height), smoothing, rows_done).map(|(r, d)| (r, Some(d)));
     }
-    let smoothing = Smoothing {
-        crease_angle_deg: params.crease_angle_deg,
-        weld_tolerance: params.weld_tolerance,
-        material_seams: params.material_seams,
-    };
-    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
-    let rays = (!triangles.is_empty()).then(|| scene_rays(&triangles, extras.detail));
-    let textures = extras.detail.filter(|_| scene.manifest.effects.textures);
-    let emission: Vec<[f64; 3]> = match textures {
-        Some(_) => scene.mesh.triangles.iter().map(|t| scene.manifest.materials[t.material as usize].emission).collect(),
-        None => Vec::new(),
-    };
-    let irradiance = match textures {
-        Some(detail) => Some(Gouraud::of(&triangles, &materials, scene.solution, scene.solution_path, smoothing, &|corners, e| {
-            let m = &scene.manifest.materials[scene.mesh.triangles[e.triangle as usize].material as usize];
-            detail.irradiance(e.triangle, corners, e.radiosity.map(f64::from), m.emission, m.diffuse)
-        })?),
-        None => None,
-    };
-    let textured = textures.zip(irradiance.as_ref()).map(|(detail, irradiance)| render::Textured { detail, irradiance, emission: &emission });
-    let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
-    let specular = specular::Specular::new(scene.mesh, scene.manifest, &triangles, params.specular_depth, params.specular_min_weight);
-    let view = View {
-        camera: &camera,
-        triangles: &triangles,
-        rays: rays.as_ref(),
-        shading: &shading,
-        textured,
-        surfaces: &ids,
-        crease_angle_deg: params.crease_angle_deg,
-        specular: specular.as_ref(),
-    };
-    let film = render::render(&view, Sampling { width, height, spp: params.spp, seed: params.seed }, rows_done);
-
-    let pixels = f64::from(width) * f64::from(height);
-    let mut counters = BTreeMap::from([
-        ("pixels".to_string(), pixels),
-        ("samples_per_pixel".to_string(), f64::from(params.spp)),
-        ("rays_cast".to_string(), pixels * f64::from(params.spp)),
-        ("ray_hits".to_string(), film.hits as f64),
-        ("back_face_hits".to_string(), film.back_face_hits as f64),
-        ("triangles".to_string(), triangles.len() as f64),
-        ("elements".to_string(), scene.solution.elements.len() as f64),
-        ("leaf_elements".to_string(), shading.leaves() as f64),
-        ("vertices".to_string(), shading.vertices() as f64),
-    ]);
-    if specular.is_some() {
-        specular::count(&mut counters, film.specular);
-    }
-    Ok((
-        Rendered {
-            width: width as usize,
-            height: height as usize,
-            rgb: film.rgb,
-            coverage: film.coverage,
-            surfaces: film.surfaces,
-            counters,
-            skipped: skipped(scene.manifest, Mode::Preview, extras.detail.is_some()),
-        },
-        None,
-    ))
+    preview::render(params, scene, extras, (&camera, &triangles), (width, height), smoothing, rows_done).map(|r| (r, None))
 }
 
 /// Per triangle of a two-sided translucent material, its diffuse
@@ -485,11 +433,11 @@ fn full_gather(
     camera: &Pinhole,
     triangles: &[radiometry::geometry::TriangleGeometry],
     (width, height): (u32, u32),
+    smoothing: Smoothing,
     rows_done: &(dyn Fn(u64) + Sync),
-) -> Result<(Rendered, final_gather::Diagnostics)> {
+) -> Result<(Rendered, Diagnostics)> {
     // The same structural checks as the preview's, with the same message.
     let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams };
     Gouraud::new(triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
     if let Some(c) = extras.clusters {
         if c.nodes.len() != scene.solution.clusters.len() && !scene.solution.clusters.is_empty() {
@@ -498,20 +446,20 @@ fn full_gather(
     } else if scene.solution.links.iter().any(|l| matches!(l.receiver, schemas::solution::Node::Cluster(_)) || matches!(l.sender, schemas::solution::Node::Cluster(_))) {
         return Err(Error::invalid(scene.solution_path, None, "solution has links between clusters: pass the hierarchy with --clusters"));
     }
-    let surfaces: Vec<full::Surface> = scene
+    let surfaces: Vec<gather::Surface> = scene
         .mesh
         .triangles
         .iter()
         .map(|t| {
             let m = scene.manifest.materials.get(t.material as usize);
-            full::Surface { reflectance: m.map_or([0.0; 3], |m| m.diffuse), emission: m.map_or([0.0; 3], |m| m.emission) }
+            gather::Surface { reflectance: m.map_or([0.0; 3], |m| m.diffuse), emission: m.map_or([0.0; 3], |m| m.emission) }
         })
         .collect();
     if triangles.is_empty() {
         let n = width as usize * height as usize;
         let surfaces = pixel_surfaces::collect(std::iter::repeat_n(pixel_surfaces::NOTHING, n));
         let rendered = Rendered { width: width as usize, height: height as usize, rgb: vec![[0.0; 3]; n], coverage: vec![0.0; n], surfaces, counters: BTreeMap::new(), skipped: Vec::new() };
-        return Ok((rendered, final_gather::Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
+        return Ok((rendered, Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
     }
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
     let lights = if scene.manifest.effects.goniometric_lights {

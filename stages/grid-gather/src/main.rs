@@ -3,11 +3,11 @@
 
 use clap::Parser;
 use stage_kit::cli::{check_outputs, main_of};
-use grid_gather::final_gather::{ContrastImage, Diagnostics, CLASS_NAMES_PIXEL};
+use grid_gather::contrast::ContrastImage;
 use grid_gather::{gather_with, image_size, Extras, GridKind, Mode, Params, Scene};
 use schemas::cluster::Clusters;
-use schemas::exr_io::{write_exr, Channel, ExrArtifact, Layer, LayerKind};
-use schemas::header::{Header, Schema};
+use schemas::diagnostics::GatherDiagnostics;
+use schemas::header::Schema;
 use schemas::image::HdrImage;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
@@ -21,56 +21,10 @@ use std::process::ExitCode;
 
 const STAGE: &str = "grid-gather";
 
-/// The diagnostics artifact of a full or brute-force gather: image layer
-/// `pixel` (work and classes per camera sample), table layer `vertex`
-/// (class counts per built grid vertex).
-struct GatherDiagnostics;
-
-impl Schema for GatherDiagnostics {
-    const NAME: &'static str = "gather-diagnostics";
-    const VERSION: u32 = 1;
-}
-
 /// The mask's contrast channel (schema `threshold`), as the gather uses it.
 fn read_threshold(path: &std::path::Path) -> Result<(ContrastImage, schemas::header::Input)> {
     let (t, input) = ThresholdImage::read(path)?;
     Ok((ContrastImage { width: t.width, height: t.height, contrast: t.contrast }, input))
-}
-
-fn write_diagnostics(path: &std::path::Path, header: Header, d: &Diagnostics) -> Result<()> {
-    let mut pixel = vec![
-        Channel::f32("visibility_rays", "visibility rays per camera sample", d.visibility_rays.clone()),
-        Channel::f32("form_factors", "form-factor evaluations per camera sample", d.form_factors.clone()),
-        Channel::f32("surface", "fraction of camera samples shaded by the surface-based gather", d.surface.clone()),
-    ];
-    for (k, name) in CLASS_NAMES_PIXEL.iter().enumerate() {
-        pixel.push(Channel::f32(name, "senders per camera sample in this class (000 Sec. 4.3)", d.classes[k].clone()));
-    }
-    let v = &d.vertices;
-    let u = |f: &dyn Fn(&grid_gather::final_gather::VertexRecord) -> u32| v.iter().map(f).collect::<Vec<u32>>();
-    let f = |f: &dyn Fn(&grid_gather::final_gather::VertexRecord) -> f32| v.iter().map(f).collect::<Vec<f32>>();
-    let vertex = Layer::table(
-        "vertex",
-        v.len(),
-        vec![
-            Channel::u32("i", "grid vertex x index", u(&|r| r.ijk[0])),
-            Channel::u32("j", "grid vertex y index (down the image)", u(&|r| r.ijk[1])),
-            Channel::u32("k", "grid vertex depth index", u(&|r| r.ijk[2])),
-            Channel::f32("P.X", "position, mesh frame, m", f(&|r| r.position[0])),
-            Channel::f32("P.Y", "position, mesh frame, m", f(&|r| r.position[1])),
-            Channel::f32("P.Z", "position, mesh frame, m", f(&|r| r.position[2])),
-            Channel::u32("rv_rf", "senders: resample visibility, resample form factor", u(&|r| r.classes[0])),
-            Channel::u32("rv_if", "senders: resample visibility, interpolate form factor", u(&|r| r.classes[1])),
-            Channel::u32("iv_rf", "senders: interpolate visibility, resample form factor", u(&|r| r.classes[2])),
-            Channel::u32("iv_if", "senders: interpolate visibility, interpolate form factor", u(&|r| r.classes[3])),
-            Channel::u32("skipped", "senders skipped: fully occluded by every link", u(&|r| r.skipped)),
-            Channel::f32("contrast", "contrast threshold (mask average or parameter)", f(&|r| r.contrast)),
-            Channel::u32("rays", "visibility rays cast to classify", u(&|r| r.rays)),
-            Channel::u32("factors", "form-factor evaluations to classify", u(&|r| r.factors)),
-        ],
-    );
-    let image = Layer { name: "pixel".into(), kind: LayerKind::Image { width: d.width, height: d.height }, channels: pixel };
-    write_exr(path, &ExrArtifact { header, layers: vec![image, vertex] })
 }
 
 /// Render the radiosity solution through the manifest camera to a linear HDR
@@ -319,7 +273,7 @@ fn run(args: &Args) -> Result<ExitCode> {
     };
     outputs.write(output, |p| image.write(p))?;
     if let (Some(path), Some(d)) = (&args.diagnostics, &diagnostics) {
-        outputs.write(path, |p| write_diagnostics(p, GatherDiagnostics::header(run.provenance(&params)), d))?;
+        outputs.write(path, |p| d.write(p, GatherDiagnostics::header(run.provenance(&params))))?;
     }
     let warnings = back_face_warning(&rendered.counters).into_iter().collect::<Vec<_>>();
     for warning in &warnings {

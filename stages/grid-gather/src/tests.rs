@@ -1,7 +1,7 @@
 //! Tests over small in-memory scenes with known answers.
 
 use crate::gouraud::{Gouraud, Smoothing};
-use crate::render::pixel_offset;
+use crate::film::pixel_offset;
 use crate::{gather, Mode, Params, Rendered, Scene};
 use glam::{dvec3, DVec3};
 use radiometry::geometry::TriangleGeometry;

@@ -1,6 +1,6 @@
 //! The full gather against the brute-force gather and closed forms.
 
-use crate::final_gather::Diagnostics;
+use schemas::diagnostics::Diagnostics;
 use crate::grid::{barycentric, Grid};
 use crate::{gather_with, Extras, Mode, Params, Rendered, Scene};
 use glam::{dvec3, DVec3};
@@ -383,8 +383,8 @@ fn the_brute_gather_of_a_straddling_sender_matches_lambert_for_its_front_part_at
                 let uv = [(i as f64 + 0.3) / 12.0, (j as f64 + 0.3) / 12.0];
                 let p = tri.point(uv);
                 senders.chain(t, uv, &mut links);
-                let mut work = crate::full::Work::default();
-                let h = crate::full::brute_irradiance(&senders, &rays, p, tri.normal, t, &links, 64, &mut stream, &mut work);
+                let mut work = crate::diagnostics::Work::default();
+                let h = crate::brute::brute_irradiance(&senders, &rays, p, tri.normal, t, &links, 64, &mut stream, &mut work);
                 let exact = front_part_factor(p);
                 worst = worst.max((h[0] - exact).abs() / exact);
                 checked += 1;
