@@ -564,3 +564,29 @@ fn an_occluder_before_and_after_the_mirror_blocks_the_mirrored_light_where_it_li
     assert!(least < 0.05 && most == 1.0, "visible shares from {least} to {most}");
     eprintln!("floor beside a mirror with an occluder: {leaves} leaves, largest irradiance error {worst:.4}");
 }
+
+/// Issue 14 item 5: what the solver and the display do not simulate of
+/// mirrors and glass stays said, in the report's `skipped` (and the
+/// solver's stderr): glossy reflection (a curved mirror is its facets) and
+/// refraction bending by thick glass, for a pane that both reflects and
+/// transmits (`illum 6`: `Ks` a mirror, `Tf` glass).
+#[test]
+fn the_solver_and_the_display_say_what_of_mirrors_and_glass_they_do_not_simulate() {
+    let dir = scratch("mirror_not_simulated");
+    let scene = pane_scene(&dir, "Kd 0\nKs 0.2\nTf 0.6\nillum 6\n");
+    let (mesh, manifest, solution, report) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("solution.exr"), dir.join("solve.report.ron"));
+    run_ok("mesh-prep", &[s(&scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let solved = run_ok("hierarchical-solve", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--report", s(&report)]);
+    let said = |what: &str, skipped: &[String]| {
+        let glossy = skipped.iter().any(|l| l.starts_with("specular reflection:") && l.contains("no glossy reflection") && l.contains("a curved mirror is its facets"));
+        let bending = skipped.iter().any(|l| l.starts_with("specular transmission:") && l.contains("no refraction bending by thick glass"));
+        assert!(glossy && bending, "{what}: {skipped:?}");
+    };
+    said("hierarchical-solve's report", &read_ron::<schemas::report::Report>(&report).unwrap().value.skipped);
+    let stderr: Vec<String> = String::from_utf8_lossy(&solved.stderr).lines().filter_map(|l| l.strip_prefix("hierarchical-solve: skipped: ")).map(String::from).collect();
+    said("hierarchical-solve's stderr", &stderr);
+    for mode in ["preview", "full"] {
+        gather(&dir, mode);
+        said(&format!("grid-gather --mode {mode}'s report"), &read_ron::<schemas::report::Report>(&dir.join(format!("{mode}.report.ron"))).unwrap().value.skipped);
+    }
+}

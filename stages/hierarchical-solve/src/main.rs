@@ -137,7 +137,7 @@ fn skipped(effects: &Effects, surface: bool, one_sided: usize) -> Vec<String> {
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
         (effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, up to --specular-depth mirrors and panes per path (light meeting one more stops there), senders at their elements' mean radiosity --specular-sender-level levels down; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
-        (effects.specular_transmission, "specular transmission: thin panes by transmitted senders, one pane per path; no refraction bending by thick glass"),
+        (effects.specular_transmission, "specular transmission: thin panes by transmitted senders, in the chains of up to --specular-depth mirrors and panes per path; no refraction bending by thick glass (a pane is a thin plate: light goes straight through)"),
         (effects.diffuse_transmission && one_sided > 0, &transmits),
         (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),
         (effects.alpha_masks && !surface, "alpha masks: no --surface given; surfaces are treated as opaque"),
@@ -207,6 +207,14 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
     };
     let mut outputs = Outputs::new();
     outputs.write(output, |p| solution.write(p))?;
+    let one_sided = Transmission::new(&mesh, &manifest).map_or(0, |t| t.one_sided);
+    let mut skipped = skipped(&manifest.effects, with_surface, one_sided);
+    if !clustered && manifest.effects.fine_clustered_geometry {
+        skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
+    }
+    for note in &skipped {
+        eprintln!("hierarchical-solve: skipped: {note}");
+    }
     if let Some(report) = &args.stage.report {
         let mut counters = BTreeMap::from([
             ("passes".to_string(), w.passes as f64),
@@ -243,11 +251,6 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
             if value.is_finite() {
                 counters.insert(name.to_string(), value);
             }
-        }
-        let one_sided = Transmission::new(&mesh, &manifest).map_or(0, |t| t.one_sided);
-        let mut skipped = skipped(&manifest.effects, with_surface, one_sided);
-        if !clustered && manifest.effects.fine_clustered_geometry {
-            skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
         }
         outputs.write(report, |p| run.write_report(p, &params, counters, skipped, notes.clone()))?;
     }
