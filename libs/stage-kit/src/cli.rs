@@ -16,7 +16,18 @@ use std::process::ExitCode;
 /// Negative numbers are values, not flags, so `--eps -1` reaches the
 /// stage's own range check and its message.
 pub fn main_of<A: clap::Parser>(stage: &str, run: impl FnOnce(A) -> Result<ExitCode>) -> ExitCode {
-    let parsed = A::command().allow_negative_numbers(true).try_get_matches().and_then(|m| A::from_arg_matches(&m));
+    main_with(stage, A::command(), |m| A::from_arg_matches(m), run)
+}
+
+/// [`main_of`] for a command line `command` whose matches `from` turns into
+/// the run's arguments (the stage kit adds the common flags to a stage's).
+pub fn main_with<A>(
+    stage: &str,
+    command: clap::Command,
+    from: impl FnOnce(&clap::ArgMatches) -> std::result::Result<A, clap::Error>,
+    run: impl FnOnce(A) -> Result<ExitCode>,
+) -> ExitCode {
+    let parsed = command.allow_negative_numbers(true).try_get_matches().and_then(|m| from(&m));
     match parsed {
         Ok(args) => exit_code(stage, run(args)),
         Err(e) if !e.use_stderr() => {

@@ -87,6 +87,7 @@ pub struct Run {
     version: String,
     started: Instant,
     inputs: Vec<Input>,
+    outputs: Vec<PathBuf>,
 }
 
 impl Run {
@@ -104,7 +105,24 @@ impl Run {
             let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, std::sync::Arc::default());
             schemas::atomic::remove_temporaries_on_interrupt();
         });
-        Run { stage: stage.into(), version: version.into(), started: Instant::now(), inputs: Vec::new() }
+        Run { stage: stage.into(), version: version.into(), started: Instant::now(), inputs: Vec::new(), outputs: Vec::new() }
+    }
+
+    /// Records the files this run writes (the kit does, after checking
+    /// them against the inputs given on the command line), for
+    /// [`Run::check_outputs_against`].
+    pub fn writing(mut self, outputs: &[Option<&Path>]) -> Self {
+        self.outputs = outputs.iter().flatten().map(|p| p.to_path_buf()).collect();
+        self
+    }
+
+    /// Checks this run's outputs against inputs found only while it runs
+    /// (the files a scene names): none may be one of them
+    /// ([`crate::cli::check_outputs`]).
+    pub fn check_outputs_against(&self, inputs: &[&Path]) -> Result<()> {
+        let inputs: Vec<Option<&Path>> = inputs.iter().map(|p| Some(*p)).collect();
+        let outputs: Vec<Option<&Path>> = self.outputs.iter().map(|p| Some(p.as_path())).collect();
+        crate::cli::check_outputs(&inputs, &outputs)
     }
 
     /// Records an input file, refusing one that does not belong with the

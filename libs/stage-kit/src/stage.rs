@@ -12,7 +12,8 @@
 //! report (`--report`) from what it returns ([`Done`]) and puts every
 //! output in place at once ([`Outputs::keep`]).
 
-use crate::cli::{check_outputs, main_of};
+use crate::cli::{check_outputs, main_with};
+use clap::{Args, FromArgMatches};
 use crate::knobs::{table, Knobs};
 use crate::run::{bad_parameter, print_params, read_prepared, Outputs, Run, StageArgs};
 use schemas::error::Result;
@@ -24,13 +25,14 @@ use std::process::ExitCode;
 /// The hidden flag that prints a stage's knob table (markdown) and exits.
 pub const PRINT_KNOBS: &str = "--print-knobs";
 
-/// A stage's command line, which the kit runs (see the module).
+/// A stage's own command line (its paths and flags that are not knobs),
+/// which the kit runs (see the module). The kit adds the flags every stage
+/// has ([`StageArgs`]: `--report`, `--params`, `--print-params` and one per
+/// knob of [`Stage::Params`]), so a path clap requires except with
+/// `--print-params` says `required_unless_present = "print_params"`.
 pub trait Stage: clap::Parser {
     /// The stage's knobs, declared with [`knobs!`](crate::knobs!).
     type Params: Knobs;
-
-    /// The flags every stage has (`#[command(flatten)]`).
-    fn common(&self) -> &StageArgs<Self::Params>;
 
     /// The files it reads and the files it writes (the report aside),
     /// `None` for optional ones not given: no output may be an input, and
@@ -80,12 +82,13 @@ pub fn main<S: Stage>() -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let label = name.clone();
-    main_of(&label, move |stage: S| run(stage, name, version))
+    let command = StageArgs::<S::Params>::augment_args(command);
+    let from = |m: &clap::ArgMatches| Ok((S::from_arg_matches(m)?, StageArgs::<S::Params>::from_arg_matches(m)?));
+    main_with(&label, command, from, move |(stage, common)| run(stage, &common, name, version))
 }
 
 /// The run of `stage`, from its parsed command line to its outputs in place.
-fn run<S: Stage>(stage: S, name: String, version: String) -> Result<ExitCode> {
-    let common = stage.common();
+fn run<S: Stage>(stage: S, common: &StageArgs<S::Params>, name: String, version: String) -> Result<ExitCode> {
     let mut params = common.knobs()?;
     stage.settle(&mut params)?;
     if common.print_params {
@@ -96,7 +99,7 @@ fn run<S: Stage>(stage: S, name: String, version: String) -> Result<ExitCode> {
     let (inputs, mut outputs) = stage.files();
     outputs.push(report.as_deref());
     check_outputs(&inputs, &outputs)?;
-    let mut run = Run::start(name, version);
+    let mut run = Run::start(name, version).writing(&outputs);
     let mut outputs = Outputs::new();
     let done = stage.run(&params, &mut run, &mut outputs)?;
     if let Some(report) = &report {

@@ -4,7 +4,7 @@ use clap::Parser;
 use cluster::{build, Params};
 use schemas::cluster::Clusters;
 use schemas::header::Schema;
-use stage_kit::run::{Outputs, Run, StageArgs};
+use stage_kit::run::{Outputs, Run};
 use stage_kit::stage::{required, Done, SceneArgs, Stage};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -22,16 +22,10 @@ struct Args {
     /// Output: the cluster hierarchy.
     #[arg(short = 'o', long = "output", value_name = "CLUSTERS.exr", required_unless_present = "print_params")]
     output: Option<PathBuf>,
-    #[command(flatten)]
-    stage: StageArgs<Params>,
 }
 
 impl Stage for Args {
     type Params = Params;
-
-    fn common(&self) -> &StageArgs<Params> {
-        &self.stage
-    }
 
     fn files(&self) -> (Vec<Option<&Path>>, Vec<Option<&Path>>) {
         (self.scene.paths().to_vec(), vec![self.output.as_deref()])

@@ -7,7 +7,7 @@ use schemas::header::{Input, Schema};
 use schemas::ron_io::read_bytes;
 use schemas::threshold::ThresholdImage;
 use schemas::{Error, Result};
-use stage_kit::run::{Outputs, Run, StageArgs};
+use stage_kit::run::{Outputs, Run};
 use stage_kit::stage::{required, Done, Stage};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -24,16 +24,10 @@ struct Args {
     /// Output threshold image (EXR: L, La, elevation, threshold, contrast).
     #[arg(short = 'o', long = "output", value_name = "THRESHOLD.exr", required_unless_present = "print_params")]
     output: Option<PathBuf>,
-    #[command(flatten)]
-    stage: StageArgs<Params>,
 }
 
 impl Stage for Args {
     type Params = Params;
-
-    fn common(&self) -> &StageArgs<Params> {
-        &self.stage
-    }
 
     fn files(&self) -> (Vec<Option<&Path>>, Vec<Option<&Path>>) {
         (vec![self.image.as_deref()], vec![self.output.as_deref()])

@@ -3,7 +3,7 @@
 use clap::Parser;
 use schemas::image::HdrImage;
 use schemas::Error;
-use stage_kit::run::{Outputs, Run, StageArgs};
+use stage_kit::run::{Outputs, Run};
 use stage_kit::stage::{required, Done, Stage};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -19,16 +19,10 @@ struct Args {
     /// Output PNG.
     #[arg(short, long, required_unless_present = "print_params")]
     output: Option<PathBuf>,
-    #[command(flatten)]
-    stage: StageArgs<Params>,
 }
 
 impl Stage for Args {
     type Params = Params;
-
-    fn common(&self) -> &StageArgs<Params> {
-        &self.stage
-    }
 
     fn files(&self) -> (Vec<Option<&Path>>, Vec<Option<&Path>>) {
         (vec![self.image.as_deref()], vec![self.output.as_deref()])
