@@ -9,7 +9,8 @@
 //! calls for. The OBJ and MTL readers ([`obj`], [`mtl`], [`text`]) take
 //! files as exporters write them. The binary writes the result as
 //! `mesh.exr` and `manifest.ron` (see the `schemas` crate), and a make
-//! dependency file of every file it read ([`depfile`]).
+//! dependency file of every file it read ([`depfile`]); [`report`] says
+//! what the run did.
 
 pub mod builtin;
 pub mod depfile;
@@ -20,6 +21,7 @@ pub mod obj;
 pub mod photometry;
 pub mod prepare;
 pub mod procedural;
+pub mod report;
 pub mod scene;
 pub mod surface;
 pub mod text;

@@ -2,11 +2,10 @@
 
 use clap::Parser;
 use mesh_prep::builtin::Builtin;
-use mesh_prep::obj::Files;
+use mesh_prep::obj::{Files, TextSource};
 use mesh_prep::{prepare, read_scene, Params, Recording};
-use stage_kit::cli::{check_outputs, main_of};
-use stage_kit::run::{load_params, print_params, Outputs, Run, StageArgs};
-use std::collections::BTreeMap;
+use stage_kit::run::{Outputs, Run};
+use stage_kit::stage::{required, Done, Stage};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -42,95 +41,49 @@ struct Args {
     /// photometric files), for the Makefile to include.
     #[arg(long, value_name = "MESH.d")]
     depfile: Option<PathBuf>,
-    #[command(flatten)]
-    stage: StageArgs,
-    /// Weld vertices closer than this times the scene's diagonal.
-    #[arg(long)]
-    weld_tolerance: Option<f64>,
-    /// Drop triangles smaller than this times the squared diagonal.
-    #[arg(long)]
-    degenerate_area: Option<f64>,
-    /// Flag the geometry as fine (for clustering) above this many triangles.
-    #[arg(long)]
-    fine_geometry_triangles: Option<usize>,
 }
 
-fn run(args: Args) -> schemas::Result<ExitCode> {
-    let mut params: Params = load_params(args.stage.params.as_deref())?;
-    params.weld_tolerance = args.weld_tolerance.unwrap_or(params.weld_tolerance);
-    params.degenerate_area = args.degenerate_area.unwrap_or(params.degenerate_area);
-    params.fine_geometry_triangles = args.fine_geometry_triangles.unwrap_or(params.fine_geometry_triangles);
-    if args.stage.print_params {
-        print_params(&params);
-        return Ok(ExitCode::SUCCESS);
+impl Stage for Args {
+    type Params = Params;
+
+    fn files(&self) -> (Vec<Option<&Path>>, Vec<Option<&Path>>) {
+        (vec![self.scene.as_deref()], vec![self.mesh.as_deref(), self.manifest.as_deref(), self.surface.as_deref(), self.depfile.as_deref()])
     }
-    let (Some(mesh_path), Some(manifest_path)) = (args.mesh, args.manifest) else {
-        unreachable!("clap requires --mesh and --manifest without --print-params")
-    };
-    let outputs = [Some(mesh_path.as_path()), Some(manifest_path.as_path()), args.surface.as_deref(), args.stage.report.as_deref(), args.depfile.as_deref()];
-    check_outputs(&[args.scene.as_deref()], &outputs)?;
-    let mut run = Run::start("mesh-prep", env!("CARGO_PKG_VERSION"));
-    let (source, scene_path): (&dyn mesh_prep::obj::TextSource, PathBuf) = match (&args.builtin, &args.scene) {
-        (Some(b), _) => (b, b.scene_path()),
-        (None, Some(path)) => (&Files, path.clone()),
-        (None, None) => unreachable!("clap requires a scene or --builtin"),
-    };
-    let recording = Recording::new(source);
-    let scene = read_scene(&recording, &scene_path)?;
-    let prepared = prepare(&scene, &scene_path, &recording, &params)?;
-    for input in recording.into_inputs() {
-        run.input(input)?;
+
+    fn run(self, params: &Params, run: &mut Run, outputs: &mut Outputs) -> schemas::Result<Done> {
+        let (mesh_path, manifest_path) = (required(&self.mesh, "--mesh")?, required(&self.manifest, "--manifest")?);
+        let (source, scene_path): (&dyn TextSource, PathBuf) = match &self.builtin {
+            Some(b) => (b, b.scene_path()),
+            None => (&Files, required(&self.scene, "SCENE")?.to_path_buf()),
+        };
+        let recording = Recording::new(source);
+        let prepared = prepare(&read_scene(&recording, &scene_path)?, &scene_path, &recording, params)?;
+        for input in recording.into_inputs() {
+            run.input(input)?;
+        }
+        let provenance = run.provenance(params);
+        // Every file the scene named (OBJ, MTL, textures, photometry) is an
+        // input too: none may be overwritten. A built-in scene's files are
+        // inside the binary, which the Makefile already lists.
+        let read: Vec<&str> = if self.builtin.is_some() { Vec::new() } else { provenance.inputs.iter().map(|i| i.path.as_str()).collect() };
+        run.check_outputs_against(&read.iter().map(Path::new).collect::<Vec<_>>())?;
+        let targets: Vec<String> = [Some(mesh_path), Some(manifest_path), self.surface.as_deref()].into_iter().flatten().map(|p| p.display().to_string()).collect();
+        let depfile = mesh_prep::depfile::rule(&targets.iter().map(String::as_str).collect::<Vec<_>>(), &read);
+        let done = mesh_prep::report::summarise(&prepared);
+        let surface = self.surface.as_ref().map(|_| prepared.surface_artifact(provenance.clone()));
+        let (mesh, manifest) = prepared.into_artifacts(provenance);
+        outputs.write(mesh_path, |p| mesh.write(p))?;
+        outputs.write(manifest_path, |p| schemas::ron_io::write_ron(p, &manifest))?;
+        if let (Some(path), Some(surface)) = (&self.surface, &surface) {
+            outputs.write(path, |p| surface.write(p))?;
+        }
+        if let Some(path) = &self.depfile {
+            outputs.write(path, |p| std::fs::write(p, &depfile).map_err(|e| schemas::Error::io(path, e)))?;
+        }
+        Ok(done)
     }
-    let statistics = prepared.statistics.clone();
-    let warnings = prepared.warnings.clone();
-    let provenance = run.provenance(&params);
-    // A built-in scene's files are inside the binary, which the Makefile
-    // already lists.
-    let read: Vec<&str> = if args.builtin.is_some() { Vec::new() } else { provenance.inputs.iter().map(|i| i.path.as_str()).collect() };
-    // Every file the scene named (OBJ, MTL, textures, photometry) is an
-    // input too: none may be overwritten.
-    check_outputs(&read.iter().map(|p| Some(Path::new(*p))).collect::<Vec<_>>(), &outputs)?;
-    let mut targets = vec![mesh_path.display().to_string(), manifest_path.display().to_string()];
-    targets.extend(args.surface.as_ref().map(|p| p.display().to_string()));
-    let depfile_text = mesh_prep::depfile::rule(&targets.iter().map(String::as_str).collect::<Vec<_>>(), &read);
-    let surface = args.surface.as_ref().map(|_| prepared.surface_artifact(provenance.clone()));
-    let (mesh, manifest) = prepared.into_artifacts(provenance);
-    for warning in &warnings {
-        eprintln!("mesh-prep: warning: {warning}");
-    }
-    let twins = match statistics.two_sided_twins {
-        0 => String::new(),
-        n => format!(", {n} of them two-sided twins"),
-    };
-    eprintln!(
-        "mesh-prep: {} triangles{twins}, {} vertices ({} degenerate and {} duplicate triangles dropped, {} vertices welded)",
-        statistics.triangles, statistics.vertices, statistics.degenerate_dropped, statistics.duplicates_dropped, statistics.vertices_welded
-    );
-    let mut outputs = Outputs::new();
-    outputs.write(&mesh_path, |p| mesh.write(p))?;
-    outputs.write(&manifest_path, |p| schemas::ron_io::write_ron(p, &manifest))?;
-    if let (Some(path), Some(surface)) = (&args.surface, &surface) {
-        outputs.write(path, |p| surface.write(p))?;
-    }
-    if let Some(report) = &args.stage.report {
-        let counters = BTreeMap::from([
-            ("input_triangles".to_string(), statistics.input_triangles as f64),
-            ("triangles".to_string(), statistics.triangles as f64),
-            ("vertices".to_string(), statistics.vertices as f64),
-            ("degenerate_dropped".to_string(), statistics.degenerate_dropped as f64),
-            ("duplicates_dropped".to_string(), statistics.duplicates_dropped as f64),
-            ("two_sided_twins".to_string(), statistics.two_sided_twins as f64),
-            ("vertices_welded".to_string(), statistics.vertices_welded as f64),
-        ]);
-        outputs.write(report, |p| run.write_report(p, &params, counters, vec![], warnings))?;
-    }
-    if let Some(path) = &args.depfile {
-        outputs.write(path, |p| std::fs::write(p, &depfile_text).map_err(|e| schemas::Error::io(path, e)))?;
-    }
-    outputs.keep()?;
-    Ok(ExitCode::SUCCESS)
 }
 
 fn main() -> ExitCode {
-    main_of("mesh-prep", run)
+    stage_kit::stage::main::<Args>()
 }

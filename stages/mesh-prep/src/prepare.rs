@@ -14,31 +14,18 @@ use stage_kit::scene::pinhole;
 use radiometry::geometry::TriangleGeometry;
 use schemas::mesh::{cyclic, reversed, Camera, Effects, GoniometricLight, Material, MeshStatistics, Triangle};
 use schemas::Error;
-use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
-/// Knobs of mesh preparation.
-///
-/// | parameter | meaning | default |
-/// |---|---|---|
-/// | `weld_tolerance` | vertices closer than this times the scene diagonal merge | 1e-9 |
-/// | `degenerate_area` | triangles smaller than this times the squared diagonal are dropped (f32 positions cannot resolve them) | 1e-14 |
-/// | `fine_geometry_triangles` | above this many triangles the manifest flags fine geometry for clustering | 10000 |
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Weld distance, relative to the bounding-box diagonal.
-    pub weld_tolerance: f64,
-    /// Smallest kept area, relative to the squared diagonal.
-    pub degenerate_area: f64,
-    /// Triangle count above which geometry counts as fine.
-    pub fine_geometry_triangles: usize,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params { weld_tolerance: 1e-9, degenerate_area: 1e-14, fine_geometry_triangles: 10_000 }
+stage_kit::knobs! {
+    /// Knobs of mesh preparation.
+    pub struct Params {
+        /// Weld vertices closer than this times the scene's diagonal.
+        weld_tolerance: f64 = 1e-9, "diagonal", value(positive());
+        /// Drop triangles of this area or less, times the squared diagonal (f32 positions cannot resolve smaller ones).
+        degenerate_area: f64 = 1e-14, "diagonal²", value(at_least(0.0));
+        /// Flag the geometry as fine (for clustering) above this many triangles.
+        fine_geometry_triangles: usize = 10_000, "triangles", value;
     }
 }
 
@@ -541,6 +528,19 @@ mod tests {
         let lamp = format!("{}o lamp\nusemtl glow\nv 0.2 0.5 0.5\nv 0.4 0.5 0.5\nv 0.6 0.5 0.5\nf -3 -2 -1\n", room(true, None));
         let message = prepare_with(&lamp, "").err().map(|e| e.to_string());
         assert_eq!(message.as_deref(), Some("s/a.obj:22: emitter 'lamp' (material 'glow', s/a.obj:22) has zero area: all 1 of its triangles are degenerate"));
+    }
+
+    /// A weld cell of zero width keys every vertex by the sign of its
+    /// coordinates (`x / 0`), so the knobs are checked before any work.
+    #[test]
+    fn knobs_out_of_range_are_refused_naming_the_knob_and_value() {
+        use stage_kit::knobs::Knobs;
+        let error = |p: Params| p.check("").err().map(|e| e.to_string());
+        assert_eq!(error(Params::default()), None);
+        assert_eq!(error(Params { weld_tolerance: 0.0, ..Params::default() }).as_deref(), Some("parameters: weld_tolerance must be a positive number, not 0"));
+        assert_eq!(error(Params { weld_tolerance: f64::NAN, ..Params::default() }).as_deref(), Some("parameters: weld_tolerance must be a positive number, not NaN"));
+        assert_eq!(error(Params { degenerate_area: -1e-14, ..Params::default() }).as_deref(), Some("parameters: degenerate_area must be at least 0, not -0.00000000000001"));
+        assert_eq!(error(Params { degenerate_area: 0.0, ..Params::default() }), None);
     }
 
     #[test]
