@@ -47,6 +47,7 @@ pub mod emitters;
 pub mod placement;
 pub mod probes;
 pub mod render;
+pub mod report;
 pub mod shooting;
 pub mod surfaces;
 
@@ -61,137 +62,66 @@ use radiometry::rays::SceneRays;
 use render::Film;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::samples::{Reason, SampledSurface, Sample, SecondaryEmitter, NO_EMITTER};
-use serde::{Deserialize, Serialize};
 use shooting::{shoot, Collector, ShootingParams, ShootingWork};
 use std::f64::consts::PI;
 
-/// The stage's parameters. Spacings and radii are fractions of each
-/// surface's extent (the longer side of its bounding rectangle).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Probe grid cells along a surface's longer side.
-    pub probe_resolution: usize,
-    /// Isolux bands per surface (`levels - 1` contours).
-    pub levels: usize,
-    /// Sample spacing along a straight isolux contour and along edges.
-    pub contour_spacing: f64,
-    /// Turning of a curved contour between two of its samples, degrees.
-    pub turn_angle_deg: f64,
-    /// Spacing of the lattice in smooth regions.
-    pub lattice_spacing: f64,
-    /// Spacing of samples in a penumbra.
-    pub shadow_spacing: f64,
-    /// Spacing of samples in an umbra.
-    pub umbra_spacing: f64,
-    /// One view-dependent display sample per this many pixels squared.
-    pub screen_spacing: u32,
-    /// Rays per light-source triangle for the direct light's visibility.
-    pub visibility_rays: usize,
-    /// Least area of a secondary emitter, as a fraction of its surface's:
-    /// smaller isolux regions are merged into a neighbour.
-    pub emitter_min_area: f64,
-    /// At most this many of a secondary emitter's vertices cast its
-    /// occlusion rays.
-    pub occlusion_vertices: usize,
-    /// Stop shooting when the unshot power (all polygons together) is
-    /// under this fraction of the emitted power.
-    pub threshold: f64,
-    /// Most shots.
-    pub max_shots: usize,
-    /// Reflections off secondary emitters (0: all, until `threshold`).
-    pub bounces: u32,
-    /// Display grid cells along a surface's longer side.
-    pub display_resolution: usize,
-    /// The display filter: paper 002's cone, or the cone with a
-    /// first-order correction ([`display::Filter`]).
-    pub filter: display::Filter,
-    /// Radius `r` of the conical filter.
-    pub filter_radius: f64,
-    /// Radius of the cone near shadow-boundary samples.
-    pub shadow_filter_radius: f64,
-    /// Image width (default: the camera's).
-    pub width: Option<u32>,
-    /// Image height (default: the camera's).
-    pub height: Option<u32>,
-    /// Rays per pixel along each side (`spp_side`² per pixel).
-    pub spp_side: u32,
-    /// Seed of the visibility rays.
-    pub seed: u64,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            probe_resolution: 96,
-            levels: 8,
-            contour_spacing: 0.12,
-            turn_angle_deg: 25.0,
-            lattice_spacing: 0.25,
-            shadow_spacing: 0.04,
-            umbra_spacing: 0.3,
-            screen_spacing: 12,
-            visibility_rays: 16,
-            emitter_min_area: 0.02,
-            occlusion_vertices: 16,
-            threshold: 1e-3,
-            max_shots: 10_000,
-            bounces: 0,
-            display_resolution: 64,
-            filter: display::Filter::ConicalLinear,
-            filter_radius: 0.2,
-            shadow_filter_radius: 0.04,
-            width: None,
-            height: None,
-            spp_side: 2,
-            seed: 1,
-        }
+stage_kit::knobs! {
+    /// The stage's parameters. Spacings and radii are fractions of each
+    /// surface's extent (the longer side of its bounding rectangle).
+    pub struct Params {
+        /// Probe grid cells along a surface's longer side.
+        probe_resolution: usize = 96, "cells", value(4..=4096);
+        /// Isolux bands per surface (`levels - 1` contours).
+        levels: usize = 8, "bands", value(1..=256);
+        /// Sample spacing along a straight isolux contour.
+        contour_spacing: f64 = 0.12, "fraction of extent", value(left_open(0.0, 10.0));
+        /// Turning of a curved contour between two of its samples.
+        turn_angle_deg: f64 = 25.0, "degrees", value(left_open(0.0, 180.0));
+        /// Spacing of the lattice in smooth regions and of the samples along
+        /// a surface's edges.
+        lattice_spacing: f64 = 0.25, "fraction of extent", value(left_open(0.0, 10.0));
+        /// Spacing of samples in a penumbra.
+        shadow_spacing: f64 = 0.04, "fraction of extent", value(left_open(0.0, 10.0));
+        /// Spacing of samples in an umbra.
+        umbra_spacing: f64 = 0.3, "fraction of extent", value(left_open(0.0, 10.0));
+        /// One view-dependent display sample per this many pixels squared.
+        screen_spacing: u32 = 12, "pixels", value(1..=16384);
+        /// Rays per light-source triangle for the direct light's visibility.
+        visibility_rays: usize = 16, "rays", value(1..=4096);
+        /// Least area of a secondary emitter, as a fraction of its surface's:
+        /// smaller isolux regions are merged into a neighbour.
+        emitter_min_area: f64 = 0.02, "fraction of surface area", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
+        /// At most this many of a secondary emitter's vertices cast its
+        /// occlusion rays.
+        occlusion_vertices: usize = 16, "vertices", value(1..=4096);
+        /// Stop shooting when the unshot power (all polygons together) is
+        /// under this fraction of the emitted power.
+        threshold: f64 = 1e-3, "fraction of emitted power", value(open(0.0, 1.0));
+        /// Most shots.
+        max_shots: usize = 10_000, "shots", value;
+        /// Reflections off secondary emitters (0: all, until `threshold`).
+        bounces: u32 = 0, "", value;
+        /// Display grid cells along a surface's longer side.
+        display_resolution: usize = 64, "cells", value(1..=4096);
+        /// The display filter: `conical` (paper 002's cone) or
+        /// `conical-linear` (the cone with a first-order correction).
+        filter: display::Filter = display::Filter::ConicalLinear, "", value;
+        /// Radius `r` of the conical filter.
+        filter_radius: f64 = 0.2, "fraction of extent", value(left_open(0.0, 10.0));
+        /// Radius of the cone near shadow-boundary samples.
+        shadow_filter_radius: f64 = 0.04, "fraction of extent", value(left_open(0.0, 10.0));
+        /// Image width (none: the camera's).
+        width: Option<u32> = None, "pixels", optional(1..=16384);
+        /// Image height (none: the camera's).
+        height: Option<u32> = None, "pixels", optional(1..=16384);
+        /// Rays per pixel along each side (`spp_side`² per pixel).
+        spp_side: u32 = 2, "rays", value(1..=16);
+        /// Seed of the visibility rays.
+        seed: u64 = 1, "", value;
     }
 }
 
-impl Params {
-    /// The first parameter out of range, as a message naming it.
-    pub fn problem(&self) -> Option<String> {
-        let fractions = [
-            ("contour_spacing", self.contour_spacing),
-            ("lattice_spacing", self.lattice_spacing),
-            ("shadow_spacing", self.shadow_spacing),
-            ("umbra_spacing", self.umbra_spacing),
-            ("filter_radius", self.filter_radius),
-            ("shadow_filter_radius", self.shadow_filter_radius),
-        ];
-        if let Some((name, v)) = fractions.iter().find(|(_, v)| !(*v > 0.0 && *v <= 10.0)) {
-            return Some(format!("{name} must be in (0, 10] (a fraction of the surface's extent), not {v}"));
-        }
-        let counts = [
-            ("probe_resolution", self.probe_resolution, 4, 4096),
-            ("levels", self.levels, 1, 256),
-            ("visibility_rays", self.visibility_rays, 1, 4096),
-            ("occlusion_vertices", self.occlusion_vertices, 1, 4096),
-            ("display_resolution", self.display_resolution, 1, 4096),
-            ("screen_spacing", self.screen_spacing as usize, 1, 16384),
-            ("spp_side", self.spp_side as usize, 1, 16),
-        ];
-        if let Some((name, v, lo, hi)) = counts.iter().find(|(_, v, lo, hi)| v < lo || v > hi) {
-            return Some(format!("{name} must be in {lo}..={hi}, not {v}"));
-        }
-        if !(self.turn_angle_deg > 0.0 && self.turn_angle_deg <= 180.0) {
-            return Some(format!("turn_angle_deg must be in (0, 180], not {}", self.turn_angle_deg));
-        }
-        if !(self.emitter_min_area >= 0.0 && self.emitter_min_area <= 1.0) {
-            return Some(format!("emitter_min_area must be in [0, 1], not {}", self.emitter_min_area));
-        }
-        if !(self.threshold > 0.0 && self.threshold < 1.0) {
-            return Some(format!("threshold must be in (0, 1), not {}", self.threshold));
-        }
-        for (name, v) in [("width", self.width), ("height", self.height)] {
-            if v.is_some_and(|v| v == 0 || v > 16_384) {
-                return Some(format!("{name} must be in 1..=16384, not {}", v.unwrap_or(0)));
-            }
-        }
-        None
-    }
-}
+stage_kit::show_by_name!(display::Filter);
 
 /// What the run did, for the report.
 #[derive(Clone, Debug, Default, PartialEq)]
