@@ -113,16 +113,19 @@ impl Occluders {
         if self.nodes.is_empty() {
             return true;
         }
-        let shaft = Shaft::new(receiver, sender, self.touch);
+        let mut shaft = Shaft::new(receiver, sender, self.touch);
         let skipped = |t: u32| ends.iter().any(|&e| e == t || self.twins[e as usize] == Some(t));
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
-            let node = self.nodes[i];
+        // The tree is balanced, so its depth is under 64 for any mesh.
+        let (mut stack, mut top) = ([0usize; 64], 1);
+        while top > 0 {
+            top -= 1;
+            let node = self.nodes[stack[top]];
             if !shaft.may_meet_box(node.lo, node.hi) {
                 continue;
             }
             if node.count == 0 {
-                stack.extend([i + 1, node.second]);
+                (stack[top], stack[top + 1]) = (stack[top] + 1, node.second);
+                top += 2;
                 continue;
             }
             for &t in &self.order[node.first..node.first + node.count] {
@@ -136,35 +139,41 @@ impl Occluders {
 }
 
 /// The convex hull of two triangles, by its bounding box and its extents
-/// along candidate separating axes, each shrunk by the touching
-/// tolerance.
+/// along candidate separating axes, each shrunk by the touching tolerance.
+/// The side faces' axes are made only for a triangle that the box, the two
+/// elements' planes and its own plane do not separate.
 struct Shaft {
-    points: [DVec3; 6],
+    ends: [[DVec3; 3]; 2],
     lo: DVec3,
     hi: DVec3,
-    /// Unit axis and the hull's shrunk interval along it.
+    /// Unit axis and the hull's shrunk interval along it: the two
+    /// elements' normals, then, once made, the side faces'.
     axes: Vec<(DVec3, f64, f64)>,
     touch: f64,
 }
 
 impl Shaft {
     fn new(receiver: &[DVec3; 3], sender: &[DVec3; 3], touch: f64) -> Self {
-        let points = [receiver[0], receiver[1], receiver[2], sender[0], sender[1], sender[2]];
-        let (lo, hi) = points.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let mut shaft = Shaft { points, lo: lo + DVec3::splat(touch), hi: hi - DVec3::splat(touch), axes: Vec::with_capacity(20), touch };
-        let normal = |t: &[DVec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]);
-        shaft.push(normal(receiver));
-        shaft.push(normal(sender));
-        // Side faces: an edge of one triangle and a corner of the other.
-        for (a, b) in [(receiver, sender), (sender, receiver)] {
+        let ends = [*receiver, *sender];
+        let (lo, hi) = ends.as_flattened().iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let mut shaft = Shaft { ends, lo: lo + DVec3::splat(touch), hi: hi - DVec3::splat(touch), axes: Vec::new(), touch };
+        for t in ends {
+            shaft.push((t[1] - t[0]).cross(t[2] - t[0]));
+        }
+        shaft
+    }
+
+    /// Adds the side faces' axes: an edge of one element with a corner of
+    /// the other.
+    fn push_sides(&mut self) {
+        for (a, b) in [(self.ends[0], self.ends[1]), (self.ends[1], self.ends[0])] {
             for i in 0..3 {
                 let edge = a[(i + 1) % 3] - a[i];
                 for corner in b {
-                    shaft.push(edge.cross(*corner - a[i]));
+                    self.push(edge.cross(corner - a[i]));
                 }
             }
         }
-        shaft
     }
 
     /// Adds `axis` (any length; a degenerate one is left out).
@@ -175,10 +184,11 @@ impl Shaft {
     }
 
     fn extent(&self, axis: DVec3) -> (f64, f64) {
-        self.points.iter().map(|p| p.dot(axis)).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)))
+        self.ends.as_flattened().iter().map(|p| p.dot(axis)).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)))
     }
 
-    /// Whether the box `lo..hi` may meet the hull (no axis separates them).
+    /// Whether the box `lo..hi` may meet the hull (neither the bounding
+    /// box nor an axis made so far separates them).
     fn may_meet_box(&self, lo: DVec3, hi: DVec3) -> bool {
         if (lo.cmpge(self.hi) | hi.cmple(self.lo)).any() {
             return false;
@@ -191,16 +201,16 @@ impl Shaft {
     }
 
     /// Whether the triangle `t` (unit normal `normal`) may meet the hull.
-    fn may_meet_triangle(&self, t: &[DVec3; 3], normal: DVec3) -> bool {
+    fn may_meet_triangle(&mut self, t: &[DVec3; 3], normal: DVec3) -> bool {
         let (lo, hi) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
         if (lo.cmpge(self.hi) | hi.cmple(self.lo)).any() {
             return false;
         }
-        let separated = |axis: DVec3, a: f64, b: f64| {
+        let separated = |&(axis, a, b): &(DVec3, f64, f64)| {
             let x = [t[0].dot(axis), t[1].dot(axis), t[2].dot(axis)];
-            x.iter().copied().fold(f64::NEG_INFINITY, f64::max) <= a || x.iter().copied().fold(f64::INFINITY, f64::min) >= b
+            x[0].max(x[1]).max(x[2]) <= a || x[0].min(x[1]).min(x[2]) >= b
         };
-        if self.axes.iter().any(|&(axis, a, b)| separated(axis, a, b)) {
+        if self.axes.iter().take(2).any(separated) {
             return false;
         }
         // The triangle's own plane.
@@ -211,7 +221,10 @@ impl Shaft {
                 return false;
             }
         }
-        true
+        if self.axes.len() <= 2 {
+            self.push_sides();
+        }
+        !self.axes.iter().skip(2).any(separated)
     }
 }
 
