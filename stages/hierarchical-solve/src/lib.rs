@@ -275,6 +275,9 @@ pub struct Work {
     pub luminaire_rays: u64,
     /// Seconds lighting elements from luminaires.
     pub luminaire_seconds: f64,
+    /// Links whose sender the last solve resolved into parts
+    /// ([`gather::SenderTerms`]).
+    pub resolved_links: usize,
     /// Couplings through mirrors and panes in the last pass ([`mirrors`]).
     pub specular_couplings: usize,
     /// Rays cast to build them, all passes.
@@ -505,11 +508,21 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let started = Instant::now();
         all_links.par_sort_unstable_by_key(|l| (h.flat(l.receiver), h.flat(l.sender)));
         let offsets = csr_offsets(&h, &all_links, b.len());
-        // The passes refine with senders' area means; the last one solves
-        // with senders resolved by the kernel (gather::SenderTerms).
-        let resolve = if pass == passes || (!refined_any && pass > 1) { gather::Senders::Resolved } else { gather::Senders::Means };
-        senders = gather::SenderTerms::new(&h, &all_links, resolve);
-        let convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders);
+        // The passes refine with senders' area means; the last one then
+        // solves on with the senders whose radiosity varies resolved by the
+        // kernel (gather::SenderTerms), judged on the means' solution.
+        senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
+        let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders);
+        if pass == passes || (!refined_any && pass > 1) {
+            let deviation = links::leaf_deviation(&h, &b);
+            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation });
+            work.resolved_links = senders.resolved();
+            let means = convergence;
+            convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, means.rates, &senders);
+            work.iterations += means.iterations;
+            work.capped_passes += usize::from(!means.converged);
+            work.extrapolations += means.extrapolations;
+        }
         rates = convergence.rates;
         work.iterations += convergence.iterations;
         work.relative_change = convergence.relative_change;

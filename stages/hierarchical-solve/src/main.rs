@@ -219,6 +219,7 @@ fn run(args: Args) -> schemas::Result<ExitCode> {
         let mut counters = BTreeMap::from([
             ("passes".to_string(), w.passes as f64),
             ("links".to_string(), w.links as f64),
+            ("resolved_links".to_string(), w.resolved_links as f64),
             ("cluster_links".to_string(), w.cluster_links as f64),
             ("elements".to_string(), w.elements as f64),
             ("leaves".to_string(), w.leaves as f64),
