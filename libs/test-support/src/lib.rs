@@ -12,9 +12,11 @@
 //! - [`artifacts`]: small artifacts of every kind, valid by construction
 //!   (the seeds of the fuzz targets).
 //! - [`gpu`]: a GPU test without a GPU skips, loudly (fails under CI).
+//! - [`metrics`]: error measures against a reference.
 
 pub mod artifacts;
 pub mod closed_form;
 pub mod gpu;
 pub mod meshes;
+pub mod metrics;
 pub mod scenes;

@@ -366,7 +366,7 @@ impl FullGather<'_> {
                 direction: (self.senders.centre(e.node) - position).normalize_or_zero(),
             });
         }
-        data.senders.sort_by(|a, b| a.node.cmp(&b.node));
+        data.senders.sort_by_key(|s| s.node);
         data
     }
 }

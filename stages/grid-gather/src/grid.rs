@@ -191,7 +191,7 @@ impl Grid {
 
     /// The five tetrahedra of cell `c`, as cell corner numbers.
     pub fn tetrahedra(c: [usize; 3]) -> [[usize; 4]; 5] {
-        if (c[0] + c[1] + c[2]) % 2 == 0 {
+        if (c[0] + c[1] + c[2]).is_multiple_of(2) {
             EVEN
         } else {
             EVEN.map(|t| t.map(|m| m ^ 1))
