@@ -18,9 +18,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// The options every stage binary has, flattened into its clap `Args`
-/// (`#[command(flatten)] stage: StageArgs<Params>`), with one flag per knob
-/// of `P` (see [`crate::knobs`]).
+/// The options every stage binary has, with one flag per knob of `P` (see
+/// [`crate::knobs`]): [`crate::stage::main`] adds them to a stage's own
+/// `Args`. (A stage not yet run by the kit flattens `StageArgs` into its
+/// `Args` itself, without knobs.)
 #[derive(Debug, Clone, Default)]
 pub struct StageArgs<P = NoKnobs> {
     /// Output: a report of the run.
@@ -151,7 +152,19 @@ impl Run {
         }
     }
 
-    /// Writes this run's report to `path`.
+    /// This run's report: its provenance with `params`, the wall time so
+    /// far, and what it counted, skipped and noted.
+    pub fn report<P: Serialize>(&self, params: &P, counters: BTreeMap<String, f64>, skipped: Vec<String>, notes: Vec<String>) -> Report {
+        Report {
+            header: Report::header(self.provenance(params)),
+            wall_time_s: self.started.elapsed().as_secs_f64(),
+            counters,
+            skipped,
+            notes,
+        }
+    }
+
+    /// Writes this run's [report](Run::report) to `path`.
     pub fn write_report<P: Serialize>(
         &self,
         path: &Path,
@@ -160,14 +173,7 @@ impl Run {
         skipped: Vec<String>,
         notes: Vec<String>,
     ) -> Result<()> {
-        let report = Report {
-            header: Report::header(self.provenance(params)),
-            wall_time_s: self.started.elapsed().as_secs_f64(),
-            counters,
-            skipped,
-            notes,
-        };
-        write_ron(path, &report)
+        write_ron(path, &self.report(params, counters, skipped, notes))
     }
 }
 

@@ -21,14 +21,8 @@
 //! error, and paper 002's percentage of samples over τ, relative per
 //! sample) are defined in [`metrics::Metrics`].
 //!
-//! | parameter | type | meaning | default |
-//! |---|---|---|---|
-//! | `tau` | list of f64 | thresholds τ on `|L_a − L_b| / L_b`, per sample | `[0.02, 0.05, 0.1]` |
-//! | `exclude_emitters` | bool | images: leave out pixels whose surface emits | false |
-//! | `exclude_edges` | optional count | images: leave out pixels within N px of a pixel not covered by one surface (and of an emitter, with `exclude_emitters`) | none |
-//! | `max_rel_rmse` | optional f64 | tolerance on `relative_rmse` | none |
-//! | `max_rmse` | optional f64 | tolerance on `rmse`, in the data's unit | none |
-//! | `max_pixels_over_tau` | optional f64 | tolerance, in percent, on the share of samples over the largest τ | none |
+//! The knobs are [`Params`] (`compare --print-knobs`, the README's "Stage
+//! knobs"): the thresholds τ, the pixels left out, and the tolerances.
 //!
 //! ```
 //! use compare::metrics::{metrics, Sample};
@@ -40,6 +34,7 @@
 
 #![deny(missing_docs)]
 
+pub mod files;
 pub mod images;
 pub mod metrics;
 pub mod scale_bar;
@@ -48,7 +43,7 @@ pub mod solutions;
 use metrics::Metrics;
 use schemas::image::HdrImage;
 use schemas::solution::Solution;
-use serde::{Deserialize, Serialize};
+use stage_kit::knobs::Knobs;
 use std::collections::BTreeMap;
 use std::fmt;
 
@@ -91,55 +86,35 @@ impl fmt::Display for CompareError {
     }
 }
 
-/// The stage's parameters (see the table in the crate documentation).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Thresholds τ for the percentage-over-τ metric, each on the
-    /// sample's relative luminance difference `|L_a − L_b| / L_b`.
-    pub tau: Vec<f64>,
-    /// Images: leave out the pixels whose surface emits.
-    pub exclude_emitters: bool,
-    /// Images: leave out the pixels within this many pixels of an edge
-    /// (see [`images::Exclusions::edges`]).
-    pub exclude_edges: Option<u32>,
-    /// Largest allowed `relative_rmse`.
-    pub max_rel_rmse: Option<f64>,
-    /// Largest allowed `rmse`, in the data's unit (W/(m² sr) for images,
-    /// W/m² for solutions).
-    pub max_rmse: Option<f64>,
-    /// Largest allowed percentage (0-100) of samples whose luminance
-    /// difference exceeds the largest τ.
-    pub max_pixels_over_tau: Option<f64>,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            tau: vec![0.02, 0.05, 0.1],
-            exclude_emitters: false,
-            exclude_edges: None,
-            max_rel_rmse: None,
-            max_rmse: None,
-            max_pixels_over_tau: None,
-        }
+stage_kit::knobs! {
+    /// The stage's parameters.
+    pub struct Params {
+        /// Thresholds τ for the percentage-over-τ metric, each on the
+        /// sample's relative luminance difference `|L_a − L_b| / L_b`.
+        tau: Vec<f64> = vec![0.02, 0.05, 0.1], "", list(positive());
+        /// Images: leave out the pixels whose surface emits (needs a surface layer in A or B).
+        exclude_emitters: bool = false, "", switch;
+        /// Images: leave out the pixels within this many pixels of a pixel not covered by one surface
+        /// (and of an emitter, with `exclude_emitters`).
+        exclude_edges: Option<u32> = None, "pixels", optional;
+        /// Largest allowed `relative_rmse`.
+        max_rel_rmse: Option<f64> = None, "", optional(at_least(0.0));
+        /// Largest allowed `rmse`, in the data's unit (W/(m² sr) for images,
+        /// W/m² for solutions).
+        max_rmse: Option<f64> = None, "", optional(at_least(0.0));
+        /// Largest allowed percentage (0-100) of samples whose luminance
+        /// difference exceeds the largest τ.
+        max_pixels_over_tau: Option<f64> = None, "%", optional(at_least(0.0));
     }
 }
 
 impl Params {
-    /// Refuses an empty τ list, a τ that is not positive and finite, and a
-    /// tolerance that is negative or not finite.
+    /// Checks every knob's range ([`Knobs::check`]) and that τ has at
+    /// least one value.
     pub fn validate(&self) -> schemas::Result<()> {
+        self.check("")?;
         if self.tau.is_empty() {
             return Err(stage_kit::run::bad_parameter("tau needs at least one value"));
-        }
-        if let Some(tau) = self.tau.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-            return Err(stage_kit::run::bad_parameter(format!("tau must be positive, got {tau}")));
-        }
-        for (name, tolerance) in self.tolerances() {
-            if let Some(t) = tolerance.filter(|t| !(t.is_finite() && *t >= 0.0)) {
-                return Err(stage_kit::run::bad_parameter(format!("{name} must be a non-negative number, got {t}")));
-            }
         }
         Ok(())
     }
@@ -154,17 +129,9 @@ impl Params {
         self.tau.iter().copied().fold(0.0, f64::max)
     }
 
-    fn tolerances(&self) -> [(&'static str, Option<f64>); 3] {
-        [
-            ("max_rel_rmse", self.max_rel_rmse),
-            ("max_rmse", self.max_rmse),
-            ("max_pixels_over_tau", self.max_pixels_over_tau),
-        ]
-    }
-
     /// Whether any tolerance is given.
     pub fn has_tolerance(&self) -> bool {
-        self.tolerances().iter().any(|(_, t)| t.is_some())
+        [self.max_rel_rmse, self.max_rmse, self.max_pixels_over_tau].iter().any(Option::is_some)
     }
 
     /// Each given tolerance that `m` exceeds, as `metric value > tolerance`;

@@ -328,9 +328,11 @@ fn different_meshes_and_bad_hierarchies_are_errors() {
 #[test]
 fn parameters_validate_and_parse_strictly() {
     assert!(Params::default().validate().is_ok());
-    assert!(Params { tau: vec![], ..Params::default() }.validate().is_err());
-    assert!(Params { tau: vec![0.0], ..Params::default() }.validate().is_err());
-    assert!(Params { max_rmse: Some(-1.0), ..Params::default() }.validate().is_err());
+    let refused = |p: Params| p.validate().unwrap_err().to_string();
+    assert_eq!(refused(Params { tau: vec![], ..Params::default() }), "parameters: tau needs at least one value");
+    assert_eq!(refused(Params { tau: vec![0.1, 0.0], ..Params::default() }), "parameters: tau must be a positive number, not 0");
+    assert_eq!(refused(Params { max_rmse: Some(-1.0), ..Params::default() }), "parameters: max_rmse must be at least 0, not -1");
+    assert_eq!(refused(Params { max_rel_rmse: Some(f64::NAN), ..Params::default() }), "parameters: max_rel_rmse must be at least 0, not NaN");
     let params: Params = ron::from_str("(max_rel_rmse: Some(0.02))").unwrap();
     assert_eq!(params.tau, vec![0.02, 0.05, 0.1]);
     assert_eq!(params.max_rel_rmse, Some(0.02));

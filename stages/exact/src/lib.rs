@@ -18,14 +18,9 @@
 //! those positions, and the bound covers the quadrature and iteration, not
 //! the scene file's rounding to f32 (about 6e-8 of the scene's size).
 //!
-//! | parameter | meaning | default |
-//! |---|---|---|
-//! | `bounces` | 0: direct light; 1: the paper's one bounce; n: n bounces, iterated between two planes | 1 |
-//! | `tolerance` | relative tolerance of each pixel's one-bounce integral, at most 1e-4 | 1e-6 |
-//! | `gauss_order` | Gauss-Legendre points per direction of the triangle rule | 6 |
-//! | `max_depth` | deepest 1:4 refinement of the adaptive quadrature | 12 |
-//! | `nystrom_level` | 1:4 splits of the reflectors for the iterated bounces' nodes | 2 |
-//! | `width`, `height` | image size | the manifest camera's |
+//! The knobs are [`Params`] (`exact --print-knobs`, the README's "Stage
+//! knobs"): the bounces, the quadrature's tolerance and depth, the
+//! iterated bounces' nodes, the image size.
 
 #![deny(missing_docs)]
 
@@ -39,67 +34,33 @@ use quadrature::LOOSEST_TOLERANCE;
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::rays::SceneRays;
-use serde::{Deserialize, Serialize};
 use transport::{Accuracy, Transport};
-
-/// The stage's parameters (see the table in the crate documentation).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Bounces after the direct light.
-    pub bounces: u32,
-    /// Relative tolerance of the one-bounce integral.
-    pub tolerance: f64,
-    /// Gauss-Legendre points per direction.
-    pub gauss_order: u32,
-    /// Deepest adaptive refinement.
-    pub max_depth: u32,
-    /// Node refinement of the iterated bounces.
-    pub nystrom_level: u32,
-    /// Image width in pixels; `None`: the manifest camera's.
-    pub width: Option<u32>,
-    /// Image height in pixels; `None`: the manifest camera's.
-    pub height: Option<u32>,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params { bounces: 1, tolerance: 1e-6, gauss_order: 6, max_depth: 12, nystrom_level: 2, width: None, height: None }
-    }
-}
 
 /// Largest image side and pixel count, as the other image stages allow.
 const MAX_SIDE: u32 = 16_384;
 const MAX_PIXELS: u64 = 64 << 20;
 
-impl Params {
-    /// Refuses values outside their ranges, naming the parameter.
-    pub fn validate(&self) -> Result<(), String> {
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance <= LOOSEST_TOLERANCE) {
-            return Err(format!("tolerance must be a number in (0, {LOOSEST_TOLERANCE:e}] (looser, the error bound is not trusted), not {}", self.tolerance));
-        }
-        if !(1..=32).contains(&self.gauss_order) {
-            return Err(format!("gauss_order must be in 1..=32, not {}", self.gauss_order));
-        }
-        if !(1..=30).contains(&self.max_depth) {
-            return Err(format!("max_depth must be in 1..=30, not {}", self.max_depth));
-        }
-        if !(1..=6).contains(&self.nystrom_level) {
-            return Err(format!("nystrom_level must be in 1..=6, not {}", self.nystrom_level));
-        }
-        if self.bounces > 1000 {
-            return Err(format!("bounces must be at most 1000, not {}", self.bounces));
-        }
-        for (name, side) in [("width", self.width), ("height", self.height)] {
-            if let Some(side) = side {
-                if !(1..=MAX_SIDE).contains(&side) {
-                    return Err(format!("{name} must be in 1..={MAX_SIDE}, not {side}"));
-                }
-            }
-        }
-        Ok(())
+stage_kit::knobs! {
+    /// The stage's parameters.
+    pub struct Params {
+        /// Bounces after the direct light: 0, 1 (the paper's one bounce), or more, iterated between two planes.
+        bounces: u32 = 1, "", value(0..=1000);
+        /// Relative tolerance of each pixel's one-bounce integral (looser than 1e-4, the error bound is not trusted).
+        tolerance: f64 = 1e-6, "", value(left_open(0.0, LOOSEST_TOLERANCE));
+        /// Gauss-Legendre points per direction of the triangle rule.
+        gauss_order: u32 = 6, "", value(1..=32);
+        /// Deepest 1:4 refinement of the adaptive quadrature.
+        max_depth: u32 = 12, "", value(1..=30);
+        /// 1:4 splits of the reflectors for the iterated bounces' nodes.
+        nystrom_level: u32 = 2, "", value(1..=6);
+        /// Image width; `none`: the manifest camera's.
+        width: Option<u32> = None, "pixels", optional(1..=MAX_SIDE);
+        /// Image height; `none`: the manifest camera's.
+        height: Option<u32> = None, "pixels", optional(1..=MAX_SIDE);
     }
+}
 
+impl Params {
     /// The transport's accuracy settings.
     pub fn accuracy(&self) -> Accuracy {
         Accuracy { tolerance: self.tolerance, gauss_order: self.gauss_order, max_depth: self.max_depth, bounces: self.bounces, nystrom_level: self.nystrom_level }
