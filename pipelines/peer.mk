@@ -31,6 +31,14 @@ PEER_TARGETS ?= 0.05,0.02,0.01
 PEER_REF_BUDGET_S ?= 480
 # Extra flags of the pipeline's sweep (e.g. --knob EPS=0.01,0.001 --reps 1).
 PEER_SWEEP_FLAGS ?=
+# PEER_SWEEP=0: no sweep, only Mitsuba's points and the images below (for
+# a scene whose every solve takes minutes, such as the mirror boxes).
+PEER_SWEEP ?= 1
+# Other pipeline images of the scene whose error against the same
+# reference is reported, NAME=IMAGE each, built by make first: e.g.
+# PEER_ALSO='gpu-shoot=$(OUT)/gpu/preview.exr full=$(OUT)/final.exr' for
+# both solvers on a scene with mirrors (make bench-mirror-peer).
+PEER_ALSO ?=
 
 .PHONY: mitsuba bench-peer
 mitsuba: $(MITSUBA_XML)
@@ -47,7 +55,7 @@ $(PEER_VENV)/.installed:
 	$(PEER_VENV)/bin/pip install --quiet $(PEER_MITSUBA) numpy
 	@touch $@
 
-bench-peer: $(BINS) $(BENCH_BINS) $(call sweep_bins,$(PEER_SWEEP_FLAGS)) $(OUT)/preview.exr $(MITSUBA_XML) | $(PEER_VENV)/.installed
+bench-peer: $(BINS) $(BENCH_BINS) $(call sweep_bins,$(PEER_SWEEP_FLAGS)) $(OUT)/preview.exr $(foreach a,$(PEER_ALSO),$(lastword $(subst =, ,$(a)))) $(MITSUBA_XML) | $(PEER_VENV)/.installed
 	@mkdir -p $(PEER_OUT)
 	@if [ "$(PEER_VARIANT)" != scalar_rgb ] && ! ls /usr/lib/x86_64-linux-gnu/libLLVM.so.19* /usr/lib/x86_64-linux-gnu/libLLVM-19.so* >/dev/null 2>&1; then \
 	  if [ "$$(id -u)" = 0 ] && apt-cache show libllvm19 >/dev/null 2>&1; then \
@@ -57,4 +65,5 @@ bench-peer: $(BINS) $(BENCH_BINS) $(call sweep_bins,$(PEER_SWEEP_FLAGS)) $(OUT)/
 	$(PEER_VENV)/bin/python bench/peer/bench_peer.py --xml $(MITSUBA_XML) --pipeline-image $(OUT)/preview.exr \
 	  --manifest $(OUT)/manifest.ron --compare $(BIN)/compare --out $(PEER_OUT) --variant $(PEER_VARIANT) \
 	  --spp $(PEER_SPP) --reps $(PEER_REPS) --rep-cap-s $(PEER_REP_CAP_S) --targets $(PEER_TARGETS) --ref-budget-s $(PEER_REF_BUDGET_S) \
-	  --sweep '$(BIN)/sweep --scene $(SCENE) --reference {reference} -o {out}/sweep $(PEER_SWEEP_FLAGS)' --sweep-csv $(PEER_OUT)/sweep/sweep.csv
+	  $(foreach a,$(PEER_ALSO),--also $(a)) \
+	  --sweep '$(if $(filter 1,$(PEER_SWEEP)),$(BIN)/sweep --scene $(SCENE) --reference {reference} -o {out}/sweep $(PEER_SWEEP_FLAGS))' --sweep-csv $(PEER_OUT)/sweep/sweep.csv

@@ -161,6 +161,22 @@ def per_object(a, b, mask, objects, names):
     return rows
 
 
+def against_reference(label, rgb, ref, mask, objects, names):
+    """Two lines: `label`'s relative RMSE and mean signed error against the
+    reference over the compared pixels, and its mean signed error per
+    object (how each solver's image of the scene is reported)."""
+    return [f"{label} vs the Mitsuba reference: relative RMSE {100 * relative_rmse(rgb, ref, mask):.2f}%, mean signed error {100 * mean_signed_error(rgb, ref, mask):+.2f}%",
+            "  per object: " + "; ".join(f"{n} {100 * m:+.2f}%" for n, _, _, m in per_object(rgb, ref, mask, objects, names))]
+
+
+def named_image(text):
+    """`NAME=IMAGE` of --also: (name, path)."""
+    name, sep, path = text.partition("=")
+    if not sep or not name or not path:
+        raise argparse.ArgumentTypeError(f"--also takes NAME=IMAGE, not {text!r}")
+    return name, path
+
+
 def manifest_objects(path):
     text = open(path).read()
     found = re.search(r"\bobjects:\s*\[(.*?)\]", text, re.S)
@@ -357,6 +373,8 @@ def main():
     p.add_argument("--ref-budget-s", type=float, default=480.0, help="render time the reference may take (both halves)")
     p.add_argument("--fresh-reference", action="store_true", help="render the reference anew even if one with the same scene and variant exists")
     p.add_argument("--exclude-edges", type=int, default=2)
+    p.add_argument("--also", type=named_image, action="append", default=[], metavar="NAME=IMAGE",
+                   help="another pipeline image of the scene (another solver's preview, the full gather) whose error against the reference is reported beside --pipeline-image's; repeatable")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
     targets = sorted((float(t) for t in args.targets.split(",")), reverse=True)
@@ -388,7 +406,8 @@ def main():
     ours = relative_rmse(pipeline_rgb, ref, mask)
     flips = {"left-right": ref[:, ::-1], "upside-down": ref[::-1, :]}
     flipped = {k: relative_rmse(pipeline_rgb, v, mask & mask[:, ::-1] if k == "left-right" else mask & mask[::-1, :]) for k, v in flips.items()}
-    lines.append(f"pipeline image {args.pipeline_image} vs the Mitsuba reference: relative RMSE {100 * ours:.2f}%, mean signed error {100 * mean_signed_error(pipeline_rgb, ref, mask):+.2f}%")
+    image_lines = against_reference(f"pipeline image {args.pipeline_image}", pipeline_rgb, ref, mask, objects, names)
+    lines.append(image_lines[0])
     lines.append("  orientation: against the reference mirrored " + ", ".join(f"{k} {100 * v:.1f}%" for k, v in flipped.items()) + (" (larger: not mirrored)" if min(flipped.values()) > ours else " (NOT larger: mirrored?)"))
     report = os.path.join(args.out, "pipeline-image.compare.ron")
     cmd = [args.compare, args.pipeline_image, ref_path, "--exclude-emitters", "--exclude-edges", str(args.exclude_edges), "--manifest", args.manifest, "-o", report]
@@ -400,7 +419,12 @@ def main():
             raise SystemExit("bench-peer: error: this script's masked relative RMSE differs from compare's: the mask or the metric drifted")
     else:
         lines.append(f"  compare could not read the reference ({(run.stderr.strip().splitlines() or ['?'])[-1]}): this script's metric is unchecked")
-    lines.append(f"  per object (pipeline image vs reference): " + "; ".join(f"{n} {100 * m:+.2f}%" for n, _, _, m in per_object(pipeline_rgb, ref, mask, objects, names)))
+    lines.append(image_lines[1])
+    for name, path in args.also:
+        rgb, _ = read_exr(mi, path)
+        if rgb.shape != ref.shape:
+            raise SystemExit(f"bench-peer: error: {path} is {rgb.shape[1]}x{rgb.shape[0]}, the Mitsuba film {ref.shape[1]}x{ref.shape[0]}")
+        lines.extend(against_reference(f"{name} ({path})", rgb, ref, mask, objects, names))
     for line in lines:
         log(line)
 
@@ -492,7 +516,9 @@ def main():
             for t, e, label in sorted(pts):
                 w.writerow([name, label, t, e])
     os.replace(os.path.join(args.out, "points.csv.tmp"), os.path.join(args.out, "points.csv"))
-    title = f"Cornell box: time to error, Mitsuba 3 ({args.variant_used}) vs this pipeline"
+    # The scene's name: the folder of make's OUT, which holds mitsuba/scene.xml.
+    scene = os.path.basename(os.path.dirname(os.path.dirname(os.path.abspath(args.xml)))) or "scene"
+    title = f"{scene}: time to error, Mitsuba 3 ({args.variant_used}) vs this pipeline"
     atomic_write(os.path.join(args.out, "time_to_error.svg"), svg_plot(series, targets, title))
 
 

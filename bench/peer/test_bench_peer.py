@@ -47,6 +47,31 @@ class Mask(unittest.TestCase):
         self.assertAlmostEqual(estimate, actual, delta=0.03 * actual)
 
 
+class OtherImages(unittest.TestCase):
+    def test_each_image_is_reported_against_the_reference_per_object(self):
+        # Object 0 (left half) 10% too bright, object 1 (right half) 20% too dark.
+        ref = np.ones((4, 4, 3))
+        objects = np.zeros((4, 4))
+        objects[:, 2:] = 1
+        rgb = ref.copy()
+        rgb[:, :2] *= 1.1
+        rgb[:, 2:] *= 0.8
+        mask = np.ones((4, 4), bool)
+        mask[0, 0] = False  # a left-out pixel counts nowhere
+        whole, per = bp.against_reference("gpu-shoot (gpu/preview.exr)", rgb, ref, mask, objects, ["mirror", "floor"])
+        # relative RMSE sqrt((7 x 0.01 + 8 x 0.04) / 15) over 15 pixels; signed (7 x 0.1 - 8 x 0.2) / 15
+        self.assertIn(f"relative RMSE {100 * np.sqrt((7 * 0.01 + 8 * 0.04) / 15):.2f}%", whole)
+        self.assertIn(f"mean signed error {100 * (7 * 0.1 - 8 * 0.2) / 15:+.2f}%", whole)
+        self.assertTrue(whole.startswith("gpu-shoot (gpu/preview.exr) vs the Mitsuba reference"))
+        self.assertEqual(per, "  per object: mirror +10.00%; floor -20.00%")
+
+    def test_also_takes_name_equals_image(self):
+        self.assertEqual(bp.named_image("gpu-shoot=out/x/gpu/preview.exr"), ("gpu-shoot", "out/x/gpu/preview.exr"))
+        for bad in ("gpu-shoot", "=a.exr", "gpu="):
+            with self.assertRaises(bp.argparse.ArgumentTypeError):
+                bp.named_image(bad)
+
+
 class BestRuns(unittest.TestCase):
     def test_most_accurate_run_per_series_and_its_surfaces(self):
         import tempfile

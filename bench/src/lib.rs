@@ -1,10 +1,12 @@
 //! Measuring helpers the benchmark binaries share, the sweep of error
 //! against time ([`sweep`], the `sweep` binary), and paper 002's
 //! benchmark of structured sampling ([`structured`], `bench-structured`),
-//! and the summary of `make bench-gather` ([`gather`], `bench-gather`).
+//! the summary of `make bench-gather` ([`gather`], `bench-gather`), and the
+//! table of `make bench-mirror` ([`mirror`], `bench-mirror`).
 
 pub mod gather;
 pub mod mask;
+pub mod mirror;
 pub mod structured;
 pub mod sweep;
 
