@@ -18,10 +18,6 @@ use schemas::solution::{Node, Solution};
 use std::path::Path;
 use test_support::metrics::relative_rmse;
 
-fn material(name: &str, diffuse: f64, emission: f64) -> Material {
-    Material::diffuse(name, [diffuse; 3], [emission; 3])
-}
-
 /// A scene in memory.
 struct Room {
     mesh: Mesh,
@@ -142,7 +138,7 @@ fn straddled() -> Room {
         header: Manifest::header(Provenance::in_memory("test")),
         world_from_mesh_translation: [0.0; 3],
         camera: Camera { eye: [2.5, 0.5, 0.5], target: [0.0, 0.5, 0.5], up: [0.0, 0.0, 1.0], vertical_fov_deg: 20.0, width: 24, height: 24 },
-        materials: vec![material("receiving", 0.5, 0.0), material("black", 0.0, 0.0), material("emitting", 0.0, 1.0)],
+        materials: vec![Material::diffuse("receiving", [0.5; 3], [0.0; 3]), Material::diffuse("black", [0.0; 3], [0.0; 3]), Material::diffuse("emitting", [0.0; 3], [1.0; 3])],
         objects: vec!["R".into(), "box".into(), "lamp".into()],
         goniometric_lights: vec![],
         effects: Effects::default(),
