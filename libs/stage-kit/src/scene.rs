@@ -85,3 +85,75 @@ pub fn alpha_masks(surface: &Surface, mesh: &Mesh) -> Option<AlphaMasks> {
         .collect();
     (!textures.is_empty()).then_some(AlphaMasks { masked, textures })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use schemas::header::{Provenance, Schema};
+    use schemas::mesh::Triangle;
+
+    /// A 1 x 1 texture of `kind` holding `value` in every channel.
+    fn texture(kind: TextureKind, value: f32) -> Texture {
+        Texture { kind, width: 1, height: 1, texels: vec![[value; 4]], scale: [2.0, 1.0], offset: [0.5, 0.0], clamp: true, strength: 1.0 }
+    }
+
+    /// Materials 0 (diffuse texture 1, alpha 3), 1 (alpha 2), 2 (diffuse
+    /// texture 0); triangles of materials 1, 0, 0, 1, of which 0 and 2 have
+    /// texture coordinates.
+    fn scene() -> (Surface, Mesh) {
+        let uv = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let surface = Surface {
+            header: Surface::header(Provenance::in_memory("test")),
+            uvs: vec![(0, uv), (2, uv)],
+            shading_normals: Vec::new(),
+            tangents: Vec::new(),
+            material_maps: vec![[1, 3, NONE], [NONE, 2, NONE], [0, NONE, NONE]],
+            textures: vec![texture(TextureKind::Diffuse, 0.125), texture(TextureKind::Diffuse, 0.25), texture(TextureKind::Alpha, 0.0), texture(TextureKind::Alpha, 1.0)],
+        };
+        let triangle = |material: u32| Triangle { vertices: [0, 1, 2], material, object: 0, area: 0.5, normal: [0.0, 0.0, 1.0] };
+        let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        (surface, Mesh { header: Mesh::header(Provenance::in_memory("test")), positions, triangles: [1, 0, 0, 1].map(triangle).to_vec() })
+    }
+
+    #[test]
+    fn material_maps_and_alpha_masks_follow_the_surface_tables() {
+        let (surface, mesh) = scene();
+        let maps = material_maps(&surface, 0);
+        let (diffuse, alpha) = (maps.diffuse.unwrap(), maps.alpha.unwrap());
+        assert_eq!((diffuse.texels, alpha.texels), (&[[0.25; 4]][..], &[[1.0; 4]][..]));
+        assert_eq!((diffuse.width, diffuse.height, diffuse.scale, diffuse.offset, diffuse.clamp), (1, 1, [2.0, 1.0], [0.5, 0.0], true));
+        assert!(material_maps(&surface, 1).diffuse.is_none() && material_maps(&surface, 2).alpha.is_none());
+        assert!(material_maps(&surface, 3).is_empty(), "a material past the table has no maps");
+        // Triangle 0 (material 1) first uses alpha texture 2, triangle 2
+        // (material 0) texture 3; triangles 1 and 3 have no coordinates.
+        let masks = alpha_masks(&surface, &mesh).unwrap();
+        assert_eq!(masks.masked.iter().map(|m| m.map(|(_, k)| k)).collect::<Vec<_>>(), [Some(0), None, Some(1), None]);
+        assert_eq!(masks.masked[2].unwrap().0, [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        assert_eq!((masks.textures[0].texels.clone(), masks.textures[1].texels.clone()), (vec![[0.0; 4]], vec![[1.0; 4]]));
+        let unmasked = Surface { material_maps: vec![[1, NONE, NONE]; 3], ..surface };
+        assert!(alpha_masks(&unmasked, &mesh).is_none());
+    }
+
+    #[test]
+    fn the_manifest_s_camera_and_lights_are_placed_and_a_bad_light_is_named() {
+        let camera = Camera { eye: [0.0, 0.0, 0.0], target: [0.0, 0.0, -5.0], up: [0.0, 1.0, 0.0], vertical_fov_deg: 90.0, width: 4, height: 2 };
+        let centre = pinhole(&camera, 200, 100).unwrap().direction(100.0, 50.0);
+        assert!((centre - DVec3::NEG_Z).length() < 1e-12);
+        assert!(pinhole(&Camera { vertical_fov_deg: 180.0, ..camera }, 200, 100).is_none());
+        let light = |label: &str, scale: f64| GoniometricLight {
+            label: label.into(),
+            position: [1.0, 2.0, 3.0],
+            nadir: [0.0, 0.0, -1.0],
+            c0: [1.0, 0.0, 0.0],
+            scale,
+            c_angles_deg: vec![0.0],
+            gamma_angles_deg: vec![0.0, 180.0],
+            intensity_cd: vec![683.0, 683.0],
+            flux_lm: 0.0,
+        };
+        let placed = luminaires(&[light("a.ies", 2.0)]).unwrap();
+        assert_eq!((placed[0].position, placed[0].frame[2], placed[0].w_per_sr_per_cd), (DVec3::new(1.0, 2.0, 3.0), DVec3::NEG_Z, 2.0 / 683.0));
+        let error = luminaires(&[light("a.ies", 2.0), light("b.ldt", -1.0)]).unwrap_err();
+        assert_eq!(error, "goniometric light 1 ('b.ldt'): scale -1 must be finite and > 0 (and scale x largest intensity finite)");
+    }
+}
