@@ -535,7 +535,7 @@ pub mod group {
     }
 }
 
-/// Declares a stage's parameters once; see the [module](crate::knobs).
+/// Declares a stage's parameters once; see the [module](mod@crate::knobs).
 ///
 /// ```text
 /// stage_kit::knobs! {

@@ -1,7 +1,7 @@
 //! # stage-kit: what every stage binary shares
 //!
 //! The file contracts live in `schemas`; this crate holds the grammar of a
-//! stage's run around them: its knobs, declared once ([`knobs`]: the
+//! stage's run around them: its knobs, declared once ([`knobs`](mod@knobs): the
 //! `Params` struct, defaults, ranges, flags, the knob table), the common
 //! start and end of a run ([`stage`]: parse, `--print-params`, outputs
 //! checked, the prepared scene read, report, outputs kept), the command

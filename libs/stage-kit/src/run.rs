@@ -19,7 +19,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 /// The options every stage binary has, with one flag per knob of `P` (see
-/// [`crate::knobs`]): [`crate::stage::main`] adds them to a stage's own
+/// [`crate::knobs`](mod@crate::knobs)): [`crate::stage::main`] adds them to a stage's own
 /// `Args`. (A stage not yet run by the kit flattens `StageArgs` into its
 /// `Args` itself, without knobs.)
 #[derive(Debug, Clone, Default)]
