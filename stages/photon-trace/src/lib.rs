@@ -43,11 +43,16 @@
 //! `(seed, s, i)`; batches are traced in parallel and added in index
 //! order; every stop test runs between rounds. So a run gives the same
 //! bits at any thread count, unless it stops on `time_budget_s`.
+//!
+//! The binary writes the solutions of the way there ([`snapshot`]) and
+//! reports the work and the error against time ([`report`]).
 
 pub mod direct;
 pub mod filter;
 pub mod mesh;
 pub mod perceptual;
+pub mod report;
+pub mod snapshot;
 pub mod tally;
 pub mod tracing;
 
@@ -64,126 +69,48 @@ use radiometry::sampling::Stream;
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Element;
-use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::time::Instant;
 use tally::Tally;
 use tracing::{Deposit, Emitters, Scene};
 
-/// The solver's parameters (the stage's `--params` file).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Seed of every photon and shadow ray.
-    pub seed: u64,
-    /// Photons per batch (the unit of the variance estimate).
-    pub batch_photons: usize,
-    /// Batches per round (traced in parallel; stop tests between rounds).
-    pub batches_per_round: usize,
-    /// Photons of stage 1 (every hit deposited), a whole number of rounds
-    /// (rounded up).
-    pub preview_photons: u64,
-    /// Stage 3 stops once every vertex's estimated relative standard error
-    /// of radiosity is under this (see [`Params::relative_floor`]).
-    pub target_error: f64,
-    /// Stage 3 stops once the indirect estimate holds this many photons
-    /// (stage 1's included), whatever the error.
-    pub max_photons: u64,
-    /// Stage 3 stops after this many seconds of the whole run (makes the
-    /// result depend on the machine); none by default.
-    pub time_budget_s: Option<f64>,
-    /// A vertex's error is relative to its radiosity, or to this fraction of
-    /// the scene's area-mean radiosity where that is larger (dark corners
-    /// would otherwise never converge).
-    pub relative_floor: f64,
-    /// Corners (and filter neighbours) whose normals differ by more than
-    /// this, degrees, are not one vertex (do not filter into each other).
-    pub crease_angle_deg: f64,
-    /// Largest filter radius, as a fraction of the scene's bounding-box
-    /// diagonal; 0 turns filtering off.
-    pub filter_radius: f64,
-    /// Shadow rays per vertex and emitting triangle in the direct pass.
-    pub visibility_rays: usize,
-    /// Split a leaf when the Stevens brightness at an edge midpoint departs
-    /// from the mean of its edge's ends by more than this (brightness 1 =
-    /// the adaptation luminance; [`perceptual`]).
-    pub brightness_threshold: f64,
-    /// Exponent of Stevens' power law.
-    pub stevens_exponent: f64,
-    /// Splitting passes at most (each splits every leaf over the threshold
-    /// once).
-    pub max_splits: u32,
-    /// Smallest element area, as a fraction of the scene's total area.
-    pub min_area: f64,
-    /// Before stage 1, elements are split 1:4 until none is larger than
-    /// this fraction of the scene's total area, so photons have vertices to
-    /// land on and the splitting criterion samples every surface.
-    pub initial_area: f64,
-    /// Bounces after which a photon is dropped.
-    pub max_bounces: u32,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            seed: 1,
-            batch_photons: 4096,
-            batches_per_round: 16,
-            preview_photons: 65_536,
-            target_error: 0.005,
-            max_photons: 1 << 24,
-            time_budget_s: None,
-            relative_floor: 0.1,
-            crease_angle_deg: 45.0,
-            filter_radius: 0.2,
-            visibility_rays: 16,
-            brightness_threshold: 0.02,
-            stevens_exponent: 1.0 / 3.0,
-            max_splits: 6,
-            min_area: 1e-4,
-            initial_area: 1e-2,
-            max_bounces: 1000,
-        }
-    }
-}
-
-impl Params {
-    /// What is wrong with these parameters, if anything.
-    pub fn problem(&self) -> Option<String> {
-        let positive = [
-            ("target_error", self.target_error),
-            ("relative_floor", self.relative_floor),
-            ("brightness_threshold", self.brightness_threshold),
-            ("stevens_exponent", self.stevens_exponent),
-            ("min_area", self.min_area),
-            ("initial_area", self.initial_area),
-        ];
-        if let Some((name, value)) = positive.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
-            return Some(format!("{name} must be a positive number, not {value}"));
-        }
-        if !(self.filter_radius.is_finite() && self.filter_radius >= 0.0) {
-            return Some(format!("filter_radius must be a number >= 0, not {}", self.filter_radius));
-        }
-        if !(self.crease_angle_deg.is_finite() && (0.0..=180.0).contains(&self.crease_angle_deg)) {
-            return Some(format!("crease_angle_deg must be in 0..180, not {}", self.crease_angle_deg));
-        }
-        if let Some(t) = self.time_budget_s.filter(|t| !(t.is_finite() && *t > 0.0)) {
-            return Some(format!("time_budget_s must be a positive number, not {t}"));
-        }
-        let counts = [
-            ("batch_photons", self.batch_photons as u64),
-            ("preview_photons", self.preview_photons),
-            ("max_photons", self.max_photons),
-            ("visibility_rays", self.visibility_rays as u64),
-            ("max_bounces", u64::from(self.max_bounces)),
-        ];
-        if let Some((name, _)) = counts.iter().find(|(_, v)| *v == 0) {
-            return Some(format!("{name} must be at least 1, not 0"));
-        }
-        if self.batches_per_round < 2 {
-            return Some(format!("batches_per_round must be at least 2 (the variance needs two batches), not {}", self.batches_per_round));
-        }
-        None
+stage_kit::knobs! {
+    /// The solver's parameters (the stage's `--params` file).
+    pub struct Params {
+        /// Seed of every photon and shadow ray.
+        seed: u64 = 1, "", value;
+        /// Photons per batch (the unit of the variance estimate).
+        batch_photons: usize = 4096, "photons", value(at_least(1));
+        /// Batches per round (traced in parallel; stop tests between rounds); the variance needs two.
+        batches_per_round: usize = 16, "batches", value(at_least(2));
+        /// Photons of stage 1 (every hit deposited), a whole number of rounds (rounded up).
+        preview_photons: u64 = 65_536, "photons", value(at_least(1));
+        /// Stage 3 stops once every vertex's estimated relative standard error of radiosity is under this (see `relative_floor`).
+        target_error: f64 = 0.005, "", value(positive());
+        /// Stage 3 stops once the indirect estimate holds this many photons (stage 1's included), whatever the error.
+        max_photons: u64 = 1 << 24, "photons", value(at_least(1));
+        /// Stage 3 stops after this many seconds of the whole run (makes the result depend on the machine).
+        time_budget_s: Option<f64> = None, "s", optional(positive());
+        /// A vertex's error is relative to its radiosity, or to this fraction of the scene's area-mean radiosity where that is larger (dark corners would otherwise never converge).
+        relative_floor: f64 = 0.1, "fraction of mean radiosity", value(positive());
+        /// Corners (and filter neighbours) whose normals differ by more than this are not one vertex (do not filter into each other).
+        crease_angle_deg: f64 = 45.0, "degrees", value(0.0..=180.0);
+        /// Largest filter radius; 0 turns filtering off.
+        filter_radius: f64 = 0.2, "fraction of diagonal", value(at_least(0.0));
+        /// Shadow rays per vertex and emitting triangle in the direct pass.
+        visibility_rays: usize = 16, "rays", value(at_least(1));
+        /// Split a leaf when the Stevens brightness at an edge midpoint departs from the mean of its edge's ends by more than this (brightness 1 = the adaptation luminance).
+        brightness_threshold: f64 = 0.02, "brightness", value(positive());
+        /// Exponent of Stevens' power law.
+        stevens_exponent: f64 = 1.0 / 3.0, "", value(positive());
+        /// Splitting passes at most (each splits every leaf over the threshold once).
+        max_splits: u32 = 6, "passes", value;
+        /// Smallest element area.
+        min_area: f64 = 1e-4, "fraction of total area", value(positive());
+        /// Before stage 1, elements are split 1:4 until none is larger than this, so photons have vertices to land on and the splitting criterion samples every surface.
+        initial_area: f64 = 1e-2, "fraction of total area", value(positive());
+        /// Bounces after which a photon is dropped.
+        max_bounces: u32 = 1000, "bounces", value(at_least(1));
     }
 }
 
