@@ -14,9 +14,12 @@
 //!   its Catmull-Rom lookup and flux, irradiance from a luminaire.
 //! - [`texture`]: texture lookups and their exact averages over elements.
 //! - [`camera`]: pinhole camera rays.
-//! - [`color`]: luminance.
+//! - [`color`]: a colour's luminance and largest channel.
 //!
-//! Everything here takes data, not paths, and never prints.
+//! Everything here takes data, not paths, never prints, and knows no
+//! artifact type: the stage kit's `scene` module turns the prepared
+//! scene's artifacts (mesh, camera, lights, textures) into this crate's
+//! data.
 
 pub mod bounds;
 pub mod camera;
