@@ -755,6 +755,17 @@ mod tests {
     }
 
     #[test]
+    fn flags_override_the_params_file_knob_by_knob() {
+        let file = std::env::temp_dir().join(format!("knobs-{}.ron", std::process::id()));
+        std::fs::write(&file, "(leaf_size: 4, seams: false, adaptive: Some((levels: 2)))").unwrap();
+        let path = file.to_str().unwrap();
+        let toy = parse(&["--params", path, "--seams", "--adaptive-lower", "0.5"]).unwrap();
+        std::fs::remove_file(&file).unwrap();
+        let want = Toy { leaf_size: 4, seams: true, adaptive: Some(Adaptive { lower: 0.5, levels: 2 }), ..Toy::default() };
+        assert_eq!(toy, want, "the file's leaf_size and levels kept, the flags' seams and lower over them");
+    }
+
+    #[test]
     fn a_value_out_of_range_is_one_line_naming_the_knob_and_value() {
         let refused = |args: &[&str]| parse(args).unwrap_err();
         assert_eq!(refused(&["--leaf-size", "0"]), "parameters: leaf_size must be in 1..=255, not 0");
