@@ -2,6 +2,7 @@
 //! configuration factors, implemented here from the catalogue's formulas,
 //! independently of the stages' kernels.
 
+use crate::vec3::{cross, dot, sub};
 use std::f64::consts::PI;
 
 /// C-11: between directly opposed parallel rectangles `a x b`, `c` apart.
@@ -41,18 +42,6 @@ pub fn point_to_rectangle(x: f64, y: f64, rect: [f64; 4], c: f64) -> f64 {
     let [x0, x1, y0, y1] = rect;
     let corner = |dx: f64, dy: f64| dx.signum() * dy.signum() * point_to_corner_rectangle(dx.abs(), dy.abs(), c);
     corner(x1 - x, y1 - y) - corner(x0 - x, y1 - y) - corner(x1 - x, y0 - y) + corner(x0 - x, y0 - y)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Lambert's formula: the form factor from a differential area at `point`
@@ -102,6 +91,17 @@ pub fn clip_to_front(polygon: &[[f64; 3]], origin: [f64; 3], normal: [f64; 3]) -
     out
 }
 
+/// The mean of `f` over a triangle: its centroids after `levels` midpoint
+/// subdivisions (4^levels sub-triangles of equal area).
+pub fn mean_over_triangle(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -> f64) -> f64 {
+    if levels == 0 {
+        return f(std::array::from_fn(|a| (c[0][a] + c[1][a] + c[2][a]) / 3.0));
+    }
+    let mid = |i: usize, j: usize| std::array::from_fn::<f64, 3, _>(|a| 0.5 * (c[i][a] + c[j][a]));
+    let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
+    [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]].iter().map(|t| mean_over_triangle(t, levels - 1, f)).sum::<f64>() / 4.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,15 +126,4 @@ mod tests {
         assert_eq!(half.len(), 4);
         assert!((lambert_polygon([0.0; 3], [0.0, 0.0, 1.0], &half) - 0.5 * centre).abs() < 1e-14);
     }
-}
-
-/// The mean of `f` over a triangle: its centroids after `levels` midpoint
-/// subdivisions (4^levels sub-triangles of equal area).
-pub fn mean_over_triangle(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -> f64) -> f64 {
-    if levels == 0 {
-        return f(std::array::from_fn(|a| (c[0][a] + c[1][a] + c[2][a]) / 3.0));
-    }
-    let mid = |i: usize, j: usize| std::array::from_fn::<f64, 3, _>(|a| 0.5 * (c[i][a] + c[j][a]));
-    let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
-    [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]].iter().map(|t| mean_over_triangle(t, levels - 1, f)).sum::<f64>() / 4.0
 }

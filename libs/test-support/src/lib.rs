@@ -20,3 +20,4 @@ pub mod gpu;
 pub mod meshes;
 pub mod metrics;
 pub mod scenes;
+mod vec3;

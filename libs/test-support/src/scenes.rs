@@ -1,6 +1,7 @@
 //! Test scenes written from code: quads with materials, as OBJ + MTL +
 //! scene.ron in a directory.
 
+use crate::vec3::{cross, sub};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -29,14 +30,6 @@ pub struct QuadScene {
     pub lights: Vec<String>,
     /// Names of the materials made two-sided in `scene.ron`.
     pub two_sided: Vec<String>,
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 impl QuadScene {
