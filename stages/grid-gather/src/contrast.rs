@@ -1,6 +1,7 @@
 //! The contrast threshold `c` of the full gather: the smallest visible
-//! contrast (a Weber fraction), from the mask stage's threshold image
-//! (paper 000 Sec. 5.2) or the `contrast` parameter.
+//! contrast (a Weber fraction), from the `contrast` channel of the mask
+//! stage's threshold image (paper 000 Sec. 5.2) or the `contrast`
+//! parameter.
 //!
 //! Where it goes: [`vertex_contrast`] gives each grid vertex its `c`
 //! (recorded in the vertex's diagnostics); a vertex classifies its senders
@@ -14,17 +15,7 @@
 use crate::gather::FullGather;
 use crate::grid::{Grid, Location};
 use glam::DVec3;
-
-/// A per-pixel contrast threshold image (the mask stage's `contrast`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ContrastImage {
-    /// Pixels per row.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// Smallest visible contrast per pixel, row-major.
-    pub contrast: Vec<f32>,
-}
+use schemas::threshold::ThresholdImage;
 
 /// Per grid vertex, the contrast threshold: the mask's contrast averaged
 /// over the pixels whose centre ray hits one of the (up to eight) cells
@@ -32,7 +23,7 @@ pub struct ContrastImage {
 /// adjacent grid cells"); `default` (the `contrast` parameter) where no
 /// mask is given or no pixel sees those cells. `centres` holds each pixel's
 /// centre hit of a `w` x `h` image.
-pub fn vertex_contrast(default: f64, grid: &Grid, centres: &[Option<DVec3>], w: usize, h: usize, threshold: Option<&ContrastImage>) -> Vec<f64> {
+pub fn vertex_contrast(default: f64, grid: &Grid, centres: &[Option<DVec3>], w: usize, h: usize, threshold: Option<&ThresholdImage>) -> Vec<f64> {
     let mut out = vec![default; grid.vertex_count()];
     let Some(t) = threshold else { return out };
     let cells = grid.n[0] * grid.n[1] * grid.n[2];

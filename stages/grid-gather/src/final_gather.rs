@@ -4,7 +4,7 @@
 //! camera rays reach, directly or through mirrors and glass.
 
 use crate::brute::brute_irradiance;
-use crate::contrast::{vertex_contrast, ContrastImage};
+use crate::contrast::vertex_contrast;
 use crate::detail::Detail;
 use crate::diagnostics::{record, Tally, Work};
 use crate::film::{expose, CameraHit, Lens, Sampling, Shader};
@@ -24,6 +24,7 @@ use rayon::prelude::*;
 use schemas::cluster::Clusters;
 use schemas::diagnostics::Diagnostics;
 use schemas::solution::Solution;
+use schemas::threshold::ThresholdImage;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
@@ -40,7 +41,7 @@ pub struct FullScene<'a> {
     /// The cluster hierarchy, if the solution was clustered.
     pub clusters: Option<&'a Clusters>,
     /// The mask's threshold, if given.
-    pub threshold: Option<&'a ContrastImage>,
+    pub threshold: Option<&'a ThresholdImage>,
     /// The camera.
     pub camera: &'a Pinhole,
     /// Surface detail (textures, alpha masks, normal maps), where the scene

@@ -33,30 +33,8 @@
 //!
 //! ## Parameters
 //!
-//! | name | type | meaning | default |
-//! |---|---|---|---|
-//! | `mode` | `"preview"` / `"full"` | gather mode | `"preview"` |
-//! | `width`, `height` | pixels | image size | the manifest camera's |
-//! | `spp` | count | camera rays per pixel (stratified, jittered) | 4 |
-//! | `seed` | u64 | seed of the per-pixel random streams | 0 |
-//! | `crease_angle_deg` | degrees | leaves whose normals differ more do not blend at a shared corner; a pixel whose hits differ more is an edge in the surface layer | 30 |
-//! | `weld_tolerance` | fraction of the bounding-box diagonal | corners closer than this are one point | 1e-7 |
-//! | `material_seams` | bool | leaves of different materials do not blend at a shared corner | true |
-//! | `grid` | `"perspective"` / `"regular"` | full: grid uniform in post-perspective space, or cubes | `"perspective"` |
-//! | `grid_pixels` | pixels | full: grid spacing on screen | 16 |
-//! | `grid_depth` | count | full: cells along the view axis (perspective) | 16 |
-//! | `samples` | count | full: N of Eq. 1, classification samples shared by a vertex's senders | 128 |
-//! | `min_samples` | count | full: fewest samples per sender (classification and shadows) | 4 |
-//! | `max_shadow_samples` | count | full: most visibility samples per resampled sender | 128 |
-//! | `contrast` | fraction | full: smallest visible contrast where no mask is given; a sender is resampled when its error exceeds `contrast x` the vertex's radiosity | 0.02 |
-//! | `allowed_hits` | 1 or 2 | full: hits a classification ray may cross unblocked (1: double-sided sheets, 2: single-sided solids; Fig. 2) | 1 |
-//! | `interior_rays` | count | full: rays from a vertex inside a sender cluster | 100 |
-//! | `surface_gather` | bool | full: surface-based gather where leaves are finer than the grid (Sec. 4.5) | true |
-//! | `leaf_check_rays` | count | full: rays a leaf of the surface-based gather casts to check each link the solver called fully visible or occluded whose error would not fit the threshold; 0 trusts the solver | 8 |
-//! | `view_dependent` | bool | full: shadow samples bounded by penumbra size and contrast (Sec. 5.3) | true |
-//! | `brute_samples` | count | brute: visibility rays per link per camera sample | 64 |
-//! | `specular_depth` | count | most mirror reflections and glass passages along a camera ray ([`specular`]) | 8 |
-//! | `specular_min_weight` | fraction | a ray through mirrors and glass stops when its largest channel weight (product of `rho_s`, `tau_s`) falls under this | 1e-3 |
+//! [`Params`], declared once with the stage kit's `knobs!`: `grid-gather
+//! --print-knobs` prints their table (the README's "Stage knobs").
 //!
 //! Same inputs and parameters give bit-identical images, whatever the
 //! number of threads.
@@ -86,6 +64,7 @@ use radiometry::rays::SceneRays;
 use schemas::diagnostics::Diagnostics;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
+use stage_kit::knobs::Knobs;
 use stage_kit::run::bad_parameter;
 use schemas::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -163,134 +142,67 @@ impl TryFrom<String> for GridKind {
     }
 }
 
-/// The stage's parameters (`--params file.ron`, overridden by flags).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Gather mode.
-    pub mode: Mode,
-    /// Image width in pixels; `None`: the manifest camera's.
-    pub width: Option<u32>,
-    /// Image height in pixels; `None`: the manifest camera's.
-    pub height: Option<u32>,
-    /// Camera rays per pixel, at least 1.
-    pub spp: u32,
-    /// Seed of the per-pixel random streams.
-    pub seed: u64,
-    /// Crease angle, degrees in [0, 180]: leaves meeting at a corner blend
-    /// only if their normals differ by at most this.
-    pub crease_angle_deg: f64,
-    /// Corner weld tolerance, as a fraction of the scene's bounding-box
-    /// diagonal, in (0, 1e-3].
-    pub weld_tolerance: f64,
-    /// Leaves of different materials do not blend at a shared corner (B
-    /// jumps where emission or reflectance does, even on a flat surface).
-    pub material_seams: bool,
-    /// Full: the grid's kind.
-    pub grid: GridKind,
-    /// Full: grid spacing on screen, pixels, at least 1.
-    pub grid_pixels: u32,
-    /// Full: cells along the view axis (perspective grid), at least 1.
-    pub grid_depth: u32,
-    /// Full: N of 000 Eq. 1, the classification samples a vertex shares
-    /// among its senders in proportion to their unoccluded irradiance.
-    pub samples: u32,
-    /// Full: fewest samples per sender, at least 1.
-    pub min_samples: u32,
-    /// Full: most visibility samples per resampled sender.
-    pub max_shadow_samples: u32,
-    /// Full: smallest visible contrast (a Weber fraction) where no mask
-    /// threshold is given, in (0, 1].
-    pub contrast: f64,
-    /// Full: surfaces a classification ray may cross and still count as
-    /// unblocked: 1 for double-sided sheets, 2 for single-sided solids
-    /// (000 Fig. 2).
-    pub allowed_hits: u32,
-    /// Full: rays from a vertex inside a sender cluster (000 Sec. 4.3).
-    pub interior_rays: u32,
-    /// Full: surface-based gather where leaves are finer than the grid.
-    pub surface_gather: bool,
-    /// Full: rays per checked link and leaf in the surface-based gather (0:
-    /// trust the solver's fully visible and fully occluded links).
-    pub leaf_check_rays: u32,
-    /// Full: view-dependent shadow sample counts (000 Sec. 5.3).
-    pub view_dependent: bool,
-    /// Brute: visibility rays per link per camera sample, at least 1.
-    pub brute_samples: u32,
-    /// Most specular events (mirror reflections, glass passages) along a
-    /// camera ray.
-    pub specular_depth: u32,
-    /// A branch through mirrors and glass stops when its largest channel
-    /// weight falls under this, in [0, 1].
-    pub specular_min_weight: f64,
-}
+stage_kit::show_by_name!(Mode, GridKind);
 
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            mode: Mode::Preview,
-            width: None,
-            height: None,
-            spp: 4,
-            seed: 0,
-            crease_angle_deg: 30.0,
-            weld_tolerance: 1e-7,
-            material_seams: true,
-            grid: GridKind::Perspective,
-            grid_pixels: 16,
-            grid_depth: 16,
-            samples: 128,
-            min_samples: 4,
-            max_shadow_samples: 128,
-            contrast: 0.02,
-            allowed_hits: 1,
-            interior_rays: 100,
-            surface_gather: true,
-            leaf_check_rays: 8,
-            view_dependent: true,
-            brute_samples: 64,
-            specular_depth: 8,
-            specular_min_weight: 1e-3,
-        }
+stage_kit::knobs! {
+    /// The stage's parameters (`--params file.ron`, overridden by flags).
+    pub struct Params {
+        /// Gather mode: preview interpolates the solution; full classifies and resamples critical senders (paper 000); brute resamples every link.
+        mode: Mode = Mode::Preview, "", value;
+        /// Image width; none: the manifest camera's.
+        width: Option<u32> = None, "pixels", optional(1..=MAX_SIDE);
+        /// Image height; none: the manifest camera's.
+        height: Option<u32> = None, "pixels", optional(1..=MAX_SIDE);
+        /// Camera rays per pixel, stratified and jittered.
+        spp: u32 = 4, "", value(at_least(1));
+        /// Seed of the per-pixel random streams.
+        seed: u64 = 0, "", value;
+        /// Leaves whose normals differ by more than this do not blend at a shared corner; a pixel whose hits differ more is an edge in the surface layer.
+        crease_angle_deg: f64 = 30.0, "degrees", value(0.0..=180.0);
+        /// Corners closer than this fraction of the scene's bounding-box diagonal (per coordinate) are one point.
+        weld_tolerance: f64 = 1e-7, "", value(left_open(0.0, 1e-3));
+        /// Leaves of different materials do not blend at a shared corner (B jumps where emission or reflectance does, even on a flat surface).
+        material_seams: bool = true, "", switch;
+        /// Full: the grid, uniform in post-perspective space or cubes (000 Sec. 4.2).
+        grid: GridKind = GridKind::Perspective, "", value;
+        /// Full: grid spacing on screen.
+        grid_pixels: u32 = 16, "pixels", value(at_least(1));
+        /// Full: cells along the view axis (perspective grid).
+        grid_depth: u32 = 16, "", value(1..=4096);
+        /// Full: N of 000 Eq. 1, the classification samples a vertex shares among its senders in proportion to their unoccluded irradiance.
+        samples: u32 = 128, "", value;
+        /// Full: fewest samples per sender (classification and shadows).
+        min_samples: u32 = 4, "", value(at_least(1));
+        /// Full: most visibility samples per resampled sender, at least min_samples.
+        max_shadow_samples: u32 = 128, "", value;
+        /// Full: smallest visible contrast (a Weber fraction) where no mask is given; a sender is resampled when its error exceeds contrast x the vertex's radiosity.
+        contrast: f64 = 0.02, "", value(left_open(0.0, 1.0));
+        /// Full: surfaces a classification ray may cross and still count as unblocked: 1 for double-sided sheets, 2 for single-sided solids (000 Fig. 2).
+        allowed_hits: u32 = 1, "", value(1..=2);
+        /// Full: rays from a vertex inside a sender cluster (000 Sec. 4.3).
+        interior_rays: u32 = 100, "", value;
+        /// Full: surface-based gather where leaves are finer than the grid (000 Sec. 4.5).
+        surface_gather: bool = true, "", switch;
+        /// Full: rays a leaf of the surface-based gather casts to check each link the solver called fully visible or occluded whose error would not fit the threshold; 0 trusts the solver.
+        leaf_check_rays: u32 = 8, "", value;
+        /// Full: shadow samples bounded by penumbra size and contrast (000 Sec. 5.3); off: Eq. 1's count.
+        view_dependent: bool = true, "", switch;
+        /// Brute: visibility rays per link per camera sample.
+        brute_samples: u32 = 64, "", value(at_least(1));
+        /// Most mirror reflections and glass passages along a camera ray.
+        specular_depth: u32 = 8, "", value(0..=64);
+        /// A ray through mirrors and glass stops when its largest channel weight (product of rho_s, tau_s) falls under this.
+        specular_min_weight: f64 = 1e-3, "", value(0.0..=1.0);
     }
 }
 
 impl Params {
-    /// Checks every value's range; the error names the parameter.
+    /// Checks every knob's range, and that `max_shadow_samples` is at
+    /// least `min_samples`; the error names the parameter.
     pub fn validate(&self) -> Result<()> {
-        if self.spp == 0 {
-            return Err(bad_parameter("spp must be at least 1"));
-        }
-        // The whole size (with the camera's for a side not given) is
-        // checked by `gather_with`.
-        for (name, side) in [("width", self.width), ("height", self.height)] {
-            if let Some(side) = side {
-                check_side(name, side).map_err(bad_parameter)?;
-            }
-        }
-        if !(0.0..=180.0).contains(&self.crease_angle_deg) {
-            return Err(bad_parameter(format!("crease_angle_deg must be in [0, 180], got {}", self.crease_angle_deg)));
-        }
-        if !(self.weld_tolerance > 0.0 && self.weld_tolerance <= 1e-3) {
-            return Err(bad_parameter(format!("weld_tolerance must be in (0, 1e-3], got {}", self.weld_tolerance)));
-        }
-        if self.grid_pixels == 0 || self.grid_depth == 0 || self.grid_depth > 4096 {
-            return Err(bad_parameter("grid_pixels must be at least 1 and grid_depth in 1..=4096"));
-        }
-        if self.min_samples == 0 || self.brute_samples == 0 || self.max_shadow_samples < self.min_samples {
-            return Err(bad_parameter("min_samples and brute_samples must be at least 1, max_shadow_samples at least min_samples"));
-        }
-        if !(self.contrast > 0.0 && self.contrast <= 1.0) {
-            return Err(bad_parameter(format!("contrast must be in (0, 1], got {}", self.contrast)));
-        }
-        if !(0.0..=1.0).contains(&self.specular_min_weight) {
-            return Err(bad_parameter(format!("specular_min_weight must be in [0, 1], got {}", self.specular_min_weight)));
-        }
-        if self.specular_depth > 64 {
-            return Err(bad_parameter(format!("specular_depth must be at most 64, got {}", self.specular_depth)));
-        }
-        if !(1..=2).contains(&self.allowed_hits) {
-            return Err(bad_parameter(format!("allowed_hits must be 1 or 2, got {}", self.allowed_hits)));
+        self.check("")?;
+        if self.max_shadow_samples < self.min_samples {
+            return Err(bad_parameter(format!("max_shadow_samples must be at least min_samples ({}), not {}", self.min_samples, self.max_shadow_samples)));
         }
         Ok(())
     }
@@ -302,8 +214,8 @@ impl Params {
 pub struct Extras<'a> {
     /// The cluster hierarchy the solution was solved with.
     pub clusters: Option<&'a schemas::cluster::Clusters>,
-    /// The mask stage's contrast threshold per pixel.
-    pub threshold: Option<&'a contrast::ContrastImage>,
+    /// The mask stage's threshold image (its `contrast` per pixel).
+    pub threshold: Option<&'a schemas::threshold::ThresholdImage>,
     /// Surface detail (textures, alpha masks, normal maps) from mesh-prep's
     /// surface artifact, for a scene that has some.
     pub detail: Option<&'a detail::Detail<'a>>,
@@ -531,6 +443,20 @@ pub fn skipped(manifest: &Manifest, mode: Mode, detail: bool) -> Vec<String> {
     ];
     skipped.extend(present.into_iter().filter(|(on, _)| *on).map(|(_, why)| why));
     skipped
+}
+
+/// A warning when more than 1% of the camera's hits (the report's
+/// `counters`) are back faces, which show black: the camera sits outside a
+/// wall, or thin surfaces (leaves, paper) are one-sided where they should
+/// be two-sided.
+pub fn back_face_warning(counters: &BTreeMap<String, f64>) -> Option<String> {
+    let (hits, back) = (counters.get("ray_hits")?, counters.get("back_face_hits")?);
+    (*back > 0.01 * hits).then(|| {
+        format!(
+            "{:.1}% of the camera's hits are back faces, shown black: a camera outside a wall, or thin surfaces (leaves, paper) that need `two_sided: Some(true)` in the scene's material overrides",
+            100.0 * back / hits
+        )
+    })
 }
 
 #[cfg(test)]
