@@ -46,14 +46,14 @@ fn rect(x0: f64, x1: f64, z0: f64, z1: f64, y: f64) -> Vec<DVec3> {
     vec![DVec3::new(x0, y, z0), DVec3::new(x1, y, z0), DVec3::new(x1, y, z1), DVec3::new(x0, y, z1)]
 }
 
-/// A quad of `testing::quads` for the rectangle `[x0, x1] x [z0, z1]` at
-/// height `y`, facing up or down.
-fn horizontal(x0: f64, x1: f64, z0: f64, z1: f64, y: f64, up: bool, material: u32, object: u32) -> (DVec3, DVec3, DVec3, u32, u32) {
+/// A quad of `meshes::quads` for the rectangle `[x0, x1] x [z0, z1]` at
+/// height `y`, facing up or down, of material and object `id`.
+fn horizontal([x0, x1]: [f64; 2], [z0, z1]: [f64; 2], y: f64, up: bool, id: u32) -> (DVec3, DVec3, DVec3, u32, u32) {
     let (u, v) = (DVec3::Z * (z1 - z0), DVec3::X * (x1 - x0));
     if up {
-        (DVec3::new(x0, y, z0), u, v, material, object)
+        (DVec3::new(x0, y, z0), u, v, id, id)
     } else {
-        (DVec3::new(x0, y, z0), v, u, material, object)
+        (DVec3::new(x0, y, z0), v, u, id, id)
     }
 }
 
@@ -124,9 +124,9 @@ const LAMP_Y: f64 = 0.6;
 #[test]
 fn a_mirror_wall_adds_rho_s_times_the_lamps_image_through_its_window() {
     let mesh = quads(&[
-        horizontal(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0),
+        horizontal([0.0, 1.0], [0.0, 1.0], 0.0, true, 0),
         (DVec3::ZERO, DVec3::Y * WALL_TOP, DVec3::Z, 1, 1),
-        horizontal(0.2, 0.4, 0.4, 0.6, LAMP_Y, false, 2, 2),
+        horizontal([0.2, 0.4], [0.4, 0.6], LAMP_Y, false, 2),
     ]);
     let m = with_effects(manifest(3, vec![material([RHO_FLOOR; 3], [0.0; 3]), mirror(RHO_S), material([0.0; 3], [E; 3])]));
     let params = Params { min_size: 32, max_size: 32, shoot_level: 1, max_shots: 2, convergence_target: 1.0, resolution: 256, ..Params::default() };
@@ -164,9 +164,9 @@ fn a_mirror_wall_adds_rho_s_times_the_lamps_image_through_its_window() {
 /// `[0.25, 0.75]^2` at height 1 facing down (triangles 4, 5).
 fn pane_scene(tau_s: f64) -> (Mesh, Manifest) {
     let mesh = quads(&[
-        horizontal(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0),
-        horizontal(-0.5, 1.5, -0.5, 1.5, 0.5, true, 1, 1),
-        horizontal(0.25, 0.75, 0.25, 0.75, 1.0, false, 2, 2),
+        horizontal([0.0, 1.0], [0.0, 1.0], 0.0, true, 0),
+        horizontal([-0.5, 1.5], [-0.5, 1.5], 0.5, true, 1),
+        horizontal([0.25, 0.75], [0.25, 0.75], 1.0, false, 2),
     ]);
     let glass = if tau_s > 0.0 { pane(tau_s) } else { material([0.0; 3], [0.0; 3]) };
     (mesh, with_effects(manifest(3, vec![material([RHO_FLOOR; 3], [0.0; 3]), glass, material([0.0; 3], [E; 3])])))
@@ -202,13 +202,13 @@ fn a_thin_pane_transmits_tau_s_of_the_unoccluded_light_and_an_opaque_one_nothing
 /// `[0.5, 0.8] x [0.2, 0.8]` at height 0.45 facing down (8, 9).
 fn corridor(occluder: bool) -> (Mesh, Manifest) {
     let mut q = vec![
-        horizontal(0.0, 1.0, 0.0, 1.0, 0.0, true, 0, 0),
+        horizontal([0.0, 1.0], [0.0, 1.0], 0.0, true, 0),
         (DVec3::ZERO, DVec3::Y, DVec3::Z, 1, 1),
         (DVec3::X, DVec3::Z, DVec3::Y, 1, 1),
-        horizontal(0.3, 0.5, 0.4, 0.6, 0.9, false, 2, 2),
+        horizontal([0.3, 0.5], [0.4, 0.6], 0.9, false, 2),
     ];
     if occluder {
-        q.push(horizontal(OCCLUDER[0], OCCLUDER[1], 0.2, 0.8, OCCLUDER[2], false, 3, 3));
+        q.push(horizontal([OCCLUDER[0], OCCLUDER[1]], [0.2, 0.8], OCCLUDER[2], false, 3));
     }
     let materials = vec![material([RHO_FLOOR; 3], [0.0; 3]), mirror(RHO_S), material([0.0; 3], [E; 3]), material([0.0; 3], [0.0; 3])];
     (quads(&q), with_effects(manifest(4, materials)))
@@ -381,3 +381,46 @@ fn a_closed_box_with_a_mirror_wall_balances_energy() {
     assert!(error.abs() < 0.01, "absorbed / emitted - 1 = {error}");
 }
 
+
+/// A goniometric point light (a table that varies with C and gamma) at
+/// (0.3, 0.6, 0.35), nadir down, above the floor of the mirror-wall scene:
+/// its image is mirrored with its frame, so the table is read in the
+/// light's own angles. Every floor texel gets `I(d) cos / r^2` from the
+/// light and `rho_s I(R d') cos' / r'^2` from its image `S'` where the ray
+/// to `S'` crosses the wall inside it (`R` the mirror, `I` radiometry's
+/// lookup), within 1%.
+#[test]
+fn a_mirrored_goniometric_light_reads_its_table_in_its_own_angles() {
+    let mesh = quads(&[horizontal([0.0, 1.0], [0.0, 1.0], 0.0, true, 0), (DVec3::ZERO, DVec3::Y * WALL_TOP, DVec3::Z, 1, 1)]);
+    let m = with_effects(manifest(2, vec![material([RHO_FLOOR; 3], [0.0; 3]), mirror(RHO_S)]));
+    let (c, gamma) = (vec![0.0, 90.0, 180.0, 270.0], vec![0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0]);
+    let intensity: Vec<f64> = c.iter().flat_map(|&c: &f64| gamma.iter().map(move |&g: &f64| (100.0 + 60.0 * c.to_radians().cos()) * (1.0 + g.to_radians().cos()) / 2.0)).collect();
+    let table = radiometry::photometry::Distribution::new(c, gamma, intensity).unwrap();
+    let position = DVec3::new(0.3, 0.6, 0.35);
+    let light = gpu_shoot::Luminaire::new(table, position, -DVec3::Y, DVec3::X, 1.0).unwrap();
+    let params = Params { min_size: 32, max_size: 32, max_shots: 1, convergence_target: 1.0, resolution: 256, ..Params::default() };
+    let Some((device, queue)) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire) else { return };
+    let solved = solve(&device, &queue, &mesh, &m, None, std::slice::from_ref(&light), &params, &mut |_| {}).unwrap();
+    let image = mirror_x(position, 0.0);
+    let (mut worst, mut through, mut over_5) = (0.0f64, 0, 0);
+    for (p, _, h) in floor_irradiance(&solved, &[0, 1]) {
+        let d = image - p;
+        // Where the ray to the image crosses the wall (x = 0).
+        let at = p + d * (p.x / (p.x - image.x));
+        let mirrored = if at.y <= WALL_TOP && (0.0..=1.0).contains(&at.z) {
+            let out = (p - image).normalize();
+            through += 1;
+            RHO_S * light.intensity(DVec3::new(-out.x, out.y, out.z)) * d.y / d.length().powi(3)
+        } else {
+            0.0
+        };
+        let reference = light.irradiance(p, DVec3::Y) + mirrored;
+        if mirrored > 0.05 * reference {
+            over_5 += 1;
+        }
+        worst = worst.max((h / reference - 1.0).abs());
+    }
+    eprintln!("mirrored light: worst floor texel {worst:.5} ({through} texels see the image, {over_5} get over 5% from it)");
+    assert!(through > 300 && over_5 > 300, "{through} see the image, {over_5} over 5%");
+    assert!(worst < 0.01, "worst floor texel {worst}");
+}
