@@ -330,6 +330,18 @@ pub struct GpuView {
     pub axis: [f32; 4],
 }
 
+/// A node of the reflection tree as the GPU reads it.
+pub struct NodeData<'a> {
+    /// Its plane and first layer (the window range is filled in).
+    pub level: GpuLevel,
+    /// Its window entries: rgb the coefficient, w the triangle's bits.
+    pub windows: &'a [[f32; 4]],
+    /// Its virtual samples, one per sample of the batch.
+    pub samples: &'a [GpuSample],
+    /// Their frustums.
+    pub views: &'a [GpuView],
+}
+
 /// The reflection tree's buffers and passes on the device.
 struct Mirrors {
     levels: wgpu::Buffer,
@@ -339,7 +351,6 @@ struct Mirrors {
     specular: Vec<u32>,
     windows_per_level: usize,
     render: wgpu::RenderPipeline,
-    receive: Vec<wgpu::ComputePipeline>,
     mark: wgpu::ComputePipeline,
 }
 
@@ -416,6 +427,8 @@ impl Gpu {
             let tree = include_str!("shaders/mirrors_common.wgsl");
             solver_source += &format!("\n{tree}\n{}", include_str!("shaders/mirrors.wgsl"));
             render_source += &format!("\n{tree}\n{}", include_str!("shaders/visibility_mirrors.wgsl"));
+        } else {
+            solver_source += &format!("\n{}", include_str!("shaders/gather.wgsl"));
         }
         let solver_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("solver.wgsl"),
@@ -558,7 +571,6 @@ impl Gpu {
             specular: m.specular.to_vec(),
             windows_per_level: m.windows_per_level.max(1),
             render: render_pipeline("vs_virtual", "fs_virtual"),
-            receive: if transmission.is_some() { vec![pipeline("receive_mirrored_translucent"), pipeline("transmit")] } else { vec![pipeline("receive_mirrored")] },
             mark: pipeline("mark_specular"),
         });
         Gpu {
@@ -630,9 +642,14 @@ impl Gpu {
     /// Renders the visibility maps of one batch of samples and runs the
     /// receiver pass over every texel.
     pub fn shoot_batch(&self, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, hemicube: bool) {
+        self.batch(device, queue, params, hemicube, self.receiver_passes());
+    }
+
+    /// The receiver pass, or with diffuse transmission its two passes.
+    fn receiver_passes(&self) -> &[wgpu::ComputePipeline] {
         match &self.transmit {
-            Some(passes) => self.batch(device, queue, params, hemicube, passes),
-            None => self.batch(device, queue, params, hemicube, std::slice::from_ref(&self.receive)),
+            Some(passes) => passes,
+            None => std::slice::from_ref(&self.receive),
         }
     }
 
@@ -721,18 +738,17 @@ impl Gpu {
     }
 
     /// Writes node `level` (0-based) of the branch: its plane and layers,
-    /// its window entries (rgb coefficient, triangle bits), and its
-    /// virtual samples (at `virtual_base + level count + i`) with their
-    /// frustums.
-    pub fn write_node(&self, queue: &wgpu::Queue, level: u32, virtual_base: u32, node: GpuLevel, windows: &[[f32; 4]], samples: &[GpuSample], views: &[GpuView]) {
+    /// its window entries, and its virtual samples (at `virtual_base +
+    /// level count + i`) with their frustums.
+    pub fn write_node(&self, queue: &wgpu::Queue, level: u32, virtual_base: u32, node: &NodeData) {
         let tree = self.tree();
         let first = level as usize * tree.windows_per_level;
-        let node = GpuLevel { window: [first as u32, windows.len() as u32, node.window[2], 0], ..node };
-        queue.write_buffer(&tree.levels, level as u64 * std::mem::size_of::<GpuLevel>() as u64, bytemuck::bytes_of(&node));
-        queue.write_buffer(&tree.windows, first as u64 * 16, bytemuck::cast_slice(windows));
-        let count = samples.len() as u64;
-        queue.write_buffer(&self.samples, (virtual_base as u64 + level as u64 * count) * SAMPLE_SIZE, bytemuck::cast_slice(samples));
-        queue.write_buffer(&tree.views, level as u64 * count * std::mem::size_of::<GpuView>() as u64, bytemuck::cast_slice(views));
+        let plane = GpuLevel { window: [first as u32, node.windows.len() as u32, node.level.window[2], 0], ..node.level };
+        queue.write_buffer(&tree.levels, level as u64 * std::mem::size_of::<GpuLevel>() as u64, bytemuck::bytes_of(&plane));
+        queue.write_buffer(&tree.windows, first as u64 * 16, bytemuck::cast_slice(node.windows));
+        let count = node.samples.len() as u64;
+        queue.write_buffer(&self.samples, (virtual_base as u64 + level as u64 * count) * SAMPLE_SIZE, bytemuck::cast_slice(node.samples));
+        queue.write_buffer(&tree.views, level as u64 * count * std::mem::size_of::<GpuView>() as u64, bytemuck::cast_slice(node.views));
     }
 
     /// Renders the frustum maps of the node at `params.level` (its
@@ -745,7 +761,7 @@ impl Gpu {
         for i in 0..params.sample_count {
             self.render_layer(&mut encoder, &tree.render, first_layer + i, i, false);
         }
-        self.dispatch_texels(&mut encoder, &tree.receive);
+        self.dispatch_texels(&mut encoder, self.receiver_passes());
         queue.submit([encoder.finish()]);
     }
 

@@ -39,7 +39,7 @@
 //! (masked surfaces are opaque there), and curved mirrors, which are their
 //! facets (each facet's plane its own node).
 
-use crate::gpu::{Gpu, GpuLevel, GpuParams, GpuSample, GpuView};
+use crate::gpu::{Gpu, GpuLevel, GpuParams, GpuSample, GpuView, NodeData};
 use glam::DVec3;
 use radiometry::geometry::frame_with_normal;
 use schemas::mesh::{Manifest, Mesh};
@@ -316,7 +316,9 @@ impl Tree<'_> {
             work.bound += bound;
             work.layers += count as u64;
             let first_layer = count * (params.layers_per_sample + level);
-            gpu.write_node(queue, level, self.virtual_base, self::level(&window, first_layer), &window.entries(), &samples, &views);
+            let entries = window.entries();
+            let data = NodeData { level: self::level(&window, first_layer), windows: &entries, samples: &samples, views: &views };
+            gpu.write_node(queue, level, self.virtual_base, &data);
             let node = GpuParams { level: level + 1, ..*params };
             gpu.shoot_node(device, queue, &node, first_layer);
             let lit = gpu.lit_specular(device, queue, &node);

@@ -142,32 +142,12 @@ fn irradiance_mirrored(k: u32) -> vec3<f32> {
     return h;
 }
 
-// The irradiance of the pass: the real samples' at level 0, the node's
-// virtual samples' below.
-fn irradiance_of_level(k: u32) -> vec3<f32> {
+// The irradiance of a receiver pass (receive, receive_translucent): the
+// real samples' at level 0, the node's virtual samples' below (Eq.
+// 4.7-4.8: rho_d H into the radiosity and the residual, as for any shot).
+fn gathered(k: u32) -> vec3<f32> {
     if (params.level == 0u) { return irradiance(k); }
     return irradiance_mirrored(k);
-}
-
-// The receiver pass of a node (Eq. 4.7-4.8): rho_d H into the radiosity
-// and the residual, as `receive` does.
-@compute @workgroup_size(64)
-fn receive_mirrored(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
-    let k = id.x + id.y * nw.x * 64u;
-    if (k >= params.n_texels || !receives(k)) { return; }
-    let db = texels[k].rho.xyz * irradiance_mirrored(k);
-    radiosity[k] += vec4<f32>(db, 0.0);
-    residual[k] += vec4<f32>(db, 0.0);
-}
-
-// With diffuse transmission: H of every texel for `transmit`.
-@compute @workgroup_size(64)
-fn receive_mirrored_translucent(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
-    let k = id.x + id.y * nw.x * 64u;
-    if (k >= params.n_texels) { return; }
-    var h = vec3<f32>(0.0);
-    if (receives(k)) { h = irradiance_mirrored(k); }
-    received[k] = vec4<f32>(h, 0.0);
 }
 
 // The specular triangles the pass lit (004 Sec. 4.3.2: "if specular
@@ -179,5 +159,5 @@ fn mark_specular(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_work
     if (k >= params.n_texels || !receives(k)) { return; }
     let t = bitcast<u32>(texels[k].normal.w);
     if ((atomicLoad(&hits[t]) & 1u) == 0u) { return; }
-    if (any(irradiance_of_level(k) > vec3<f32>(0.0))) { atomicOr(&hits[t], 2u); }
+    if (any(gathered(k) > vec3<f32>(0.0))) { atomicOr(&hits[t], 2u); }
 }

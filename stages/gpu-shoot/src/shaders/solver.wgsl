@@ -542,6 +542,8 @@ fn receives(k: u32) -> bool {
 
 // The receiver pass (004 Sec. 2.3, Eq. 2.2 / 4.1-4.3): every covered texel
 // tests its depth against each sample's visibility map and gathers
+// (`gathered`: gather.wgsl's `irradiance`, or with specular materials
+// mirrors.wgsl's, which also gathers a reflection-tree node's samples)
 //   area sample:  H += dB_s A_s cos_s cos_r / (pi d^2 + A_s)
 //   point light:  H += I_max LDT(C, gamma) cos_r / d^2      (Eq. 3.4)
 // then adds rho H to both its radiosity and its residual.
@@ -549,7 +551,7 @@ fn receives(k: u32) -> bool {
 fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) nw: vec3<u32>) {
     let k = id.x + id.y * nw.x * 64u;
     if (k >= params.n_texels || !receives(k)) { return; }
-    let db = texels[k].rho.xyz * irradiance(k);
+    let db = texels[k].rho.xyz * gathered(k);
     radiosity[k] += vec4<f32>(db, 0.0);
     residual[k] += vec4<f32>(db, 0.0);
 }
@@ -638,7 +640,7 @@ fn receive_translucent(@builtin(global_invocation_id) id: vec3<u32>, @builtin(nu
     let k = id.x + id.y * nw.x * 64u;
     if (k >= params.n_texels) { return; }
     var h = vec3<f32>(0.0);
-    if (receives(k)) { h = irradiance(k); }
+    if (receives(k)) { h = gathered(k); }
     received[k] = vec4<f32>(h, 0.0);
 }
 

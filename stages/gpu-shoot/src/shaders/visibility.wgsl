@@ -51,16 +51,19 @@ fn vs(@builtin(vertex_index) vi: u32, @builtin(instance_index) layer: u32) -> Ve
         let z = (f.z - params.near) * params.far / (params.far - params.near);
         out.clip = vec4<f32>(f.x, f.y, z, f.z);
     }
-    // A triangle with a twin (w = 2: a two-sided surface's other face,
-    // over the same corners) shows only its front: seen from behind, the
-    // twin's front is there at the same depth, and the two would z-fight.
-    let t = vi / 3u;
-    if (vertices[3u * t].w > 1.5) {
-        let p0 = vertices[3u * t].xyz;
-        let front = cross(vertices[3u * t + 1u].xyz - p0, vertices[3u * t + 2u].xyz - p0);
-        if (dot(s.position.xyz - p0, front) <= 0.0) { out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0); }
-    }
+    if (hidden_twin(vi / 3u, s.position.xyz)) { out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0); }
     return out;
+}
+
+// Whether triangle t has a twin (w = 2: a two-sided surface's other face,
+// over the same corners) and `eye` sees its back: it shows only its front,
+// for seen from behind the twin's front is there at the same depth, and
+// the two would z-fight.
+fn hidden_twin(t: u32, eye: vec3<f32>) -> bool {
+    if (vertices[3u * t].w <= 1.5) { return false; }
+    let p0 = vertices[3u * t].xyz;
+    let front = cross(vertices[3u * t + 1u].xyz - p0, vertices[3u * t + 2u].xyz - p0);
+    return dot(eye - p0, front) <= 0.0;
 }
 
 fn distance_of(in: VertexOut) -> vec4<f32> {

@@ -29,13 +29,7 @@ fn vs_virtual(@builtin(vertex_index) vi: u32, @builtin(instance_index) i: u32) -
     out.beyond = dot(levels[l].plane.xyz, x) + levels[l].plane.w;
     let z = (out.local.z - params.near) * params.far / (params.far - params.near);
     out.clip = vec4<f32>(out.local.x, out.local.y, z, out.local.z);
-    // A two-sided surface's face seen from behind (as in vs).
-    let t = vi / 3u;
-    if (vertices[3u * t].w > 1.5) {
-        let p0 = vertices[3u * t].xyz;
-        let front = cross(vertices[3u * t + 1u].xyz - p0, vertices[3u * t + 2u].xyz - p0);
-        if (dot(s.position.xyz - p0, front) <= 0.0) { out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0); }
-    }
+    if (hidden_twin(vi / 3u, s.position.xyz)) { out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0); }
     return out;
 }
 
