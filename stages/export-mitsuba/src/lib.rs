@@ -35,15 +35,8 @@
 //! film x grows to the right and film y downwards, row 0 at the top, as in
 //! `radiometry::camera::Pinhole`, so the image is not mirrored.
 //!
-//! Parameters (`--params`, flags override):
-//!
-//! | parameter | meaning | default |
-//! |---|---|---|
-//! | `spp` | samples per pixel, the scene's `$spp` default | 64 |
-//! | `max_depth` | path length of the `path` integrator, -1 unbounded | -1 |
-//! | `sampler` | Mitsuba sampler plugin (`independent`, `stratified`, `multijitter`, `orthogonal`, `ldsampler`) | `multijitter` |
-//! | `seed` | the sampler's seed | 0 |
-//! | `width`, `height` | film size, pixels | the manifest camera's |
+//! Parameters: [`Params`] (`--params`, flags override; the table is
+//! `export-mitsuba --print-knobs`, in the README's "Stage knobs").
 //!
 //! ```no_run
 //! use std::path::Path;
@@ -55,58 +48,49 @@
 //! assert_eq!(export.meshes.iter().map(|m| m.triangles).sum::<usize>(), mesh.triangles.len());
 //! ```
 
+pub mod files;
 pub mod ply;
 pub mod xml;
 
 use radiometry::color::max_channel;
 use schemas::mesh::{Manifest, Material, Mesh, MeshStatistics};
-use serde::{Deserialize, Serialize};
+use stage_kit::knobs::{Check, Describe};
 use std::fmt::Write as _;
 use xml::{attribute, comment};
 
 /// The sampler plugins of Mitsuba 3 that take `sample_count` and `seed`.
 pub const SAMPLERS: &[&str] = &["independent", "stratified", "multijitter", "orthogonal", "ldsampler"];
 
-/// The exporter's parameters (see the table in the crate documentation).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Samples per pixel (the scene's `spp` default), at least 1.
-    pub spp: u32,
-    /// Longest path of the `path` integrator; -1: unbounded.
-    pub max_depth: i32,
-    /// Mitsuba sampler plugin, one of [`SAMPLERS`].
-    pub sampler: String,
-    /// The sampler's seed.
-    pub seed: u32,
-    /// Film width in pixels; `None`: the manifest camera's.
-    pub width: Option<u32>,
-    /// Film height in pixels; `None`: the manifest camera's.
-    pub height: Option<u32>,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params { spp: 64, max_depth: -1, sampler: "multijitter".into(), seed: 0, width: None, height: None }
+stage_kit::knobs! {
+    /// The exporter's parameters.
+    pub struct Params {
+        /// Samples per pixel (the scene's `spp` default; `-Dspp=N` overrides it).
+        spp: u32 = 64, "samples", value(at_least(1));
+        /// Longest path of the `path` integrator; -1: unbounded.
+        max_depth: i32 = -1, "", value(custom("-1 (unbounded) or at least 1", |d: &i32| *d == -1 || *d >= 1));
+        /// Mitsuba sampler plugin.
+        sampler: String = "multijitter".into(), "", value(OneOfSamplers);
+        /// The sampler's seed.
+        seed: u32 = 0, "", value;
+        /// Film width (none: the manifest camera's).
+        width: Option<u32> = None, "pixels", optional(at_least(1));
+        /// Film height (none: the manifest camera's).
+        height: Option<u32> = None, "pixels", optional(at_least(1));
     }
 }
 
-impl Params {
-    /// Why these parameters cannot be exported, if they cannot.
-    pub fn check(&self) -> Result<(), String> {
-        if self.spp == 0 {
-            return Err("spp must be at least 1".into());
-        }
-        if self.max_depth < -1 || self.max_depth == 0 {
-            return Err(format!("max_depth must be -1 (unbounded) or at least 1, not {}", self.max_depth));
-        }
-        if !SAMPLERS.contains(&self.sampler.as_str()) {
-            return Err(format!("sampler must be one of {}, not {:?}", SAMPLERS.join(", "), self.sampler));
-        }
-        if self.width == Some(0) || self.height == Some(0) {
-            return Err("width and height must be at least 1".into());
-        }
-        Ok(())
+/// The range of the `sampler` knob: one of [`SAMPLERS`].
+pub struct OneOfSamplers;
+
+impl Describe for OneOfSamplers {
+    fn text(&self) -> String {
+        format!("one of {}", SAMPLERS.join(", "))
+    }
+}
+
+impl Check<String> for OneOfSamplers {
+    fn admits(&self, sampler: &String) -> bool {
+        SAMPLERS.contains(&sampler.as_str())
     }
 }
 
@@ -310,7 +294,8 @@ fn clip_range(statistics: &MeshStatistics, eye: [f64; 3]) -> (f64, f64) {
 /// Exports `mesh` + `manifest`: the XML text (PLY files referenced as
 /// `mesh_folder/<file>`, relative to the XML's directory) with
 /// `provenance` (any text) in a comment at its top, the PLY files, and
-/// what was not exported. `params` must pass [`Params::check`].
+/// what was not exported. `params` must be in their ranges
+/// ([`stage_kit::knobs::Knobs::check`]).
 pub fn export(mesh: &Mesh, manifest: &Manifest, params: &Params, mesh_folder: &str, provenance: &str) -> Export {
     let camera = &manifest.camera;
     let film = (params.width.unwrap_or(camera.width), params.height.unwrap_or(camera.height));
