@@ -289,6 +289,8 @@ impl Tree<'_> {
     /// triangles it lit, their windows, and so on depth first (004
     /// Listing 4.1).
     pub fn shoot(&self, gpu: &Gpu, device: &wgpu::Device, queue: &wgpu::Queue, params: &GpuParams, root: &[GpuSample], work: &mut TreeWork) {
+        // The batch's own passes finish first, so t_spec counts only the tree.
+        device.poll(wgpu::PollType::wait_indefinitely()).expect("waiting for the GPU");
         let started = Instant::now();
         let params = GpuParams { level: 0, virtual_base: self.virtual_base, ..*params };
         let lit = gpu.lit_specular(device, queue, &params);
