@@ -1,12 +1,12 @@
 //! The classic final gather the full gather is measured against: every
 //! link of the hit point's element chain at every camera sample, the exact
 //! point form factor times the kernel-weighted visible fraction
-//! ([`crate::gather`]) of `brute_samples` rays to uniform random points on
+//! ([`crate::full_gather`]) of `brute_samples` rays to uniform random points on
 //! the sender, drawn anew per camera sample.
 
 use crate::classification::LinkClass;
 use crate::diagnostics::Work;
-use crate::gather::sample_weight;
+use crate::full_gather::sample_weight;
 use crate::senders::{SenderSample, Senders};
 use glam::DVec3;
 use radiometry::form_factor::WeightedVisibility;

@@ -4,7 +4,7 @@
 //! 1. The links arriving at every receiver (cluster, element) overlapping
 //!    the eight cells around the vertex, and their ancestors
 //!    ([`crate::senders::Senders::links_near`]), grouped by sender
-//!    ([`SenderLinks`]): the largest unoccluded irradiance `I_s`
+//!    (`SenderLinks`): the largest unoccluded irradiance `I_s`
 //!    (luminance of the links' `Eu`), whether every link calls it fully
 //!    occluded (then it is skipped), whether one calls it partly occluded,
 //!    and the nearest occluder distance.
@@ -17,7 +17,7 @@
 //!    crosses more than `allowed_hits` surfaces (1: double-sided sheets, 2:
 //!    single-sided closed objects), so a sample point that fell behind the
 //!    receiving surface is not in shadow of it. The visible fraction is
-//!    kernel-weighted ([`crate::gather`]), with the receiver facing the
+//!    kernel-weighted ([`crate::full_gather`]), with the receiver facing the
 //!    sender's centre.
 //! 3. `D^F = rho B_s (F_max - F_min) vis` (Eq. 2) and `D^vis = rho B_s
 //!    F_avg` where `0 < vis < 1` (Eq. 3; `rho` is the mean reflectance of
@@ -34,7 +34,7 @@
 //! 5. Resampled visibility gets its view-dependent sample count
 //!    ([`crate::shadow_samples`]).
 
-use crate::gather::FullGather;
+use crate::full_gather::FullGather;
 use glam::DVec3;
 use radiometry::bounds::Aabb;
 use radiometry::color::luminance;

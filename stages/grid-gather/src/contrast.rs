@@ -12,7 +12,7 @@
 //! view-dependent shadow sample counts divide by that `tau`
 //! ([`crate::shadow_samples`]).
 
-use crate::gather::FullGather;
+use crate::full_gather::FullGather;
 use crate::grid::{Grid, Location};
 use glam::DVec3;
 use schemas::threshold::ThresholdImage;

@@ -4,7 +4,7 @@
 //! the report's counters.
 
 use crate::classification::LinkClass;
-use crate::gather::FullGather;
+use crate::full_gather::FullGather;
 use crate::specular::Followed;
 use schemas::diagnostics::{Diagnostics, VertexRecord};
 use std::collections::BTreeMap;

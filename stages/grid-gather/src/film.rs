@@ -4,7 +4,7 @@
 //! depend on the thread count), the closest hit of each, and the
 //! per-pixel mean of what a [`Shader`] makes of the hits. A miss is black
 //! with no coverage. The preview ([`crate::preview`]) and the full and
-//! brute gathers ([`crate::final_gather`]) are shaders.
+//! brute gathers ([`crate::full_image`]) are shaders.
 
 use crate::pixel_surfaces::{self, PixelTally, SurfaceId};
 use crate::specular::Followed;

@@ -19,11 +19,11 @@
 //! resamples a sender and another interpolates it, both are done and
 //! blended (Sec. 4.4.2), so nothing switches at a tetrahedron face. The
 //! visibility is kernel-weighted over the sender's fixed samples
-//! ([`crate::gather`]).
+//! ([`crate::full_gather`]).
 
 use crate::classification::{LinkClass, VertexData};
 use crate::diagnostics::Work;
-use crate::gather::FullGather;
+use crate::full_gather::FullGather;
 use crate::grid::Location;
 use glam::DVec3;
 

@@ -1,9 +1,9 @@
 //! # grid-gather: from a radiosity solution to an HDR image
 //!
 //! The final gather renders the hierarchical radiosity solution through the
-//! manifest's pinhole camera. Two modes are planned:
+//! manifest's pinhole camera, in one of three modes:
 //!
-//! - **preview** (built): camera rays find the visible surface point, whose
+//! - **preview**: camera rays find the visible surface point, whose
 //!   radiosity is interpolated from the solution's leaf elements (Gouraud
 //!   over vertex radiosity, see [`gouraud`]) and turned into radiance
 //!   `L = B / pi`. Cheap, continuous, but only as sharp as the elements.
@@ -12,7 +12,7 @@
 //!   resampling of critical senders, interpolation of the rest, the
 //!   surface-based gather where the solution is finer than the grid,
 //!   view-dependent shadow samples), optionally steered by the mask
-//!   stage's threshold image. See [`gather`], which lists the sections' files.
+//!   stage's threshold image. See [`full_gather`], which lists the sections' files.
 //! - **brute**: the classic final gather it is measured against: every
 //!   link of the hit point's element chain resampled at every camera
 //!   sample ([`brute`]).
@@ -22,7 +22,7 @@
 //! holes, and the full and brute gathers take normal maps in their cosines
 //! ([`detail`]). The full and brute gathers add a two-sided translucent
 //! surface's transmitted light, `tau H_back` gathered on its other face
-//! (paper 004 Eq. 4.4; [`final_gather::FullScene::transmission`]).
+//! (paper 004 Eq. 4.4; [`full_image::FullScene::transmission`]).
 //!
 //! In every mode, a camera ray that meets an ideal mirror (`rho_s`) or thin
 //! glass (`tau_s`) is continued, reflected or straight on, to the depth and
@@ -45,8 +45,8 @@ pub mod contrast;
 pub mod detail;
 pub mod diagnostics;
 pub mod film;
-pub mod final_gather;
-pub mod gather;
+pub mod full_image;
+pub mod full_gather;
 pub mod gouraud;
 pub mod grid;
 pub mod interpolation;
@@ -57,9 +57,8 @@ pub mod shadow_samples;
 pub mod specular;
 pub mod surface_gather;
 
-use gouraud::{Gouraud, Smoothing};
-use radiometry::camera::Pinhole;
-use stage_kit::scene::{luminaires, mesh_triangles, pinhole};
+use gouraud::Smoothing;
+use stage_kit::scene::{mesh_triangles, pinhole};
 use radiometry::rays::SceneRays;
 use schemas::diagnostics::Diagnostics;
 use schemas::mesh::{Manifest, Mesh};
@@ -310,21 +309,9 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     let triangles = mesh_triangles(scene.mesh);
     let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams };
     if params.mode != Mode::Preview {
-        return full_gather(params, scene, extras, &camera, &triangles, (width, height), smoothing, rows_done).map(|(r, d)| (r, Some(d)));
+        return full_image::gather(params, scene, extras, (&camera, &triangles), (width, height), smoothing, rows_done).map(|(r, d)| (r, Some(d)));
     }
     preview::render(params, scene, extras, (&camera, &triangles), (width, height), smoothing, rows_done).map(|r| (r, None))
-}
-
-/// Per triangle of a two-sided translucent material, its diffuse
-/// transmittance and its twin (see [`final_gather::FullScene`]); empty for
-/// a scene without diffuse transmission.
-fn transmission(scene: &Scene) -> Vec<Option<([f64; 3], u32)>> {
-    if !scene.manifest.effects.diffuse_transmission {
-        return Vec::new();
-    }
-    let tau = |t: &schemas::mesh::Triangle| scene.manifest.materials[t.material as usize].diffuse_transmittance;
-    let twins = scene.mesh.twins();
-    scene.mesh.triangles.iter().zip(twins).map(|(t, twin)| twin.filter(|_| tau(t).iter().any(|&x| x > 0.0)).map(|twin| (tau(t), twin))).collect()
 }
 
 /// The BVH over `triangles`, whose rays pass through alpha-masked holes
@@ -335,84 +322,6 @@ pub fn scene_rays(triangles: &[radiometry::geometry::TriangleGeometry], detail: 
         Some(detail) => detail.rays(&corners),
         None => SceneRays::new(&corners),
     }
-}
-
-/// The full or brute-force gather.
-fn full_gather(
-    params: &Params,
-    scene: &Scene,
-    extras: Extras,
-    camera: &Pinhole,
-    triangles: &[radiometry::geometry::TriangleGeometry],
-    (width, height): (u32, u32),
-    smoothing: Smoothing,
-    rows_done: &(dyn Fn(u64) + Sync),
-) -> Result<(Rendered, Diagnostics)> {
-    // The same structural checks as the preview's, with the same message.
-    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    Gouraud::new(triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
-    if let Some(c) = extras.clusters {
-        if c.nodes.len() != scene.solution.clusters.len() && !scene.solution.clusters.is_empty() {
-            return Err(Error::invalid(scene.solution_path, None, format!("solution has {} clusters, the hierarchy {}", scene.solution.clusters.len(), c.nodes.len())));
-        }
-    } else if scene.solution.links.iter().any(|l| matches!(l.receiver, schemas::solution::Node::Cluster(_)) || matches!(l.sender, schemas::solution::Node::Cluster(_))) {
-        return Err(Error::invalid(scene.solution_path, None, "solution has links between clusters: pass the hierarchy with --clusters"));
-    }
-    let surfaces: Vec<gather::Surface> = scene
-        .mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let m = scene.manifest.materials.get(t.material as usize);
-            gather::Surface { reflectance: m.map_or([0.0; 3], |m| m.diffuse), emission: m.map_or([0.0; 3], |m| m.emission) }
-        })
-        .collect();
-    if triangles.is_empty() {
-        let n = width as usize * height as usize;
-        let surfaces = pixel_surfaces::collect(std::iter::repeat_n(pixel_surfaces::NOTHING, n));
-        let rendered = Rendered { width: width as usize, height: height as usize, rgb: vec![[0.0; 3]; n], coverage: vec![0.0; n], surfaces, counters: BTreeMap::new(), skipped: Vec::new() };
-        return Ok((rendered, Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
-    }
-    let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
-    let lights = if scene.manifest.effects.goniometric_lights {
-        luminaires(&scene.manifest.goniometric_lights).map_err(|m| Error::invalid(scene.manifest_path, None, m))?
-    } else {
-        Vec::new()
-    };
-    let transmission = transmission(scene);
-    let specular = specular::Specular::new(scene.mesh, scene.manifest, triangles, params.specular_depth, params.specular_min_weight);
-    let window_light = match specular {
-        Some(_) => {
-            let senders = senders::Senders::new(triangles, scene.solution, extras.clusters, params.seed);
-            let rays = scene_rays(triangles, extras.detail);
-            Some(specular::window_light(scene, triangles, &senders, &surfaces, extras.detail, &radiometry::photometry::DirectLight { lights: &lights, rays: &rays }, smoothing)?)
-        }
-        None => None,
-    };
-    let full_scene = final_gather::FullScene {
-        triangles,
-        surfaces: &surfaces,
-        ids: &ids,
-        solution: scene.solution,
-        clusters: extras.clusters,
-        threshold: extras.threshold,
-        camera,
-        detail: extras.detail,
-        transmission: &transmission,
-        lights: &lights,
-        specular: specular.as_ref(),
-        window_light: window_light.as_ref(),
-    };
-    let image = final_gather::render_full(params, &full_scene, width, height, rows_done);
-    let mut counters = image.counters;
-    counters.insert("triangles".into(), triangles.len() as f64);
-    counters.insert("elements".into(), scene.solution.elements.len() as f64);
-    counters.insert("links".into(), scene.solution.links.len() as f64);
-    let skipped = skipped(scene.manifest, params.mode, extras.detail.is_some());
-    Ok((
-        Rendered { width: width as usize, height: height as usize, rgb: image.rgb, coverage: image.coverage, surfaces: image.surfaces, counters, skipped },
-        image.diagnostics,
-    ))
 }
 
 /// Whether some translucent material is not two-sided.

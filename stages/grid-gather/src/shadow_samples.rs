@@ -10,7 +10,7 @@
 //! in `[min_samples, max_shadow_samples]`; without `view_dependent`, Eq. 1's
 //! count in that range.
 
-use crate::gather::FullGather;
+use crate::full_gather::FullGather;
 use glam::DVec3;
 use schemas::solution::Node;
 

@@ -24,7 +24,7 @@ use radiometry::geometry::TriangleGeometry;
 use radiometry::photometry::DirectLight;
 use radiometry::rays::{Hit, SceneRays};
 use crate::detail::Detail;
-use crate::gather::Surface;
+use crate::full_gather::Surface;
 use crate::gouraud::{Gouraud, Smoothing};
 use crate::senders::Senders;
 use schemas::mesh::{Manifest, Mesh};

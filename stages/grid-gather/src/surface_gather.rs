@@ -28,7 +28,7 @@
 
 use crate::classification::{budget, LinkClass};
 use crate::diagnostics::Work;
-use crate::gather::FullGather;
+use crate::full_gather::FullGather;
 use glam::DVec3;
 use radiometry::color::luminance;
 use radiometry::form_factor::WeightedVisibility;

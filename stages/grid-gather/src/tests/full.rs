@@ -214,7 +214,7 @@ fn room_with_missed_occluder() -> Room {
         room.mesh.positions.extend(t.iter().map(|p| p.as_vec3().to_array()));
         let g = TriangleGeometry::new(t);
         room.mesh.triangles.push(Triangle { vertices: [base, base + 1, base + 2], material: 0, object: 0, area: g.area as f32, normal: g.normal.as_vec3().to_array() });
-        let mut element = room.solution.elements[0].clone();
+        let mut element = room.solution.elements[0];
         element.triangle = room.solution.elements.len() as u32;
         element.radiosity = [0.0; 3];
         room.solution.elements.push(element);

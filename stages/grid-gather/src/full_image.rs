@@ -1,5 +1,6 @@
-//! Driving the full and brute-force gathers over the image: the pre-pass
-//! that sizes the grid and averages the mask's threshold per vertex, and
+//! Driving the full and brute-force gathers over the image: the scene's
+//! checks and tables, the pre-pass that sizes the grid and averages the
+//! mask's threshold per vertex, and
 //! the shader ([`crate::film::Shader`]) that shades the surface points the
 //! camera rays reach, directly or through mirrors and glass.
 
@@ -8,12 +9,13 @@ use crate::contrast::vertex_contrast;
 use crate::detail::Detail;
 use crate::diagnostics::{record, Tally, Work};
 use crate::film::{expose, CameraHit, Lens, Sampling, Shader};
-use crate::gather::{FullGather, Surface};
+use crate::full_gather::{FullGather, Surface};
+use crate::gouraud::{Gouraud, Smoothing};
 use crate::grid::Grid;
-use crate::pixel_surfaces::SurfaceId;
+use crate::pixel_surfaces::{self, SurfaceId};
 use crate::senders::Senders;
 use crate::specular::{Followed, Seen, Specular};
-use crate::{Mode, Params};
+use crate::{scene_rays, skipped, Extras, Mode, Params, Rendered, Scene};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
@@ -25,6 +27,8 @@ use schemas::cluster::Clusters;
 use schemas::diagnostics::Diagnostics;
 use schemas::solution::Solution;
 use schemas::threshold::ThresholdImage;
+use schemas::{Error, Result};
+use stage_kit::scene::luminaires;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
@@ -62,6 +66,98 @@ pub struct FullScene<'a> {
     /// The light the solver gathered through mirrors and glass, beyond its
     /// links ([`crate::specular::window_light`]), in a scene that has them.
     pub window_light: Option<&'a crate::gouraud::Gouraud>,
+}
+
+/// The full or brute-force gather of `scene` through `camera` (of the
+/// scene's `triangles`) at `width` x `height`; checks the solution's
+/// hierarchy as the preview does (`smoothing` only for that).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn gather(
+    params: &Params,
+    scene: &Scene,
+    extras: Extras,
+    (camera, triangles): (&Pinhole, &[TriangleGeometry]),
+    (width, height): (u32, u32),
+    smoothing: Smoothing,
+    rows_done: &(dyn Fn(u64) + Sync),
+) -> Result<(Rendered, Diagnostics)> {
+    // The same structural checks as the preview's, with the same message.
+    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
+    Gouraud::new(triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
+    if let Some(c) = extras.clusters {
+        if c.nodes.len() != scene.solution.clusters.len() && !scene.solution.clusters.is_empty() {
+            return Err(Error::invalid(scene.solution_path, None, format!("solution has {} clusters, the hierarchy {}", scene.solution.clusters.len(), c.nodes.len())));
+        }
+    } else if scene.solution.links.iter().any(|l| matches!(l.receiver, schemas::solution::Node::Cluster(_)) || matches!(l.sender, schemas::solution::Node::Cluster(_))) {
+        return Err(Error::invalid(scene.solution_path, None, "solution has links between clusters: pass the hierarchy with --clusters"));
+    }
+    let surfaces: Vec<Surface> = scene
+        .mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let m = scene.manifest.materials.get(t.material as usize);
+            Surface { reflectance: m.map_or([0.0; 3], |m| m.diffuse), emission: m.map_or([0.0; 3], |m| m.emission) }
+        })
+        .collect();
+    if triangles.is_empty() {
+        let n = width as usize * height as usize;
+        let surfaces = pixel_surfaces::collect(std::iter::repeat_n(pixel_surfaces::NOTHING, n));
+        let rendered = Rendered { width: width as usize, height: height as usize, rgb: vec![[0.0; 3]; n], coverage: vec![0.0; n], surfaces, counters: BTreeMap::new(), skipped: Vec::new() };
+        return Ok((rendered, Diagnostics { width: width as usize, height: height as usize, ..Default::default() }));
+    }
+    let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
+    let lights = if scene.manifest.effects.goniometric_lights {
+        luminaires(&scene.manifest.goniometric_lights).map_err(|m| Error::invalid(scene.manifest_path, None, m))?
+    } else {
+        Vec::new()
+    };
+    let transmission = transmission(scene);
+    let specular = Specular::new(scene.mesh, scene.manifest, triangles, params.specular_depth, params.specular_min_weight);
+    let window_light = match specular {
+        Some(_) => {
+            let senders = Senders::new(triangles, scene.solution, extras.clusters, params.seed);
+            let rays = scene_rays(triangles, extras.detail);
+            Some(crate::specular::window_light(scene, triangles, &senders, &surfaces, extras.detail, &DirectLight { lights: &lights, rays: &rays }, smoothing)?)
+        }
+        None => None,
+    };
+    let full_scene = FullScene {
+        triangles,
+        surfaces: &surfaces,
+        ids: &ids,
+        solution: scene.solution,
+        clusters: extras.clusters,
+        threshold: extras.threshold,
+        camera,
+        detail: extras.detail,
+        transmission: &transmission,
+        lights: &lights,
+        specular: specular.as_ref(),
+        window_light: window_light.as_ref(),
+    };
+    let image = render_full(params, &full_scene, width, height, rows_done);
+    let mut counters = image.counters;
+    counters.insert("triangles".into(), triangles.len() as f64);
+    counters.insert("elements".into(), scene.solution.elements.len() as f64);
+    counters.insert("links".into(), scene.solution.links.len() as f64);
+    let skipped = skipped(scene.manifest, params.mode, extras.detail.is_some());
+    Ok((
+        Rendered { width: width as usize, height: height as usize, rgb: image.rgb, coverage: image.coverage, surfaces: image.surfaces, counters, skipped },
+        image.diagnostics,
+    ))
+}
+
+/// Per triangle of a two-sided translucent material, its diffuse
+/// transmittance and its twin (see [`FullScene`]); empty for
+/// a scene without diffuse transmission.
+fn transmission(scene: &Scene) -> Vec<Option<([f64; 3], u32)>> {
+    if !scene.manifest.effects.diffuse_transmission {
+        return Vec::new();
+    }
+    let tau = |t: &schemas::mesh::Triangle| scene.manifest.materials[t.material as usize].diffuse_transmittance;
+    let twins = scene.mesh.twins();
+    scene.mesh.triangles.iter().zip(twins).map(|(t, twin)| twin.filter(|_| tau(t).iter().any(|&x| x > 0.0)).map(|twin| (tau(t), twin))).collect()
 }
 
 /// What shades one surface point a camera ray reaches in the full or
@@ -185,7 +281,7 @@ pub struct FullImage {
 /// Renders `scene` at `width` x `height` by `params.mode` (full or brute).
 pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, rows_done: &(dyn Fn(u64) + Sync)) -> FullImage {
     let (w, h) = (width as usize, height as usize);
-    let rays = crate::scene_rays(scene.triangles, scene.detail);
+    let rays = scene_rays(scene.triangles, scene.detail);
     let senders = Senders::new(scene.triangles, scene.solution, scene.clusters, params.seed);
     let camera = scene.camera;
     // Pre-pass: one ray through each pixel centre, for the depth range and
