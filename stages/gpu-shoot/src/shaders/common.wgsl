@@ -64,3 +64,13 @@ fn face_of(l: vec3<f32>) -> u32 {
 fn stereographic(w: vec3<f32>) -> vec2<f32> {
     return w.xy / max(1.0 + w.z, 1e-3);
 }
+
+// The barycentrics (u, v) of the point p0 + x in the triangle with edges
+// e1, e2 from its corner p0 (x = u e1 + v e2 for a point in its plane).
+fn barycentric(x: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>) -> vec2<f32> {
+    let d11 = dot(e1, e1);
+    let d12 = dot(e1, e2);
+    let d22 = dot(e2, e2);
+    let det = d11 * d22 - d12 * d12;
+    return vec2<f32>(d22 * dot(x, e1) - d12 * dot(x, e2), d11 * dot(x, e2) - d12 * dot(x, e1)) / det;
+}

@@ -44,7 +44,7 @@ struct Crossing {
     entry: u32,
 };
 
-// Where the segment from `from` (behind level l's plane) to `to` (in
+// Where the segment from `src` (behind level l's plane) to `dst` (in
 // front) crosses the window.
 fn crossing(l: u32, src: vec3<f32>, dst: vec3<f32>) -> Crossing {
     let a = beyond(l, src);
@@ -55,16 +55,8 @@ fn crossing(l: u32, src: vec3<f32>, dst: vec3<f32>) -> Crossing {
     for (var e = w.x; e < w.x + w.y; e += 1u) {
         let t = bitcast<u32>(windows[e].w);
         let p0 = vertices[3u * t].xyz;
-        let e1 = vertices[3u * t + 1u].xyz - p0;
-        let e2 = vertices[3u * t + 2u].xyz - p0;
-        let x = b - p0;
-        let d11 = dot(e1, e1);
-        let d12 = dot(e1, e2);
-        let d22 = dot(e2, e2);
-        let det = d11 * d22 - d12 * d12;
-        let u = (d22 * dot(x, e1) - d12 * dot(x, e2)) / det;
-        let v = (d11 * dot(x, e2) - d12 * dot(x, e1)) / det;
-        if (u >= 0.0 && v >= 0.0 && u + v <= 1.0) { return Crossing(b, e); }
+        let uv = barycentric(b - p0, vertices[3u * t + 1u].xyz - p0, vertices[3u * t + 2u].xyz - p0);
+        if (uv.x >= 0.0 && uv.y >= 0.0 && uv.x + uv.y <= 1.0) { return Crossing(b, e); }
     }
     return Crossing(b, NONE);
 }
@@ -124,12 +116,8 @@ fn irradiance_mirrored(k: u32) -> vec3<f32> {
         if (any(ns != nr)) { cos_r = max(-dot(ns, v) / d, 0.0); }
         let light = s.power.w != 0.0;
         let local = vec3<f32>(dot(v, s.t.xyz), dot(v, s.b.xyz), dot(v, s.n.xyz));
-        var cos_s = local.z / d;
-        if (!light) {
-            if (dot(p - s.polygon[0].xyz, s.n.xyz) <= 0.0) { continue; }
-            if (any(s.shading.xyz != s.n.xyz)) { cos_s = dot(v, s.shading.xyz) / d; }
-            cos_s = max(cos_s, 0.0);
-        }
+        if (!light && behind_shooter(s, p)) { continue; }
+        let cos_s = shooter_cosine(s, v, d, local.z);
         let coef = through_windows(i, p, nr, top);
         if (all(coef == vec3<f32>(0.0))) { continue; }
         if (light) {

@@ -283,14 +283,8 @@ fn visible_stereographic(layer: u32, t: u32, p: vec3<f32>, s: Sample) -> bool {
     let p0 = vertices[3u * t].xyz;
     let e1 = vertices[3u * t + 1u].xyz - p0;
     let e2 = vertices[3u * t + 2u].xyz - p0;
-    let w = p - p0;
-    let d11 = dot(e1, e1);
-    let d12 = dot(e1, e2);
-    let d22 = dot(e2, e2);
-    let det = d11 * d22 - d12 * d12;
-    let u = (d22 * dot(w, e1) - d12 * dot(w, e2)) / det;
-    let v = (d11 * dot(w, e2) - d12 * dot(w, e1)) / det;
-    let at = m[0] + u * (m[1] - m[0]) + v * (m[2] - m[0]);
+    let uv = barycentric(p - p0, e1, e2);
+    let at = m[0] + uv.x * (m[1] - m[0]) + uv.y * (m[2] - m[0]);
     let res = f32(params.res);
     let x = i32(floor((at.x * 0.5 + 0.5) * res));
     let y = i32(floor((0.5 - at.y * 0.5) * res));
@@ -556,6 +550,23 @@ fn receive(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
     residual[k] += vec4<f32>(db, 0.0);
 }
 
+// Whether p lies behind the plane of the area sample s's shooter.
+fn behind_shooter(s: Sample, p: vec3<f32>) -> bool {
+    return dot(p - s.polygon[0].xyz, s.n.xyz) <= 0.0;
+}
+
+// The shooter's cosine towards v = p - s.position (d = |v|, local_z its
+// component along the frame normal): a light's frame normal's; an area
+// sample's its group's perturbed normal's under a normal map, at least 0.
+fn shooter_cosine(s: Sample, v: vec3<f32>, d: f32, local_z: f32) -> f32 {
+    var cos_s = local_z / d;
+    if (s.power.w == 0.0) {
+        if (any(s.shading.xyz != s.n.xyz)) { cos_s = dot(v, s.shading.xyz) / d; }
+        cos_s = max(cos_s, 0.0);
+    }
+    return cos_s;
+}
+
 // The irradiance H that the texel k (one that `receives`) gathers from
 // the batch's samples through the visibility maps.
 fn irradiance(k: u32) -> vec3<f32> {
@@ -597,13 +608,8 @@ fn irradiance(k: u32) -> vec3<f32> {
         // the shooter a receiver is on is decided by the shooter's own
         // plane, or a receiver nearer to it than that hair (a sliver
         // touching it) got nothing.
-        var cos_s = local.z / d;
-        if (!light) {
-            if (dot(p - s.polygon[0].xyz, s.n.xyz) <= 0.0) { continue; }
-            // The shooter's cosine: its group's perturbed normal's.
-            if (any(s.shading.xyz != s.n.xyz)) { cos_s = dot(v, s.shading.xyz) / d; }
-            cos_s = max(cos_s, 0.0);
-        }
+        if (!light && behind_shooter(s, p)) { continue; }
+        let cos_s = shooter_cosine(s, v, d, local.z);
         var seen = straddles;
         if (!straddles) { seen = seen_in_maps(i * params.layers_per_sample, tri, p, nr, local, s, light); }
         if (!seen) { continue; }

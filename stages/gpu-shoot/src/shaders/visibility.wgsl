@@ -113,11 +113,7 @@ fn fragment_bary(in: VertexOut) -> vec2<f32> {
     let denom = dot(normal, dir);
     if (denom == 0.0) { return in.bary; }
     let x = s.position.xyz + dir * (dot(normal, p0 - s.position.xyz) / denom) - p0;
-    let d11 = dot(e1, e1);
-    let d12 = dot(e1, e2);
-    let d22 = dot(e2, e2);
-    let det = d11 * d22 - d12 * d12;
-    return vec2<f32>(d22 * dot(x, e1) - d12 * dot(x, e2), d11 * dot(x, e2) - d12 * dot(x, e1)) / det;
+    return barycentric(x, e1, e2);
 }
 
 // The visibility maps of a scene with alpha masks: texels with alpha 0 do
