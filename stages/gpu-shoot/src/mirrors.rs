@@ -56,8 +56,6 @@ const COPLANAR: f64 = 1e-4;
 pub struct Specular {
     /// Per triangle: `(rho_s, tau_s)`, RGB.
     pub coefficients: Vec<([f64; 3], [f64; 3])>,
-    /// Triangles with `rho_s > 0` or `tau_s > 0`.
-    pub count: usize,
 }
 
 impl Specular {
@@ -72,14 +70,13 @@ impl Specular {
                 (m.specular_reflectance, m.specular_transmittance)
             })
             .collect();
-        let specular = |c: &([f64; 3], [f64; 3])| c.0.iter().chain(&c.1).any(|&x| x > 0.0);
-        let count = coefficients.iter().filter(|c| specular(c)).count();
-        (count > 0).then_some(Specular { coefficients, count })
+        let scene = Specular { coefficients };
+        scene.flags().contains(&1).then_some(scene)
     }
 
     /// Per triangle: 1 where it is specular (the mark pass's flags).
     pub fn flags(&self) -> Vec<u32> {
-        self.coefficients.iter().map(|c| u32::from(c.0.iter().chain(&c.1).any(|&x| x > 0.0))).collect()
+        self.coefficients.iter().map(|(rho, tau)| u32::from(rho.iter().chain(tau).any(|&x| x > 0.0))).collect()
     }
 }
 
