@@ -33,8 +33,9 @@
 //! the emitted power, `P_s` the sample's power (W; a light's intensity,
 //! W/sr), `c*` the product of its windows' largest coefficients, `F_e`
 //! Eq. 4.6's frustum estimate made a bound ([`bound`]); a cut child adds
-//! its bound to `Work::reflection_truncated`, which bounds the power the
-//! cut leaves out (all of it would pass that window). Not simulated:
+//! its bound to [`TreeWork::truncated`], which bounds the power the cut
+//! leaves out (all of it would pass that window). Powers are summed over
+//! R, G and B, as the emitted power they are compared with. Not simulated:
 //! glossy reflection, refraction bending, alpha masks in the frustum maps
 //! (masked surfaces are opaque there), and curved mirrors, which are their
 //! facets (each facet's plane its own node).
@@ -242,11 +243,11 @@ pub struct TreeWork {
     pub nodes: u64,
     /// The deepest node rendered (windows on its path).
     pub depth: u32,
-    /// Sum of the rendered nodes' bounds, W: the power they carried is at
-    /// most this.
+    /// Sum of the rendered nodes' bounds, W (R + G + B): the power they
+    /// carried is at most this.
     pub bound: f64,
-    /// Sum of the cut nodes' bounds, W: the power the depth and the
-    /// threshold left out is at most this.
+    /// Sum of the cut nodes' bounds, W (R + G + B): the power the depth
+    /// and the threshold left out is at most this.
     pub truncated: f64,
     /// Frustum maps rendered.
     pub layers: u64,
