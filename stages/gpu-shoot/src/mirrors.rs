@@ -141,7 +141,7 @@ fn corners(mesh: &Mesh, t: u32) -> [DVec3; 3] {
 }
 
 /// Groups the lit specular triangles `lit` into windows: per plane (the
-/// triangle's front plane, within [`COPLANAR`]), a mirror of those with
+/// triangle's front plane, within `COPLANAR`), a mirror of those with
 /// `rho_s > 0` and a pane of those with `tau_s > 0`.
 pub fn windows(mesh: &Mesh, specular: &Specular, lit: &[u32], diagonal: f64) -> Vec<Window> {
     let mut out: Vec<Window> = Vec::new();
