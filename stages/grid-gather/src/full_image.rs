@@ -10,12 +10,11 @@ use crate::detail::Detail;
 use crate::diagnostics::{record, Tally, Work};
 use crate::film::{expose, CameraHit, Lens, Sampling, Shader};
 use crate::full_gather::{FullGather, Surface};
-use crate::gouraud::{Gouraud, Smoothing};
 use crate::grid::Grid;
 use crate::pixel_surfaces::{self, SurfaceId};
 use crate::senders::Senders;
 use crate::specular::{Followed, Seen, Specular};
-use crate::{scene_rays, skipped, Extras, Mode, Params, Rendered, Scene};
+use crate::{scene_rays, skipped, Extras, Frame, Mode, Params, Rendered, Scene};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
@@ -68,22 +67,10 @@ pub struct FullScene<'a> {
     pub window_light: Option<&'a crate::gouraud::Gouraud>,
 }
 
-/// The full or brute-force gather of `scene` through `camera` (of the
-/// scene's `triangles`) at `width` x `height`; checks the solution's
-/// hierarchy as the preview does (`smoothing` only for that).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn gather(
-    params: &Params,
-    scene: &Scene,
-    extras: Extras,
-    (camera, triangles): (&Pinhole, &[TriangleGeometry]),
-    (width, height): (u32, u32),
-    smoothing: Smoothing,
-    rows_done: &(dyn Fn(u64) + Sync),
-) -> Result<(Rendered, Diagnostics)> {
-    // The same structural checks as the preview's, with the same message.
-    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    Gouraud::new(triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
+/// The full or brute-force gather of `scene` in `frame` (whose solution
+/// the caller checked against the mesh).
+pub(crate) fn gather(params: &Params, scene: &Scene, extras: Extras, frame: &Frame, rows_done: &(dyn Fn(u64) + Sync)) -> Result<(Rendered, Diagnostics)> {
+    let Frame { camera, width, height, triangles, smoothing, .. } = *frame;
     if let Some(c) = extras.clusters {
         if c.nodes.len() != scene.solution.clusters.len() && !scene.solution.clusters.is_empty() {
             return Err(Error::invalid(scene.solution_path, None, format!("solution has {} clusters, the hierarchy {}", scene.solution.clusters.len(), c.nodes.len())));

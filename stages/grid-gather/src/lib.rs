@@ -57,7 +57,9 @@ pub mod shadow_samples;
 pub mod specular;
 pub mod surface_gather;
 
-use gouraud::Smoothing;
+use gouraud::{Gouraud, Smoothing};
+use radiometry::camera::Pinhole;
+use radiometry::geometry::TriangleGeometry;
 use stage_kit::scene::{mesh_triangles, pinhole};
 use radiometry::rays::SceneRays;
 use schemas::diagnostics::Diagnostics;
@@ -235,6 +237,22 @@ pub struct Scene<'a> {
     pub solution_path: &'a Path,
 }
 
+/// What every mode starts from.
+pub struct Frame<'a> {
+    /// The camera.
+    pub camera: &'a Pinhole,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// The mesh's triangles.
+    pub triangles: &'a [TriangleGeometry],
+    /// Material of each triangle.
+    pub materials: &'a [u32],
+    /// How leaf corners blend where element radiosity is interpolated.
+    pub smoothing: Smoothing,
+}
+
 /// A rendered image and the work it took.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rendered {
@@ -307,16 +325,21 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
         )
     })?;
     let triangles = mesh_triangles(scene.mesh);
+    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
     let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams };
+    // Checks in every mode that the solution belongs to the mesh; the
+    // preview's shading.
+    let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
+    let frame = Frame { camera: &camera, width, height, triangles: &triangles, materials: &materials, smoothing };
     if params.mode != Mode::Preview {
-        return full_image::gather(params, scene, extras, (&camera, &triangles), (width, height), smoothing, rows_done).map(|(r, d)| (r, Some(d)));
+        return full_image::gather(params, scene, extras, &frame, rows_done).map(|(r, d)| (r, Some(d)));
     }
-    preview::render(params, scene, extras, (&camera, &triangles), (width, height), smoothing, rows_done).map(|r| (r, None))
+    preview::render(params, scene, extras, &frame, &shading, rows_done).map(|r| (r, None))
 }
 
 /// The BVH over `triangles`, whose rays pass through alpha-masked holes
 /// where `detail` has alpha masks.
-pub fn scene_rays(triangles: &[radiometry::geometry::TriangleGeometry], detail: Option<&detail::Detail>) -> SceneRays {
+pub fn scene_rays(triangles: &[TriangleGeometry], detail: Option<&detail::Detail>) -> SceneRays {
     let corners: Vec<_> = triangles.iter().map(|t| t.corners).collect();
     match detail {
         Some(detail) => detail.rays(&corners),

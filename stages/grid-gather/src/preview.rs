@@ -8,9 +8,9 @@
 
 use crate::detail::Detail;
 use crate::film::{expose, CameraHit, Lens, Sampling, Shader};
-use crate::gouraud::{Gouraud, Smoothing};
+use crate::gouraud::Gouraud;
 use crate::specular::{self, Followed, Seen, Specular};
-use crate::{pixel_surfaces, scene_rays, skipped, Extras, Mode, Params, Rendered, Scene};
+use crate::{pixel_surfaces, scene_rays, skipped, Extras, Frame, Mode, Params, Rendered, Scene};
 use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
@@ -100,19 +100,10 @@ impl Preview<'_> {
     }
 }
 
-/// Renders the preview of `scene` through `camera` at `width` x `height`;
-/// `smoothing` says how leaf corners blend.
-pub fn render(
-    params: &Params,
-    scene: &Scene,
-    extras: Extras,
-    (camera, triangles): (&Pinhole, &[TriangleGeometry]),
-    (width, height): (u32, u32),
-    smoothing: Smoothing,
-    rows_done: &(dyn Fn(u64) + Sync),
-) -> Result<Rendered> {
-    let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    let shading = Gouraud::new(triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
+/// Renders the preview of `scene` in `frame`, shading the element radiosity
+/// with `shading`.
+pub fn render(params: &Params, scene: &Scene, extras: Extras, frame: &Frame, shading: &Gouraud, rows_done: &(dyn Fn(u64) + Sync)) -> Result<Rendered> {
+    let Frame { camera, width, height, triangles, materials, smoothing } = *frame;
     let rays = (!triangles.is_empty()).then(|| scene_rays(triangles, extras.detail));
     let textures = extras.detail.filter(|_| scene.manifest.effects.textures);
     let emission: Vec<[f64; 3]> = match textures {
@@ -120,7 +111,7 @@ pub fn render(
         None => Vec::new(),
     };
     let irradiance = match textures {
-        Some(detail) => Some(Gouraud::of(triangles, &materials, scene.solution, scene.solution_path, smoothing, &|corners, e| {
+        Some(detail) => Some(Gouraud::of(triangles, materials, scene.solution, scene.solution_path, smoothing, &|corners, e| {
             let m = &scene.manifest.materials[scene.mesh.triangles[e.triangle as usize].material as usize];
             detail.irradiance(e.triangle, corners, e.radiosity.map(f64::from), m.emission, m.diffuse)
         })?),
@@ -129,7 +120,7 @@ pub fn render(
     let textured = textures.zip(irradiance.as_ref()).map(|(detail, irradiance)| Textured { detail, irradiance, emission: &emission });
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
     let specular = Specular::new(scene.mesh, scene.manifest, triangles, params.specular_depth, params.specular_min_weight);
-    let preview = Preview { camera, triangles, rays: rays.as_ref(), shading: &shading, textured, specular: specular.as_ref() };
+    let preview = Preview { camera, triangles, rays: rays.as_ref(), shading, textured, specular: specular.as_ref() };
     let lens = Lens { camera, triangles, rays: rays.as_ref(), surfaces: &ids, crease_angle_deg: params.crease_angle_deg };
     let film = expose(&lens, Sampling { width, height, spp: params.spp, seed: params.seed }, &preview, rows_done);
 
