@@ -514,17 +514,18 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let offsets = csr_offsets(&h, &all_links, b.len());
         // The passes refine with senders' area means; the last one then
         // solves on with the senders whose radiosity varies resolved by the
-        // kernel (gather::SenderTerms), judged on the means' solution.
+        // kernel (gather::SenderTerms), judged on the means' solution,
+        // within the same iteration cap (a capped solve keeps the means).
         senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
         let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders);
-        if pass == passes || (!refined_any && pass > 1) {
+        let left = params.max_iterations - convergence.iterations;
+        if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
             senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation });
             work.resolved_links = senders.resolved();
             let means = convergence;
-            convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, means.rates, &senders);
+            convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders);
             work.iterations += means.iterations;
-            work.capped_passes += usize::from(!means.converged);
             work.extrapolations += means.extrapolations;
         }
         rates = convergence.rates;
