@@ -6,7 +6,7 @@
 //! Without an adapter the tests skip loudly, but fail under CI.
 
 use glam::DVec3;
-use gpu_shoot::{gpu, solve, Params, Solved};
+use gpu_shoot::{gpu, solve, Params, Solved, Visibility};
 use test_support::gpu::device_or_skip;
 use test_support::meshes::{closed_box, manifest, material, quads};
 use radiometry::form_factor::point_to_polygon;
@@ -120,7 +120,9 @@ const LAMP_Y: f64 = 0.6;
 /// The lamp and then nothing else shoots (2 shots; the mirror has no
 /// diffuse part): every floor texel's irradiance is
 /// `E F(p -> lamp) + rho_s E F(p -> lamp mirrored in x = 0, clipped to
-/// the wall as seen from p)`, Lambert's formula on both, within 1%.
+/// the wall as seen from p)`, Lambert's formula on both, within 1%, with
+/// either projection of the real samples' maps (the first window is
+/// checked in them).
 #[test]
 fn a_mirror_wall_adds_rho_s_times_the_lamps_image_through_its_window() {
     let mesh = quads(&[
@@ -129,13 +131,19 @@ fn a_mirror_wall_adds_rho_s_times_the_lamps_image_through_its_window() {
         horizontal([0.2, 0.4], [0.4, 0.6], LAMP_Y, false, 2),
     ]);
     let m = with_effects(manifest(3, vec![material([RHO_FLOOR; 3], [0.0; 3]), mirror(RHO_S), material([0.0; 3], [E; 3])]));
-    let params = Params { min_size: 32, max_size: 32, shoot_level: 1, max_shots: 2, convergence_target: 1.0, resolution: 256, ..Params::default() };
-    let Some(solved) = run(&mesh, &m, &params) else { return };
+    for visibility in [Visibility::Hemicube, Visibility::Stereographic] {
+        let params = Params { min_size: 32, max_size: 32, shoot_level: 1, max_shots: 2, convergence_target: 1.0, resolution: 256, visibility, ..Params::default() };
+        let Some(solved) = run(&mesh, &m, &params) else { return };
+        mirror_wall_against_lambert(&solved, visibility);
+    }
+}
+
+fn mirror_wall_against_lambert(solved: &Solved, visibility: Visibility) {
     let lamp = rect(0.2, 0.4, 0.4, 0.6, LAMP_Y);
     let image: Vec<DVec3> = lamp.iter().map(|&p| mirror_x(p, 0.0)).collect();
     let wall = [DVec3::ZERO, DVec3::Y * WALL_TOP, DVec3::new(0.0, WALL_TOP, 1.0), DVec3::Z];
     let (mut worst, mut clipped, mut mirrored_over_5, mut n) = (0.0f64, 0, 0, 0);
-    for (p, _, h) in floor_irradiance(&solved, &[0, 1]) {
+    for (p, _, h) in floor_irradiance(solved, &[0, 1]) {
         let seen = through_window(&image, p, &wall);
         let mirrored = if seen.is_empty() { 0.0 } else { E * point_to_polygon(p, DVec3::Y, &seen) };
         let full = E * point_to_polygon(p, DVec3::Y, &image);
@@ -151,7 +159,7 @@ fn a_mirror_wall_adds_rho_s_times_the_lamps_image_through_its_window() {
     }
     let r = &solved.work.reflection;
     eprintln!(
-        "mirror wall: worst floor texel {worst:.4} of {n} ({clipped} see the image clipped, {mirrored_over_5} get over 5% from it); tree: {} nodes, depth {}, {:.3} s of {:.3} s shooting",
+        "mirror wall ({visibility:?}): worst floor texel {worst:.4} of {n} ({clipped} see the image clipped, {mirrored_over_5} get over 5% from it); tree: {} nodes, depth {}, {:.3} s of {:.3} s shooting",
         r.nodes, r.depth, r.seconds, solved.work.shoot_seconds
     );
     assert!(n > 400 && clipped > 50 && mirrored_over_5 > 200, "{n} texels, {clipped} clipped, {mirrored_over_5} over 5%");
