@@ -71,6 +71,13 @@ fn per_triangle<T: Copy>(records: &[(u32, T)], triangles: usize) -> Vec<Option<T
 }
 
 impl<'a> Detail<'a> {
+    /// Whether `solution` was solved with the surface artifact read as
+    /// `surface` (an input of the solve has the same content): its element
+    /// radiosity then reflects the texture averages ([`Self::new`]).
+    pub fn solved_with(solution: &schemas::solution::Solution, surface: &schemas::header::Input) -> bool {
+        solution.header.provenance.inputs.iter().any(|i| i.sha256 == surface.sha256)
+    }
+
     /// The detail of `mesh`'s triangles from `surface` (read for this
     /// mesh). `solved_with_textures`: the solution was solved with this
     /// surface artifact (its element radiosity reflects the texture

@@ -23,8 +23,7 @@ use std::process::ExitCode;
 struct Args {
     #[command(flatten)]
     scene: SceneArgs,
-    /// Surface detail (surface.exr from mesh-prep --surface): textures,
-    /// alpha masks and normal maps, read only when the scene has some.
+    /// Surface detail (surface.exr from mesh-prep --surface: textures, alpha masks, normal maps), read only when the scene has some.
     #[arg(long, value_name = "SURFACE.exr")]
     surface: Option<PathBuf>,
     /// Radiosity solution (solution.exr from hierarchical-solve).
@@ -80,17 +79,13 @@ impl Stage for Args {
             Some(path) if manifest.effects.surface_detail() => Some(read_surface(path, required(&self.scene.mesh, "--mesh")?, &mesh, &manifest)?),
             _ => None,
         };
-        // Solved with the surface artifact (an input of the solve has its
-        // content): the element radiosity then reflects the texture averages
-        // (`Detail::new`). Recorded without the provenance it carries (the
-        // mesh's), so a solution solved without it is not refused.
-        let solved_with = surface.as_ref().is_some_and(|(_, input)| solution.header.provenance.inputs.iter().any(|i| i.sha256 == input.sha256));
+        // Recorded without the provenance it carries (the mesh's), so that
+        // a solution solved without it is not refused as another run's.
         if let Some((_, input)) = &surface {
             run.input(schemas::header::Input { made_by: None, ..input.clone() })?;
         }
-        let detail = surface.as_ref().map(|(s, _)| Detail::new(s, &mesh, &manifest, solved_with));
-        let manifest_path = required(&self.scene.manifest, "--manifest")?;
-        let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path, solution: &solution, solution_path };
+        let detail = surface.as_ref().map(|(s, input)| Detail::new(s, &mesh, &manifest, Detail::solved_with(&solution, input)));
+        let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path: required(&self.scene.manifest, "--manifest")?, solution: &solution, solution_path };
         let extras = Extras { clusters: clusters.as_ref(), threshold: threshold.as_ref(), detail: detail.as_ref() };
         let bar = progress(image_size(params, &manifest).1.into(), "rows");
         let rendered = gather_with(params, &scene, extras, &|rows| bar.inc(rows));
@@ -102,9 +97,7 @@ impl Stage for Args {
             outputs.write(path, |p| d.write(p, GatherDiagnostics::header(run.provenance(params))))?;
         }
         let notes: Vec<String> = back_face_warning(&rendered.counters).into_iter().collect();
-        for note in &notes {
-            eprintln!("grid-gather: warning: {note}");
-        }
+        notes.iter().for_each(|note| eprintln!("grid-gather: warning: {note}"));
         Ok(Done { counters: rendered.counters, skipped: rendered.skipped, notes, negative: false })
     }
 }
