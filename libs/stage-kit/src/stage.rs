@@ -99,14 +99,9 @@ fn run<S: Stage>(stage: S, common: &StageArgs<S::Params>, name: String, version:
     let (inputs, mut outputs) = stage.files();
     outputs.push(report.as_deref());
     check_outputs(&inputs, &outputs)?;
-    let label = name.clone();
     let mut run = Run::start(name, version).writing(&outputs);
     let mut outputs = Outputs::new();
     let done = stage.run(&params, &mut run, &mut outputs)?;
-    // What the stage does not simulate is said on stderr too, report or not.
-    for note in &done.skipped {
-        eprintln!("{label}: skipped: {note}");
-    }
     if let Some(report) = &report {
         outputs.write(report, |p| run.write_report(p, &params, done.counters, done.skipped, done.notes))?;
     }
