@@ -218,8 +218,8 @@ fn interpolation_inside_a_subdivided_triangle_matches_the_hand_computation() {
     let values = [a, b, c, d];
     let one = [square()[0]];
     let mut sol = solution(1, 1, |_, _| 0.0);
-    for k in 0..4 {
-        sol.elements[1 + k].radiosity = [values[k] as f32; 3];
+    for (element, value) in sol.elements[1..5].iter_mut().zip(values) {
+        element.radiosity = [value as f32; 3];
     }
     let g = gouraud(&mesh_triangles(&mesh(&one)), &sol, SMOOTH);
     let (m01, m12, m20) = ((a + b + d) / 3.0, (b + c + d) / 3.0, (a + c + d) / 3.0);
