@@ -69,9 +69,12 @@ use schemas::solution::Node;
 use std::collections::HashMap;
 use std::sync::Mutex;
 
+/// A leaf's traced pairs that are not empty, by sender element.
+type Pairs = Vec<(u32, Pair)>;
+
 /// A leaf's couplings as assembled: `(sender, weight)` pairs, their spread,
 /// the rays cast, the truncated irradiance, and its traced pairs to keep.
-type LeafCouplings = (Vec<(usize, [f64; 3])>, f64, u64, f64, Vec<(u32, Pair)>);
+type LeafCouplings = (Vec<(usize, [f64; 3])>, f64, u64, f64, Pairs);
 
 /// What the images of one sender element bring one leaf
 /// ([`Windows::images`]): each coupling's weight `coefficients x F x V'`
@@ -97,7 +100,7 @@ impl Pair {
 #[derive(Debug, Default)]
 struct Traced {
     senders: Vec<u32>,
-    leaves: HashMap<u32, Vec<(u32, Pair)>>,
+    leaves: HashMap<u32, Pairs>,
 }
 
 /// One window: the specular triangles of one material in one plane.
@@ -377,7 +380,7 @@ impl Windows {
         let mut traced = self.traced.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         let before = std::mem::take(&mut traced.senders);
         let mut lists = std::mem::take(&mut traced.leaves);
-        let previous: Vec<(u32, Option<Vec<(u32, Pair)>>)> = leaves.iter().map(|&r| (r, lists.remove(&r))).collect();
+        let previous: Vec<(u32, Option<Pairs>)> = leaves.iter().map(|&r| (r, lists.remove(&r))).collect();
         let per_leaf: Vec<LeafCouplings> = previous
             .into_par_iter()
             .map(|(r, mut old)| {
