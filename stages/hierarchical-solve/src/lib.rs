@@ -9,30 +9,11 @@
 //! ([`gather`]). Refinement needs radiosity and radiosity needs links, so
 //! the two alternate in passes until a pass refines nothing. Goniometric
 //! point lights shoot first: their direct light, with shadow rays, is a
-//! source term of every element ([`luminaires`]).
+//! source term of every element.
 //!
-//! Parameters ([`Params`]):
-//!
-//! | name | meaning | default |
-//! |---|---|---|
-//! | `criterion` | what a link's estimated error is compared with: `relative` (`eps_relative` times the receiver's radiosity) or `absolute` (`eps` times the largest emitted radiosity, HSA's BF criterion) | `relative` |
-//! | `eps` | absolute threshold, as a fraction of the largest source radiosity (emission, or the reflected direct light of luminaires, [`luminaires`]); with `relative`, used by the first pass only | 2e-4 |
-//! | `eps_relative` | relative threshold: a link's error as a fraction of its receiver's radiosity (brightest channel, current iterate); unset: `eps` x largest emission / (3 x mean reflected radiosity), so that `eps` stays the one accuracy knob ([`RELATIVE_AT`]) | unset (0.9% on the Cornell box) |
-//! | `relative_floor` | least receiver radiosity the relative criterion assumes, as a fraction of the scene's area-mean reflected radiosity (black receivers terminate) | 1e-2 |
-//! | `share_floor` | relative criterion: a link may err by `eps_relative` times what it brings its receiver, or times this share of the receiver's radiosity if more, so that the errors of an element's links add up to about `eps_relative` of its radiosity ([`links::Allowance::for_link`]) | 1/16 |
-//! | `min_area` | smallest element area, as a fraction of the scene's total area | 1e-4 |
-//! | `shadow_levels` | how many 1:4 levels below `min_area` a shadow edge across a link between elements may split ([`links::Floors`]) | 2 |
-//! | `visibility_rays` | rays per link between two elements | 16 |
-//! | `cluster_samples` | point pairs (and rays) per link with a cluster end | 16 |
-//! | `quadrature_depth` | deepest split of the adaptive receiver quadrature near touching elements, and of the near-field quadrature of a luminaire's direct light over an element ([`luminaires`]) | 3 |
-//! | `tolerance` | convergence: bound of the remaining error of a leaf's radiosity, relative to the largest radiosity ([`gather::solve`]) | 1e-5 |
-//! | `max_iterations` | Jacobi iterations per solve, at most | 2000 |
-//! | `max_passes` | refine-and-solve passes, at most | 8 |
-//! | `seed` | seed of the visibility rays | 1 |
-//! | `specular_rays` | rays per coupling through a mirror or pane ([`mirrors`]) | 16 |
-//! | `specular_depth` | most mirrors and panes along a path of light (virtual senders of virtual senders) | 2 |
-//! | `specular_sender_level` | levels below each input triangle the senders through mirrors and panes are taken at (their leaves where coarser) | 2 |
-//! | `specular_min_factor` | couplings through a mirror or pane whose `rho_s F` or `tau_s F` is under this are dropped | 1e-6 |
+//! Parameters: [`Params`], declared once with `stage_kit::knobs!`
+//! (`hierarchical-solve --print-knobs` prints their table, which the
+//! README's "Stage knobs" holds).
 //!
 //! **Why `relative` is the default.** The absolute criterion bounds each
 //! link's error in units of the brightest emitter, so on a surface lit only
@@ -74,6 +55,7 @@ pub mod links;
 pub mod luminaires;
 pub mod mirrors;
 pub mod nodes;
+pub mod report;
 pub mod rows;
 pub mod shaft;
 pub mod transfer;
@@ -91,81 +73,51 @@ use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution;
 use schemas::surface::Surface;
-use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// The solver's knobs (see the table in the crate documentation).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// What a link's error is compared with (see the table).
-    pub criterion: Criterion,
-    /// BF threshold relative to the largest emitted radiosity (absolute
-    /// criterion, and the first pass of the relative one).
-    pub eps: f64,
-    /// Relative criterion: a link's error as a fraction of its receiver's
-    /// radiosity; `None`: from `eps`, see [`RELATIVE_AT`].
-    pub eps_relative: Option<f64>,
-    /// Relative criterion: least receiver radiosity, as a fraction of the
-    /// scene's area-mean reflected radiosity.
-    pub relative_floor: f64,
-    /// Relative criterion: least share of its receiver's radiosity a link's
-    /// allowance is computed from ([`links::Allowance::for_link`]).
-    pub share_floor: f64,
-    /// Smallest element area relative to the total area.
-    pub min_area: f64,
-    /// Levels below `min_area` a shadow edge may split ([`links::Floors`]).
-    pub shadow_levels: u32,
-    /// Rays per element-element link.
-    pub visibility_rays: usize,
-    /// Point pairs per link with a cluster end.
-    pub cluster_samples: usize,
-    /// Deepest split of the adaptive receiver quadrature.
-    pub quadrature_depth: u32,
-    /// Bound of the remaining error (relative to the largest radiosity) at
-    /// which gathering stops.
-    pub tolerance: f64,
-    /// Jacobi iterations per solve, at most.
-    pub max_iterations: usize,
-    /// Refine-and-solve passes, at most.
-    pub max_passes: usize,
-    /// Seed of the visibility rays.
-    pub seed: u64,
-    /// Rays per coupling through a mirror or pane ([`mirrors`]).
-    pub specular_rays: usize,
-    /// Couplings through a mirror or pane under this factor are dropped.
-    pub specular_min_factor: f64,
-    /// Levels below each input triangle the senders through mirrors and
-    /// panes are taken at ([`mirrors`]).
-    pub specular_sender_level: u32,
-    /// Most mirrors and panes along a path of light ([`mirrors`]).
-    pub specular_depth: u32,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            criterion: Criterion::Relative,
-            eps: 2e-4,
-            eps_relative: None,
-            relative_floor: 1e-2,
-            share_floor: 1.0 / 16.0,
-            min_area: 1e-4,
-            shadow_levels: 2,
-            visibility_rays: 16,
-            cluster_samples: 16,
-            quadrature_depth: 3,
-            tolerance: 1e-5,
-            max_iterations: 2000,
-            max_passes: 8,
-            seed: 1,
-            specular_rays: 16,
-            specular_min_factor: 1e-6,
-            specular_sender_level: 2,
-            specular_depth: 2,
-        }
+stage_kit::knobs! {
+    /// The solver's knobs.
+    pub struct Params {
+        /// What a link's estimated error is compared with: `relative` (`eps_relative` times the receiver's radiosity) or `absolute` (`eps` times the largest emitted radiosity, HSA's BF criterion).
+        criterion: Criterion = Criterion::Relative, "", value;
+        /// Absolute threshold, as a fraction of the largest source radiosity (emission, or the reflected direct light of luminaires); with `relative`, used by the first pass only.
+        eps: f64 = 2e-4, "", value(positive());
+        /// Relative criterion: a link's error as a fraction of its receiver's radiosity (brightest channel, current iterate); `none`: `eps` x largest emission / (3 x mean reflected radiosity), so that `eps` stays the one accuracy knob (0.9% on the Cornell box).
+        eps_relative: Option<f64> = None, "", optional(positive());
+        /// Least receiver radiosity the relative criterion assumes, as a fraction of the scene's area-mean reflected radiosity (black receivers terminate).
+        relative_floor: f64 = 1e-2, "", value(positive());
+        /// Relative criterion: a link may err by `eps_relative` times what it brings its receiver, or times this share of the receiver's radiosity if more.
+        share_floor: f64 = 1.0 / 16.0, "", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
+        /// Smallest element area, as a fraction of the scene's total area.
+        min_area: f64 = 1e-4, "", value(left_open(0.0, 1.0));
+        /// How many 1:4 levels below `min_area` a shadow edge across a link between elements may split.
+        shadow_levels: u32 = 2, "levels", value(0..=8);
+        /// Visibility rays per link between two elements.
+        visibility_rays: usize = 16, "rays", value(1..=4096);
+        /// Point pairs (and rays) per link with a cluster at an end.
+        cluster_samples: usize = 16, "pairs", value(1..=4096);
+        /// Deepest split of the adaptive receiver quadrature near touching elements, and of the near-field quadrature of a luminaire's direct light over an element.
+        quadrature_depth: u32 = 3, "levels", value(0..=8);
+        /// Convergence: gathering stops when a bound of every leaf's remaining error is under this fraction of the largest radiosity.
+        tolerance: f64 = 1e-5, "", value(positive());
+        /// Jacobi iterations per solve, at most.
+        max_iterations: usize = 2000, "", value(at_least(1));
+        /// Refine-and-solve passes, at most.
+        max_passes: usize = 8, "", value(at_least(1));
+        /// Seed of the visibility rays.
+        seed: u64 = 1, "", value;
+        /// Rays per coupling through a mirror or pane.
+        specular_rays: usize = 16, "rays", value(1..=4096);
+        /// Couplings through a mirror or pane whose `rho_s F` or `tau_s F` is under this are dropped.
+        specular_min_factor: f64 = 1e-6, "", value(at_least(0.0));
+        /// Levels below each input triangle the senders through mirrors and panes are taken at (their leaves where coarser).
+        specular_sender_level: u32 = 2, "levels", value(0..=8);
+        /// Most mirrors and panes along a path of light (virtual senders of virtual senders).
+        specular_depth: u32 = 2, "", value(0..=16);
     }
 }
+
+stage_kit::show_by_name!(Criterion);
 
 /// Where `eps_relative` is not given, the relative criterion allows on a
 /// receiver of `RELATIVE_AT` times the scene's mean reflected radiosity
@@ -177,52 +129,14 @@ impl Default for Params {
 pub const RELATIVE_AT: f64 = 3.0;
 
 impl Params {
-    /// Why the parameters are unusable, if they are.
+    /// Why the parameters are unusable, if they are: the first knob out of
+    /// its declared range (`NAME must be RANGE, not VALUE`).
     pub fn problem(&self) -> Option<String> {
-        let positive = |x: f64| x.is_finite() && x > 0.0;
-        if !positive(self.eps) {
-            return Some(format!("eps must be a positive number, not {}", self.eps));
-        }
-        if let Some(e) = self.eps_relative.filter(|e| !positive(*e)) {
-            return Some(format!("eps_relative must be a positive number, not {e}"));
-        }
-        if !positive(self.relative_floor) {
-            return Some(format!("relative_floor must be a positive number, not {}", self.relative_floor));
-        }
-        if !(self.share_floor.is_finite() && (0.0..=1.0).contains(&self.share_floor)) {
-            return Some(format!("share_floor must be in [0, 1], not {}", self.share_floor));
-        }
-        if !positive(self.min_area) || self.min_area > 1.0 {
-            return Some(format!("min_area must be in (0, 1], not {}", self.min_area));
-        }
-        if self.shadow_levels > 8 {
-            return Some(format!("shadow_levels must be at most 8, not {}", self.shadow_levels));
-        }
-        if self.visibility_rays == 0 || self.visibility_rays > 4096 {
-            return Some(format!("visibility_rays must be in 1..=4096, not {}", self.visibility_rays));
-        }
-        if self.cluster_samples == 0 || self.cluster_samples > 4096 {
-            return Some(format!("cluster_samples must be in 1..=4096, not {}", self.cluster_samples));
-        }
-        if self.quadrature_depth > 8 {
-            return Some(format!("quadrature_depth must be at most 8, not {}", self.quadrature_depth));
-        }
-        if self.specular_rays == 0 || self.specular_rays > 4096 {
-            return Some(format!("specular_rays must be in 1..=4096, not {}", self.specular_rays));
-        }
-        if self.specular_depth > 16 {
-            return Some(format!("specular_depth must be at most 16, not {}", self.specular_depth));
-        }
-        if self.specular_sender_level > 8 {
-            return Some(format!("specular_sender_level must be at most 8, not {}", self.specular_sender_level));
-        }
-        if !(self.specular_min_factor.is_finite() && self.specular_min_factor >= 0.0) {
-            return Some(format!("specular_min_factor must be a non-negative number, not {}", self.specular_min_factor));
-        }
-        if !positive(self.tolerance) || self.max_iterations == 0 || self.max_passes == 0 {
-            return Some("tolerance must be positive, max_iterations and max_passes at least 1".into());
-        }
-        None
+        use stage_kit::knobs::Knobs;
+        self.check("").err().map(|e| match e {
+            schemas::Error::Invalid { message, .. } => message,
+            other => other.to_string(),
+        })
     }
 }
 
@@ -254,7 +168,7 @@ pub struct Work {
     /// Relative change of the last iteration.
     pub relative_change: f64,
     /// Bound of the remaining error of the last pass's solution, relative
-    /// to the largest radiosity ([`gather::solve`]).
+    /// to the largest radiosity.
     pub error_bound: f64,
     /// Contraction factor the last pass's bound used.
     pub contraction: f64,
@@ -271,14 +185,14 @@ pub struct Work {
     pub visibility_seconds: f64,
     /// Seconds gathering.
     pub gather_seconds: f64,
-    /// Shadow rays cast to luminaires ([`luminaires`]).
+    /// Shadow rays cast to luminaires.
     pub luminaire_rays: u64,
     /// Seconds lighting elements from luminaires.
     pub luminaire_seconds: f64,
     /// Links whose sender the last solve resolved into parts
     /// ([`gather::SenderTerms`]).
     pub resolved_links: usize,
-    /// Couplings through mirrors and panes in the last pass ([`mirrors`]).
+    /// Couplings through mirrors and panes in the last pass.
     pub specular_couplings: usize,
     /// Rays cast to build them, all passes.
     pub specular_rays: u64,
