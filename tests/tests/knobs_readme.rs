@@ -8,7 +8,7 @@ use end_to_end::run_ok;
 
 /// The stages whose knobs are declared with `stage_kit::knobs!` (a
 /// converted stage joins with one line).
-const STAGES: [&str; 9] = ["cluster", "tonemap", "mask", "structured-sample", "mesh-prep", "photon-trace", "grid-gather", "export-mitsuba", "hierarchical-solve"];
+const STAGES: [&str; 10] = ["cluster", "tonemap", "mask", "structured-sample", "mesh-prep", "photon-trace", "grid-gather", "export-mitsuba", "hierarchical-solve", "gpu-shoot"];
 
 /// The README's table for `stage`: the lines between its two markers.
 fn readme_table(readme: &str, stage: &str) -> Option<String> {

@@ -31,29 +31,18 @@
 //! atlas ([`output`]), so `grid-gather --mode preview`, `tonemap` and
 //! `compare` treat it like a hierarchical solution.
 //!
-//! | parameter | meaning | default |
-//! |---|---|---|
-//! | `texels` | covered texels to aim for over the whole scene | 32768 |
-//! | `min_size`, `max_size` | bounds of a region's side, texels | 2, 512 |
-//! | `shoot_level` | substructuring: shoot from groups of `2^level` x `2^level` texels | 3 |
-//! | `visibility` | `hemicube` or `stereographic` | `hemicube` |
-//! | `resolution` | side of a hemicube face / the stereographic map, pixels | 128 |
-//! | `tolerance` | relative depth tolerance of the visibility test | 0.02 |
-//! | `overshoot` | ambient overshooting (004 Eq. 4.9): off by default, because counted by `sum |dB| A` it converges slower (Cornell box, 8000 texels, to 99%: 1032 shots against 121) | false |
-//! | `convergence_target` | stop when the unshot power, `sum |dB| A` (negative residuals left by overshooting count by magnitude), is at most 1 - this of the emitted power | 0.99 |
-//! | `max_shots` | stop after this many shots | 100000 |
-//! | `ambient` | add `rho x ambient` (Eq. 2.4) to the solution's radiosity: a display aid for an unconverged solution, off by default because it adds light that an open scene does not have | false |
-//! | `texels_per_leaf` | solution leaves: about this many texels each | 4 |
-//! | `reflection_depth` | planar mirrors and thin panes ([`mirrors`], 004 Sec. 4.3.2-4.3.3): most windows on a light path of the reflection tree | 4 |
-//! | `reflection_threshold` | a node of the reflection tree whose power bound (Eq. 4.6) is under this fraction of the emitted power is not rendered | 1e-4 |
-//! | `adaptive` | subdivision at shadow boundaries (004 Sec. 2.4): `lower`, `upper` (the bounds `b_l`, `b_u` of the visible fraction `n_v / n_r` that splits a receiver), `levels` (most splits of an input triangle) | off; on: 0.05, 0.95, 3 |
+//! Its knobs are declared once, in [`Params`] (and [`Adaptive`]); their
+//! table with ranges and defaults is `gpu-shoot --print-knobs`, in the
+//! README's "Stage knobs".
 
 pub mod atlas;
+pub mod convergence;
 pub mod detail;
 pub mod gpu;
 pub mod mirrors;
 pub mod output;
 pub mod reference;
+pub mod report;
 pub mod tiling;
 pub mod transmission;
 
@@ -85,77 +74,78 @@ pub enum Visibility {
     Stereographic,
 }
 
-/// The stage's parameters (see the table in the crate documentation).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Covered texels to aim for over the scene.
-    pub texels: f64,
-    /// Smallest region side, texels.
-    pub min_size: u32,
-    /// Largest region side, texels.
-    pub max_size: u32,
-    /// Substructuring level: samples are groups of `2^level` squared texels.
-    pub shoot_level: u32,
-    /// Hemicube or stereographic projection.
-    pub visibility: Visibility,
-    /// Visibility map side, pixels.
-    pub resolution: u32,
-    /// Relative depth tolerance of the visibility test.
-    pub tolerance: f64,
-    /// Ambient overshooting (off by default: see the crate documentation).
-    pub overshoot: bool,
-    /// Stop when the unshot magnitude `sum |dB| A` is at most 1 - this
-    /// fraction of the emitted power.
-    pub convergence_target: f64,
-    /// Stop after this many shots.
-    pub max_shots: usize,
-    /// Add rho x ambient to the solution's radiosity (004 Eq. 2.4). The
-    /// ambient term spreads the unshot power uniformly over the scene as if
-    /// it were closed, so in an open scene it adds light that is not there
-    /// (paper 002's one-bounce receiver got +6.3% flux, 1.3% without it); it
-    /// is for displaying an unconverged solution, and off by default so a
-    /// converged one is not biased. Ambient *overshooting* (the shooter's
-    /// choice, `overshoot`) is unaffected.
-    pub ambient: bool,
-    /// Texels per solution leaf, about.
-    pub texels_per_leaf: f64,
-    /// Most windows (mirrors and panes) on a light path of the reflection
-    /// tree ([`mirrors`]); written only where not the default, so the
-    /// artifacts of a run without it keep their bits.
-    #[serde(skip_serializing_if = "is_default_depth")]
-    pub reflection_depth: u32,
-    /// A node of the reflection tree whose power bound (004 Eq. 4.6, made
-    /// a bound) is under this fraction of the emitted power is cut
-    /// (written only where not the default).
-    #[serde(skip_serializing_if = "is_default_threshold")]
-    pub reflection_threshold: f64,
-    /// Adaptive subdivision at shadow boundaries (off: `None`, and then
-    /// not written, so the artifacts of a run without it keep their bits).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub adaptive: Option<Adaptive>,
+stage_kit::show_by_name!(Visibility);
+
+stage_kit::knobs! {
+    /// The stage's parameters.
+    pub struct Params {
+        /// Covered texels to aim for over the whole scene.
+        texels: f64 = 32768.0, "texels", value(at_least(1.0));
+        /// Smallest side of a triangle's lightmap region.
+        min_size: u32 = 2, "texels", value(2..=4096);
+        /// Largest side of a triangle's lightmap region (at least `min_size`).
+        max_size: u32 = 512, "texels", value(2..=4096);
+        /// Substructuring: shoot from groups of `2^level` x `2^level` texels.
+        shoot_level: u32 = 3, "", value(0..=8);
+        /// How visibility from a shooting sample is found: `hemicube` or
+        /// `stereographic`.
+        visibility: Visibility = Visibility::Hemicube, "", value;
+        /// Side of a hemicube face / the stereographic map.
+        resolution: u32 = 128, "pixels", value(8..=2048);
+        /// Relative depth tolerance of the visibility test.
+        tolerance: f64 = 0.02, "", value(custom("in [0, 0.5)", |v: &f64| (0.0..0.5).contains(v)));
+        /// Ambient overshooting (004 Eq. 4.9); off by default, because
+        /// counted by `sum |dB| A` it converges slower (Cornell box, 8000
+        /// texels, to 99%: 1032 shots against 121).
+        overshoot: bool = false, "", switch;
+        /// Stop when the unshot power, `sum |dB| A` (negative residuals
+        /// left by overshooting count by magnitude), is at most 1 - this of
+        /// the emitted power.
+        convergence_target: f64 = 0.99, "fraction of emitted power", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
+        /// Stop after this many shots.
+        max_shots: usize = 100_000, "shots", value;
+        /// Add rho x ambient to the solution's radiosity (004 Eq. 2.4): a
+        /// display aid for an unconverged solution; in an open scene it adds
+        /// light that is not there.
+        // Off by default: the ambient term spreads the unshot power over the
+        // scene as if it were closed (paper 002's one-bounce receiver got
+        // +6.3% flux, 1.3% without it), so a converged solution would be
+        // biased. Ambient overshooting (`overshoot`) is unaffected.
+        ambient: bool = false, "", switch;
+        /// Texels per solution leaf, about.
+        texels_per_leaf: f64 = 4.0, "texels", value(at_least(1.0));
+        /// Most windows (planar mirrors and thin panes, 004 Sec.
+        /// 4.3.2-4.3.3) on a light path of the reflection tree.
+        // Written only where not the default, so the artifacts of a run
+        // without it keep their bits (as reflection_threshold, adaptive).
+        #[serde(skip_serializing_if = "is_default_depth")]
+        reflection_depth: u32 = REFLECTION_DEPTH, "windows", value(1..=16);
+        /// Cut a node of the reflection tree whose power bound (004 Eq. 4.6,
+        /// made a bound) is under this fraction of the emitted power.
+        #[serde(skip_serializing_if = "is_default_threshold")]
+        reflection_threshold: f64 = REFLECTION_THRESHOLD, "fraction of emitted power", value(custom("in [0, 1)", |v: &f64| (0.0..1.0).contains(v)));
+        /// Adaptive subdivision at shadow boundaries (004 Sec. 2.4; not with
+        /// `--lightmap`).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        adaptive: Option<Adaptive> = None, "", group;
+    }
 }
 
-/// Adaptive subdivision at shadow boundaries (004 Sec. 2.4): before a
-/// triangle first shoots, every receiving tile whose visible fraction
-/// `n_v / n_r` (texel-sample pairs the visibility maps see over those
-/// facing each other) lies in `[lower, upper]` is split 1:4, up to
-/// `levels` times per input triangle.
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct Adaptive {
-    /// `b_l`: a smaller visible fraction is a receiver in shadow but for
-    /// a short boundary, not split.
-    pub lower: f64,
-    /// `b_u`: a larger one is lit but for a short boundary, not split.
-    pub upper: f64,
-    /// Most 1:4 splits of an input triangle.
-    pub levels: u32,
-}
-
-impl Default for Adaptive {
-    fn default() -> Self {
-        Adaptive { lower: 0.05, upper: 0.95, levels: 3 }
+stage_kit::knobs! {
+    /// Adaptive subdivision at shadow boundaries (004 Sec. 2.4): before a
+    /// triangle first shoots, every receiving tile whose visible fraction
+    /// `n_v / n_r` (texel-sample pairs the visibility maps see over those
+    /// facing each other) lies in `[lower, upper]` is split 1:4, up to
+    /// `levels` times per input triangle.
+    pub struct Adaptive {
+        /// `b_l`: split a receiver whose visible fraction is at least this
+        /// (one less is in shadow but for a short boundary).
+        lower: f64 = 0.05, "visible fraction", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
+        /// `b_u`: ... and at most this (one more is lit but for a short
+        /// boundary; at least `lower`).
+        upper: f64 = 0.95, "visible fraction", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
+        /// Most 1:4 splits of an input triangle.
+        levels: u32 = 3, "splits", value(0..=8);
     }
 }
 
@@ -180,67 +170,17 @@ fn is_default_threshold(threshold: &f64) -> bool {
     *threshold == REFLECTION_THRESHOLD
 }
 
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            texels: 32768.0,
-            min_size: 2,
-            max_size: 512,
-            shoot_level: 3,
-            visibility: Visibility::Hemicube,
-            resolution: 128,
-            tolerance: 0.02,
-            overshoot: false,
-            convergence_target: 0.99,
-            max_shots: 100_000,
-            ambient: false,
-            texels_per_leaf: 4.0,
-            reflection_depth: REFLECTION_DEPTH,
-            reflection_threshold: REFLECTION_THRESHOLD,
-            adaptive: None,
-        }
-    }
-}
-
 impl Params {
-    /// What is wrong with these parameters, if anything.
-    pub fn problem(&self) -> Option<String> {
-        if !(self.texels.is_finite() && self.texels >= 1.0) {
-            return Some(format!("texels must be at least 1, got {}", self.texels));
+    /// What the knobs' ranges do not say, if anything is wrong:
+    /// `min_size <= max_size`, and the adaptive bounds `lower <= upper`.
+    pub fn conflict(&self) -> Option<String> {
+        if self.max_size < self.min_size {
+            return Some(format!("max_size must be at least min_size ({}), not {}", self.min_size, self.max_size));
         }
-        if self.min_size < 2 || self.max_size < self.min_size || self.max_size > 4096 {
-            return Some(format!("need 2 <= min_size <= max_size <= 4096, got {} and {}", self.min_size, self.max_size));
+        match &self.adaptive {
+            Some(a) if a.lower > a.upper => Some(format!("adaptive.upper must be at least adaptive.lower ({}), not {}", a.lower, a.upper)),
+            _ => None,
         }
-        if self.shoot_level > 8 {
-            return Some(format!("shoot_level must be at most 8, got {}", self.shoot_level));
-        }
-        if !(8..=2048).contains(&self.resolution) {
-            return Some(format!("resolution must be in 8..=2048, got {}", self.resolution));
-        }
-        if !(self.tolerance.is_finite() && (0.0..0.5).contains(&self.tolerance)) {
-            return Some(format!("tolerance must be in [0, 0.5), got {}", self.tolerance));
-        }
-        if !(self.convergence_target.is_finite() && (0.0..=1.0).contains(&self.convergence_target)) {
-            return Some(format!("convergence_target must be in [0, 1], got {}", self.convergence_target));
-        }
-        if !(self.texels_per_leaf.is_finite() && self.texels_per_leaf >= 1.0) {
-            return Some(format!("texels_per_leaf must be at least 1, got {}", self.texels_per_leaf));
-        }
-        if !(1..=16).contains(&self.reflection_depth) {
-            return Some(format!("reflection_depth must be in 1..=16, got {}", self.reflection_depth));
-        }
-        if !(self.reflection_threshold.is_finite() && (0.0..1.0).contains(&self.reflection_threshold)) {
-            return Some(format!("reflection_threshold must be in [0, 1), got {}", self.reflection_threshold));
-        }
-        if let Some(a) = &self.adaptive {
-            if !(0.0 <= a.lower && a.lower <= a.upper && a.upper <= 1.0) {
-                return Some(format!("adaptive bounds need 0 <= lower <= upper <= 1, got {} and {}", a.lower, a.upper));
-            }
-            if a.levels > 8 {
-                return Some(format!("adaptive levels must be at most 8, got {}", a.levels));
-            }
-        }
-        None
     }
 }
 
