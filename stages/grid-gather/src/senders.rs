@@ -64,6 +64,10 @@ pub struct Senders<'a> {
     /// Per cluster: cumulative area over its triangles (in `order`), built
     /// on first use.
     cluster_cdf: Vec<OnceLock<Vec<f64>>>,
+    /// Per cluster: its first [`CLUSTER_FACTOR_SAMPLES`] fixed samples,
+    /// built on first use. Every form factor to a cluster sums the kernel
+    /// over them; drawing them anew each time was most of that cost.
+    cluster_factor_samples: Vec<OnceLock<Vec<SenderSample>>>,
     /// Triangles binned in a uniform grid over the scene's box.
     bins: Vec<Vec<u32>>,
     bin_box: Aabb,
@@ -95,11 +99,12 @@ impl<'a> Senders<'a> {
             }
         }
         let cluster_cdf = (0..clusters.map_or(0, |c| c.nodes.len())).map(|_| OnceLock::new()).collect();
+        let cluster_factor_samples = (0..clusters.map_or(0, |c| c.nodes.len())).map(|_| OnceLock::new()).collect();
         let bin_box = Aabb::around(triangles.iter().flat_map(|t| t.corners));
         let bin_n = ((triangles.len() as f64).cbrt() * 2.0).ceil().clamp(1.0, 64.0) as usize;
         let corners = solution.elements.iter().map(|el| triangles[el.triangle as usize].element(&el.corners.map(|c| c.map(f64::from)))).collect();
         let mut senders =
-            Senders { triangles, solution, clusters, links_of, corners, leaf_cluster, cluster_cdf, bins: vec![Vec::new(); bin_n.pow(3)], bin_box, bin_n, seed };
+            Senders { triangles, solution, clusters, links_of, corners, leaf_cluster, cluster_cdf, cluster_factor_samples, bins: vec![Vec::new(); bin_n.pow(3)], bin_box, bin_n, seed };
         for (t, tri) in triangles.iter().enumerate() {
             let b = Aabb::around(tri.corners);
             let (lo, hi) = (senders.bin(b.min), senders.bin(b.max));
@@ -331,12 +336,14 @@ impl<'a> Senders<'a> {
     pub fn form_factor(&self, node: Node, p: DVec3, normal: DVec3) -> (f64, u64) {
         match node {
             Node::Element(e) => (point_to_one_sided_polygon(p, normal, &self.element_corners(e), self.triangles[self.solution.elements[e as usize].triangle as usize].normal), 1),
-            Node::Cluster(_) => {
+            Node::Cluster(c) => {
                 let area = self.area(node);
                 let k = CLUSTER_FACTOR_SAMPLES;
+                // A cluster the hierarchy does not hold has no triangles.
+                let Some(cache) = self.cluster_factor_samples.get(c as usize) else { return (0.0, k as u64) };
+                let samples = cache.get_or_init(|| (0..k).map(|s| self.sample(node, s)).collect());
                 let mut sum = 0.0;
-                for s in 0..k {
-                    let sample = self.sample(node, s);
+                for &sample in samples {
                     if sample.triangle == NONE {
                         continue;
                     }
