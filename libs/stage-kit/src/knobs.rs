@@ -70,25 +70,6 @@ pub trait Knobs: Serialize + DeserializeOwned + Default + Clone + Debug + Send +
 /// What [`Knobs::check`] returns (named here for the macro's use).
 pub type Checked = Result<()>;
 
-/// A stage without knobs.
-#[derive(Serialize, serde::Deserialize, Clone, Debug, Default, PartialEq)]
-pub struct NoKnobs {}
-
-impl Knobs for NoKnobs {
-    fn flags(cmd: Command, _prefix: &str) -> Command {
-        cmd
-    }
-    fn overlay(&mut self, _given: &ArgMatches, _prefix: &str) -> bool {
-        false
-    }
-    fn check(&self, _prefix: &str) -> Result<()> {
-        Ok(())
-    }
-    fn rows(_prefix: &str) -> Vec<Spec> {
-        Vec::new()
-    }
-}
-
 /// The markdown table of `P`'s knobs: knob, flag, meaning, unit, range,
 /// default; one row per knob, a header and its rule first.
 pub fn table<P: Knobs>() -> String {

@@ -6,12 +6,12 @@ use schemas::atomic::Staged;
 use schemas::error::{Error, Result};
 use schemas::header::{Input, Provenance};
 use schemas::report::Report;
-use schemas::ron_io::{parse_ron, read_bytes, to_ron_text, write_ron};
+use schemas::ron_io::{parse_ron, read_bytes, write_ron};
 use schemas::header::Schema;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use crate::knobs::{Knobs, NoKnobs};
+use crate::knobs::Knobs;
 use clap::{Arg, ArgAction, ArgMatches};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
@@ -20,10 +20,9 @@ use std::time::Instant;
 
 /// The options every stage binary has, with one flag per knob of `P` (see
 /// [`crate::knobs`](mod@crate::knobs)): [`crate::stage::main`] adds them to a stage's own
-/// `Args`. (A stage not yet run by the kit flattens `StageArgs` into its
-/// `Args` itself, without knobs.)
-#[derive(Debug, Clone, Default)]
-pub struct StageArgs<P = NoKnobs> {
+/// `Args`.
+#[derive(Debug, Clone)]
+pub struct StageArgs<P> {
     /// Output: a report of the run.
     pub report: Option<PathBuf>,
     /// The `--params` file.
@@ -179,7 +178,7 @@ impl Run {
 
 /// The stage's parameters: defaults, or the `--params` file (strict: an
 /// unknown field is an error naming the file and line).
-pub fn load_params<P: DeserializeOwned + Default>(path: Option<&Path>) -> Result<P> {
+fn load_params<P: DeserializeOwned + Default>(path: Option<&Path>) -> Result<P> {
     match path {
         None => Ok(P::default()),
         Some(path) => {
@@ -188,12 +187,6 @@ pub fn load_params<P: DeserializeOwned + Default>(path: Option<&Path>) -> Result
             parse_ron(path, text)
         }
     }
-}
-
-/// Prints the effective parameters as RON on stdout, in a form `--params`
-/// reads back.
-pub fn print_params<P: Serialize>(params: &P) {
-    println!("{}", to_ron_text(params));
 }
 
 /// Runs a stage's body and turns its outcome into the process exit code;

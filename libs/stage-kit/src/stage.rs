@@ -2,7 +2,7 @@
 //! says only what is particular to it: its files ([`Stage::files`]) and
 //! its work ([`Stage::run`]).
 //!
-//! [`main`] parses the command line ([`crate::cli::main_of`]: one-line
+//! [`main`] parses the command line ([`crate::cli::main_with`]: one-line
 //! errors, exit 2), prints the knob table for `--print-knobs` (hidden, for
 //! the README), settles the effective parameters (`--params`, the knobs'
 //! flags, their ranges, [`Stage::settle`]), prints them for
@@ -15,7 +15,7 @@
 use crate::cli::{check_outputs, main_with};
 use clap::{Args, FromArgMatches};
 use crate::knobs::{table, Knobs};
-use crate::run::{bad_parameter, print_params, read_prepared, Outputs, Run, StageArgs};
+use crate::run::{bad_parameter, read_prepared, Outputs, Run, StageArgs};
 use schemas::error::Result;
 use schemas::mesh::{Manifest, Mesh};
 use std::collections::BTreeMap;
@@ -92,7 +92,8 @@ fn run<S: Stage>(stage: S, common: &StageArgs<S::Params>, name: String, version:
     let mut params = common.knobs()?;
     stage.settle(&mut params)?;
     if common.print_params {
-        print_params(&params);
+        // RON, in the form `--params` reads back.
+        println!("{}", schemas::ron_io::to_ron_text(&params));
         return Ok(ExitCode::SUCCESS);
     }
     let report = common.report.clone();
