@@ -335,10 +335,11 @@ impl FullGather<'_> {
             let n = (share.round() as u32).clamp(p.min_samples, p.samples.max(p.min_samples)); // Eq. 1
             let (mut f_sum, mut f_min, mut f_max) = (0.0, f64::INFINITY, 0.0f64);
             let mut visible = WeightedVisibility::default();
+            let samples = self.senders.samples(node);
             for k in 0..n as usize {
                 let g: [f64; 3] = std::array::from_fn(|a| lo[a] + (hi[a] - lo[a]) * stream.next_f64());
                 let x = self.grid.point(g);
-                let y = self.senders.sample(node, k);
+                let y = samples.at(k);
                 let toward = (centre - x).normalize_or_zero();
                 let (f, evals) = self.senders.form_factor(node, x, toward);
                 data.factors += evals;

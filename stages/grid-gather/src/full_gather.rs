@@ -151,8 +151,9 @@ impl<'a> FullGather<'a> {
         }
         let mut visible = WeightedVisibility::default();
         let first = pass as usize * n as usize;
+        let samples = self.senders.samples(node);
         for k in first..first + n as usize {
-            let y = self.senders.sample(node, k);
+            let y = samples.at(k);
             let weight = self.sample_weight(p, normal, y);
             if weight > 0.0 {
                 work.visibility_rays += 1;

@@ -289,40 +289,19 @@ impl<'a> Senders<'a> {
 
     /// Fixed sample `k` on `node` (the same point for every caller).
     pub fn sample(&self, node: Node, k: usize) -> SenderSample {
+        self.samples(node).at(k)
+    }
+
+    /// The fixed samples of `node`, with the sender's shift drawn once for
+    /// a loop over several of them.
+    pub fn samples(&self, node: Node) -> SenderSamples<'_> {
         let key = match node {
             Node::Element(e) => u64::from(e),
             Node::Cluster(c) => u64::from(c) | 1 << 40,
         };
         let mut rotation = Stream::new(self.seed, key, 0x5e4d);
         let shift = [0, 1].map(|_| (rotation.next_f64() * 4_294_967_296.0) as u32);
-        let [u, v] = sobol_02(k as u32, shift);
-        match node {
-            Node::Element(e) => {
-                let corners = self.element_corners(e);
-                let b = square_to_triangle(u, v);
-                SenderSample { point: corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2], triangle: self.solution.elements[e as usize].triangle }
-            }
-            Node::Cluster(c) => {
-                let tris = self.triangles_of(node);
-                if tris.is_empty() {
-                    return SenderSample { point: self.centre(node), triangle: NONE };
-                }
-                let third = (radical_inverse(k as u64 + 1, 3) + rotation.next_f64()).fract();
-                let cdf = self.cluster_cdf[c as usize].get_or_init(|| {
-                    let mut acc = 0.0;
-                    tris.iter().map(|&t| {
-                        acc += self.triangles[t as usize].area;
-                        acc
-                    }).collect()
-                });
-                let total = *cdf.last().unwrap_or(&0.0);
-                let x = third * total;
-                let i = cdf.partition_point(|&a| a <= x).min(tris.len() - 1);
-                let t = &self.triangles[tris[i] as usize];
-                let b = square_to_triangle(u, v);
-                SenderSample { point: t.corners[0] * b[0] + t.corners[1] * b[1] + t.corners[2] * b[2], triangle: tris[i] }
-            }
-        }
+        SenderSamples { senders: self, node, shift, third_shift: rotation.next_f64() }
     }
 
     /// Form factor from a differential area at `p` with unit normal
@@ -341,7 +320,10 @@ impl<'a> Senders<'a> {
                 let k = CLUSTER_FACTOR_SAMPLES;
                 // A cluster the hierarchy does not hold has no triangles.
                 let Some(cache) = self.cluster_factor_samples.get(c as usize) else { return (0.0, k as u64) };
-                let samples = cache.get_or_init(|| (0..k).map(|s| self.sample(node, s)).collect());
+                let samples = cache.get_or_init(|| {
+                    let set = self.samples(node);
+                    (0..k).map(|s| set.at(s)).collect()
+                });
                 let mut sum = 0.0;
                 for &sample in samples {
                     if sample.triangle == NONE {
@@ -390,6 +372,50 @@ impl<'a> Senders<'a> {
                 }
             }
             (Node::Element(_), Node::Cluster(_)) => false,
+        }
+    }
+}
+
+/// One sender's fixed samples ([`Senders::samples`]): its digital shift of
+/// the Sobol points and, for a cluster, the shift of the third coordinate.
+pub struct SenderSamples<'a> {
+    senders: &'a Senders<'a>,
+    node: Node,
+    shift: [u32; 2],
+    third_shift: f64,
+}
+
+impl SenderSamples<'_> {
+    /// Fixed sample `k` (module docs).
+    pub fn at(&self, k: usize) -> SenderSample {
+        let senders = self.senders;
+        let [u, v] = sobol_02(k as u32, self.shift);
+        match self.node {
+            Node::Element(e) => {
+                let corners = senders.element_corners(e);
+                let b = square_to_triangle(u, v);
+                SenderSample { point: corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2], triangle: senders.solution.elements[e as usize].triangle }
+            }
+            Node::Cluster(c) => {
+                let tris = senders.triangles_of(self.node);
+                if tris.is_empty() {
+                    return SenderSample { point: senders.centre(self.node), triangle: NONE };
+                }
+                let third = (radical_inverse(k as u64 + 1, 3) + self.third_shift).fract();
+                let cdf = senders.cluster_cdf[c as usize].get_or_init(|| {
+                    let mut acc = 0.0;
+                    tris.iter().map(|&t| {
+                        acc += senders.triangles[t as usize].area;
+                        acc
+                    }).collect()
+                });
+                let total = *cdf.last().unwrap_or(&0.0);
+                let x = third * total;
+                let i = cdf.partition_point(|&a| a <= x).min(tris.len() - 1);
+                let t = &senders.triangles[tris[i] as usize];
+                let b = square_to_triangle(u, v);
+                SenderSample { point: t.corners[0] * b[0] + t.corners[1] * b[1] + t.corners[2] * b[2], triangle: tris[i] }
+            }
         }
     }
 }

@@ -111,11 +111,12 @@ impl FullGather<'_> {
                     continue;
                 }
                 let link = &solution.links[l];
+                let samples = self.senders.samples(link.sender);
                 let mut visible = WeightedVisibility::default();
                 for j in 0..m as usize {
                     let b = square_to_triangle(points.next_f64(), points.next_f64());
                     let x = corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2];
-                    let y = self.senders.sample(link.sender, j);
+                    let y = samples.at(j);
                     let weight = self.sample_weight(x, normal, y);
                     if weight > 0.0 {
                         check.rays += 1;
