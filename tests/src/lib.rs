@@ -7,6 +7,7 @@
 //! runs before the tests.
 
 pub mod fuzz;
+pub mod stages;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

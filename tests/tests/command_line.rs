@@ -2,10 +2,8 @@
 //! `--print-params` and the flags, one-line usage errors, outputs that never
 //! overwrite inputs, bounded image sizes.
 
+use end_to_end::stages::stages;
 use end_to_end::{assert_refused, run, run_ok, s, scratch};
-
-/// Every stage with parameters.
-const STAGES: [&str; 9] = ["mesh-prep", "cluster", "hierarchical-solve", "gpu-shoot", "grid-gather", "mask", "tonemap", "compare", "export-mitsuba"];
 
 /// The top-level fields of `--print-params` output (`  name: value,`).
 fn params(stage: &str, flags: &[&str]) -> Option<Vec<(String, String)>> {
@@ -55,7 +53,7 @@ fn other_values(value: &str) -> Vec<String> {
 /// a knob with no flag, fails here.
 #[test]
 fn every_parameter_has_a_flag_of_its_name_that_sets_it() {
-    for stage in STAGES {
+    for stage in &stages() {
         let defaults = params(stage, &[]).unwrap_or_else(|| panic!("{stage} --print-params fails"));
         let flags = flags(stage);
         for (name, value) in &defaults {
@@ -93,8 +91,8 @@ fn refused(stage: &str, args: &[&str], needles: &[&str]) {
 
 #[test]
 fn bad_flags_get_one_line_errors() {
-    for stage in STAGES {
-        refused(stage, &["--no-such-flag"], &[stage, "--no-such-flag"]);
+    for stage in &stages() {
+        refused(stage, &["--no-such-flag"], &[stage.as_str(), "--no-such-flag"]);
     }
     refused("hierarchical-solve", &["--print-params", "--eps", "-1"], &["eps", "-1"]);
     refused("hierarchical-solve", &["--print-params", "--eps", "x"], &["--eps", "'x'"]);

@@ -5,10 +5,7 @@
 //! row fails here.
 
 use end_to_end::run_ok;
-
-/// The stages whose knobs are declared with `stage_kit::knobs!` (a
-/// converted stage joins with one line).
-const STAGES: [&str; 10] = ["cluster", "tonemap", "mask", "structured-sample", "mesh-prep", "photon-trace", "grid-gather", "export-mitsuba", "hierarchical-solve", "gpu-shoot"];
+use end_to_end::stages::stages;
 
 /// The README's table for `stage`: the lines between its two markers.
 fn readme_table(readme: &str, stage: &str) -> Option<String> {
@@ -22,7 +19,7 @@ fn readme_table(readme: &str, stage: &str) -> Option<String> {
 fn every_readme_knob_table_is_its_stage_declaration() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md");
     let readme = std::fs::read_to_string(path).unwrap();
-    for stage in STAGES {
+    for stage in &stages() {
         let declared = String::from_utf8(run_ok(stage, &["--print-knobs"]).stdout).unwrap();
         assert!(declared.lines().count() >= 3, "{stage} --print-knobs printed no knob:\n{declared}");
         let documented = readme_table(&readme, stage).unwrap_or_else(|| panic!("README.md has no table between <!-- knobs: {stage} --> and <!-- /knobs -->"));
