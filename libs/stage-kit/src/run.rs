@@ -88,6 +88,8 @@ pub struct Run {
     started: Instant,
     inputs: Vec<Input>,
     outputs: Vec<PathBuf>,
+    /// The skipped notes already said on stderr ([`Run::say_skipped`]).
+    said: Vec<String>,
 }
 
 impl Run {
@@ -105,7 +107,7 @@ impl Run {
             let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, std::sync::Arc::default());
             schemas::atomic::remove_temporaries_on_interrupt();
         });
-        Run { stage: stage.into(), version: version.into(), started: Instant::now(), inputs: Vec::new(), outputs: Vec::new() }
+        Run { stage: stage.into(), version: version.into(), started: Instant::now(), inputs: Vec::new(), outputs: Vec::new(), said: Vec::new() }
     }
 
     /// Records the files this run writes (the kit does, after checking
@@ -123,6 +125,20 @@ impl Run {
         let inputs: Vec<Option<&Path>> = inputs.iter().map(|p| Some(*p)).collect();
         let outputs: Vec<Option<&Path>> = self.outputs.iter().map(|p| Some(p.as_path())).collect();
         crate::cli::check_outputs(&inputs, &outputs)
+    }
+
+    /// Says on stderr what the run does not simulate, one line
+    /// `<stage>: skipped: <note>` per note not said before: a stage that
+    /// would say it before long work calls this early, and
+    /// [`crate::stage::main`] calls it with [`crate::stage::Done::skipped`]
+    /// when the stage is done, so each note is said once, report or not.
+    pub fn say_skipped(&mut self, notes: &[String]) {
+        for note in notes {
+            if !self.said.contains(note) {
+                eprintln!("{}: skipped: {note}", self.stage);
+                self.said.push(note.clone());
+            }
+        }
     }
 
     /// Records an input file, refusing one that does not belong with the

@@ -8,9 +8,10 @@
 //! flags, their ranges, [`Stage::settle`]), prints them for
 //! `--print-params`, checks the outputs against the inputs before any work
 //! ([`crate::cli::check_outputs`], the report included), starts the
-//! [`Run`] (provenance, signal handlers), runs the stage, writes the
-//! report (`--report`) from what it returns ([`Done`]) and puts every
-//! output in place at once ([`Outputs::keep`]).
+//! [`Run`] (provenance, signal handlers), runs the stage, says on stderr
+//! what it skipped ([`Run::say_skipped`]), writes the report (`--report`)
+//! from what it returns ([`Done`]) and puts every output in place at once
+//! ([`Outputs::keep`]).
 
 use crate::cli::{check_outputs, main_with};
 use clap::{Args, FromArgMatches};
@@ -56,7 +57,8 @@ pub trait Stage: clap::Parser {
 pub struct Done {
     /// Work counters.
     pub counters: BTreeMap<String, f64>,
-    /// What was skipped, and why.
+    /// What was skipped, and why (the report's `skipped`, and said on
+    /// stderr by the kit: [`Run::say_skipped`]).
     pub skipped: Vec<String>,
     /// Anything else worth a line.
     pub notes: Vec<String>,
@@ -103,6 +105,7 @@ fn run<S: Stage>(stage: S, common: &StageArgs<S::Params>, name: String, version:
     let mut run = Run::start(name, version).writing(&outputs);
     let mut outputs = Outputs::new();
     let done = stage.run(&params, &mut run, &mut outputs)?;
+    run.say_skipped(&done.skipped);
     if let Some(report) = &report {
         outputs.write(report, |p| run.write_report(p, &params, done.counters, done.skipped, done.notes))?;
     }

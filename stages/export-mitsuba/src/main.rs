@@ -49,9 +49,6 @@ impl Stage for Args {
         let provenance = schemas::ron_io::to_ron_text(&run.provenance(params));
         let exported = export(&mesh, &manifest, params, &folder_name, &provenance);
         files::write(&exported, &folder, output, outputs)?;
-        for line in &exported.skipped {
-            eprintln!("export-mitsuba: not exported: {line}");
-        }
         let (triangles, (w, h)) = (mesh.triangles.len(), exported.film);
         eprintln!("export-mitsuba: {triangles} triangles in {} PLY meshes, {} area emitters, film {w}x{h}", exported.meshes.len(), exported.emitters);
         let mut done = Done::counted([

@@ -98,7 +98,6 @@ impl Stage for Args {
         }
         let notes: Vec<String> = back_face_warning(&rendered.counters).into_iter().collect();
         notes.iter().for_each(|note| eprintln!("grid-gather: warning: {note}"));
-        rendered.skipped.iter().for_each(|note| eprintln!("grid-gather: skipped: {note}"));
         Ok(Done { counters: rendered.counters, skipped: rendered.skipped, notes, negative: false })
     }
 }

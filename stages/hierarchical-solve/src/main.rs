@@ -67,7 +67,6 @@ impl Stage for Args {
         done.notes.iter().for_each(|note| eprintln!("hierarchical-solve: warning: {note}"));
         let solution = Solution { header: Solution::header(run.provenance(params)), elements: solved.elements, clusters: solved.clusters, links: solved.links };
         outputs.write(required(&self.output, "-o")?, |p| solution.write(p))?;
-        done.skipped.iter().for_each(|note| eprintln!("hierarchical-solve: skipped: {note}"));
         Ok(done)
     }
 }

@@ -51,9 +51,8 @@ impl stage_kit::stage::Stage for Args {
         }
         let (mesh, manifest) = self.scene.read(run)?;
         let skipped = skipped(&manifest.effects);
-        for note in &skipped {
-            eprintln!("photon-trace: skipped: {note}");
-        }
+        // Said now, before the photons, not only when they are done.
+        run.say_skipped(&skipped);
         let header = Solution::header(run.provenance(params));
         let bar = progress(params.max_photons, "photons");
         let mut on_progress = |p: &Progress| {
