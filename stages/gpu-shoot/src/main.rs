@@ -1,11 +1,8 @@
 //! `gpu-shoot`: see the library's documentation and `--help`.
 
 use clap::Parser;
-use gpu_shoot::{convergence, gpu, output, solve, Params};
-use schemas::header::Schema;
-use schemas::lightmap::{Convergence, Lightmap};
-use schemas::ron_io::write_ron;
-use schemas::solution::Solution;
+use gpu_shoot::output::Artifacts;
+use gpu_shoot::{gpu, solve, Params};
 use schemas::Error;
 use stage_kit::run::{bad_parameter, progress, read_surface, Outputs, Run};
 use stage_kit::stage::{required, Done, SceneArgs, Stage};
@@ -63,14 +60,8 @@ impl Stage for Args {
     fn run(self, params: &Params, run: &mut Run, outputs: &mut Outputs) -> schemas::Result<Done> {
         let (mesh, manifest) = self.scene.read(run)?;
         let (mesh_path, manifest_path) = (required(&self.scene.mesh, "--mesh")?, required(&self.scene.manifest, "--manifest")?);
-        let surface = match self.surface.as_ref().filter(|_| manifest.effects.surface_detail()) {
-            Some(path) => {
-                let (surface, input) = read_surface(path, mesh_path, &mesh, &manifest)?;
-                run.input(input)?;
-                Some(surface)
-            }
-            None => None,
-        };
+        let surface = self.surface.as_deref().filter(|_| manifest.effects.surface_detail()).map(|path| read_surface(path, mesh_path, &mesh, &manifest)).transpose()?;
+        let surface = surface.map(|(read, input)| run.input(input).map(|()| read)).transpose()?;
         let lights = stage_kit::scene::luminaires(&manifest.goniometric_lights).map_err(|m| Error::invalid(manifest_path, None, m))?;
         let (device, queue, info) = gpu::acquire().map_err(|m| Error::invalid(Path::new("gpu"), None, m))?;
         let adapter = gpu::describe(&info);
@@ -84,27 +75,9 @@ impl Stage for Args {
         .map_err(|m| Error::invalid(mesh_path, None, m))?;
         bar.finish_and_clear();
         eprintln!("gpu-shoot: {}", solved.summary(&adapter));
-        let provenance = run.provenance(params);
-        let lightmap = output::lightmap(&solved, &solved.tile_mesh(&mesh), Lightmap::header(provenance.clone()));
-        let ambient = params.ambient.then_some(solved.ambient);
-        let solution = output::solution(&lightmap, &mesh, &manifest, &solved.tiles, ambient, params.texels_per_leaf, Solution::header(provenance.clone()));
-        let convergence = solved.convergence(Convergence::header(provenance), &adapter);
-        outputs.write(required(&self.output, "-o")?, |p| solution.write(p))?;
-        if let Some(path) = &self.lightmap {
-            outputs.write(path, |p| lightmap.write(p))?;
-        }
-        if let Some(path) = &self.convergence_log {
-            outputs.write(path, |p| write_ron(p, &convergence))?;
-        }
-        if let Some(path) = &self.plot {
-            outputs.write_bytes(path, convergence::plot(&convergence).as_bytes())?;
-        }
-        let mut done = solved.done(&manifest.effects, surface.is_some());
-        done.notes.push(format!("adapter: {adapter}"));
-        if self.surface.is_some() && !manifest.effects.surface_detail() {
-            done.notes.push("surface.exr not read: the scene has no texture, alpha mask or normal map".into());
-        }
-        Ok(done)
+        let artifacts = Artifacts::of(&solved, &mesh, &manifest, params, run.provenance(params), &adapter);
+        artifacts.write(outputs, required(&self.output, "-o")?, self.lightmap.as_deref(), self.convergence_log.as_deref(), self.plot.as_deref())?;
+        Ok(solved.done(&manifest.effects, surface.is_some(), self.surface.is_some(), &adapter))
     }
 }
 

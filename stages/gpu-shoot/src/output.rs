@@ -1,19 +1,63 @@
 //! From the solved texels to the artifacts: the atlas image with seams
 //! filled (004 Sec. 2.3.1), bilinear lookup, and a `solution.exr` whose
 //! leaves average the atlas, so the preview gather renders it like a
-//! hierarchical solution.
+//! hierarchical solution; a run's artifacts ([`Artifacts`]) from them.
 
 use crate::atlas::{texel_point, Atlas};
 use crate::tiling::{from_root, to_root, Tile};
-use crate::Solved;
+use crate::{Params, Solved};
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
-use schemas::header::Header;
-use schemas::lightmap::{Lightmap, COVERED, FILLED};
+use schemas::header::{Header, Provenance, Schema};
+use schemas::lightmap::{Convergence, Lightmap, COVERED, FILLED};
 use schemas::mesh::{Manifest, Mesh};
+use schemas::ron_io::write_ron;
 use schemas::solution::{Element, Solution, NONE};
+use stage_kit::run::Outputs;
 use std::collections::HashMap;
+use std::path::Path;
+
+/// A run's artifacts, each stamped with the run's provenance: the
+/// solution, the lightmap atlas and the convergence record.
+pub struct Artifacts {
+    /// The solution whose leaves average the atlas ([`solution`]).
+    pub solution: Solution,
+    /// The atlas, seams filled ([`lightmap`]).
+    pub lightmap: Lightmap,
+    /// The unshot fraction shot by shot ([`Solved::convergence`]).
+    pub convergence: Convergence,
+}
+
+impl Artifacts {
+    /// The artifacts of `solved` (of `mesh` and `manifest`, with `params`:
+    /// `rho x ambient` added to the solution when `params.ambient`) on
+    /// `adapter`.
+    pub fn of(solved: &Solved, mesh: &Mesh, manifest: &Manifest, params: &Params, provenance: Provenance, adapter: &str) -> Artifacts {
+        let lightmap = lightmap(solved, &solved.tile_mesh(mesh), Lightmap::header(provenance.clone()));
+        let ambient = params.ambient.then_some(solved.ambient);
+        let solution = solution(&lightmap, mesh, manifest, &solved.tiles, ambient, params.texels_per_leaf, Solution::header(provenance.clone()));
+        let convergence = solved.convergence(Convergence::header(provenance), adapter);
+        Artifacts { solution, lightmap, convergence }
+    }
+
+    /// Writes the solution to `solution`, and the lightmap, the
+    /// convergence log and its plot ([`crate::convergence::plot`]) to
+    /// those of their paths that are given, through `outputs`.
+    pub fn write(&self, outputs: &mut Outputs, solution: &Path, lightmap: Option<&Path>, log: Option<&Path>, plot: Option<&Path>) -> schemas::Result<()> {
+        outputs.write(solution, |p| self.solution.write(p))?;
+        if let Some(path) = lightmap {
+            outputs.write(path, |p| self.lightmap.write(p))?;
+        }
+        if let Some(path) = log {
+            outputs.write(path, |p| write_ron(p, &self.convergence))?;
+        }
+        if let Some(path) = plot {
+            outputs.write_bytes(path, crate::convergence::plot(&self.convergence).as_bytes())?;
+        }
+        Ok(())
+    }
+}
 
 /// Fills the texels of every region that are not covered but that a
 /// bilinear lookup inside the triangle reads: two passes (004 Sec. 2.3.1

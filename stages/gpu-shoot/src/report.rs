@@ -19,8 +19,9 @@ impl Solved {
     }
 
     /// The report: the work's counters, and what the scene's `effects` ask
-    /// that the stage skips (`surface`: whether surface.exr was read).
-    pub fn done(&self, effects: &Effects, surface: bool) -> Done {
+    /// that the stage skips (`surface`: whether surface.exr was read); its
+    /// notes: the `adapter`, and surface.exr not read though `surface_given`.
+    pub fn done(&self, effects: &Effects, surface: bool, surface_given: bool, adapter: &str) -> Done {
         let w = &self.work;
         let (unshot, net) = self.final_unshot();
         let mut done = Done::counted([
@@ -52,6 +53,10 @@ impl Solved {
             ]);
         }
         done.skipped = skipped(effects, surface, w.one_sided_translucent);
+        done.notes.push(format!("adapter: {adapter}"));
+        if surface_given && !effects.surface_detail() {
+            done.notes.push("surface.exr not read: the scene has no texture, alpha mask or normal map".into());
+        }
         done
     }
 }
