@@ -44,6 +44,7 @@ pub mod classification;
 pub mod contrast;
 pub mod detail;
 pub mod diagnostics;
+pub mod files;
 pub mod film;
 pub mod full_image;
 pub mod full_gather;

@@ -2,16 +2,10 @@
 //! library docs and `grid-gather --help`.
 
 use clap::Parser;
-use grid_gather::detail::Detail;
-use grid_gather::{back_face_warning, gather_with, image_size, Extras, Mode, Params, Scene};
-use schemas::cluster::Clusters;
-use schemas::diagnostics::GatherDiagnostics;
-use schemas::header::Schema;
-use schemas::image::HdrImage;
-use schemas::solution::Solution;
-use schemas::threshold::ThresholdImage;
+use grid_gather::files::{Given, Written};
+use grid_gather::{gather_with, image_size, Mode, Params, Scene};
 use schemas::Result;
-use stage_kit::run::{bad_parameter, progress, read_surface, Outputs, Run};
+use stage_kit::run::{bad_parameter, progress, Outputs, Run};
 use stage_kit::stage::{required, Done, SceneArgs, Stage};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -71,34 +65,17 @@ impl Stage for Args {
     fn run(self, params: &Params, run: &mut Run, outputs: &mut Outputs) -> Result<Done> {
         let (mesh, manifest) = self.scene.read(run)?;
         let solution_path = required(&self.solution, "--solution")?;
-        let (solution, input) = Solution::read(solution_path)?;
-        run.input(input)?;
-        let clusters = self.clusters.as_deref().map(|path| Clusters::read(path, mesh.triangles.len()).and_then(|(c, input)| run.input(input).map(|_| c))).transpose()?;
-        let threshold = self.threshold.as_deref().map(|path| ThresholdImage::read(path).and_then(|(t, input)| run.input(input).map(|_| t))).transpose()?;
-        let surface = match &self.surface {
-            Some(path) if manifest.effects.surface_detail() => Some(read_surface(path, required(&self.scene.mesh, "--mesh")?, &mesh, &manifest)?),
-            _ => None,
-        };
-        // Recorded without the provenance it carries (the mesh's), so that
-        // a solution solved without it is not refused as another run's.
-        if let Some((_, input)) = &surface {
-            run.input(schemas::header::Input { made_by: None, ..input.clone() })?;
-        }
-        let detail = surface.as_ref().map(|(s, input)| Detail::new(s, &mesh, &manifest, Detail::solved_with(&solution, input)));
-        let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path: required(&self.scene.manifest, "--manifest")?, solution: &solution, solution_path };
-        let extras = Extras { clusters: clusters.as_ref(), threshold: threshold.as_ref(), detail: detail.as_ref() };
+        let given = Given { mesh: required(&self.scene.mesh, "--mesh")?, solution: solution_path, clusters: self.clusters.as_deref(), threshold: self.threshold.as_deref(), surface: self.surface.as_deref() };
+        let read = given.read(run, &mesh, &manifest)?;
+        let detail = read.detail(&mesh, &manifest);
+        let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path: required(&self.scene.manifest, "--manifest")?, solution: &read.solution, solution_path };
+        let extras = read.extras(detail.as_ref());
         let bar = progress(image_size(params, &manifest).1.into(), "rows");
         let rendered = gather_with(params, &scene, extras, &|rows| bar.inc(rows));
         bar.finish_and_clear();
         let (rendered, diagnostics) = rendered?;
-        let image = HdrImage { header: HdrImage::header(run.provenance(params)), width: rendered.width, height: rendered.height, rgb: rendered.rgb, coverage: rendered.coverage, surfaces: Some(rendered.surfaces) };
-        outputs.write(required(&self.output, "-o")?, |p| image.write(p))?;
-        if let (Some(path), Some(d)) = (&self.diagnostics, &diagnostics) {
-            outputs.write(path, |p| d.write(p, GatherDiagnostics::header(run.provenance(params))))?;
-        }
-        let notes: Vec<String> = back_face_warning(&rendered.counters).into_iter().collect();
-        notes.iter().for_each(|note| eprintln!("grid-gather: warning: {note}"));
-        Ok(Done { counters: rendered.counters, skipped: rendered.skipped, notes, negative: false })
+        let written = Written { image: required(&self.output, "-o")?, diagnostics: self.diagnostics.as_deref() };
+        written.write(outputs, run, params, rendered, diagnostics.as_ref())
     }
 }
 
