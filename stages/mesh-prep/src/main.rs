@@ -3,6 +3,7 @@
 use clap::Parser;
 use mesh_prep::builtin::Builtin;
 use mesh_prep::obj::{Files, TextSource};
+use mesh_prep::report::files_read;
 use mesh_prep::{prepare, read_scene, Params, Recording};
 use stage_kit::run::{Outputs, Run};
 use stage_kit::stage::{required, Done, Stage};
@@ -58,17 +59,11 @@ impl Stage for Args {
         };
         let recording = Recording::new(source);
         let prepared = prepare(&read_scene(&recording, &scene_path)?, &scene_path, &recording, params)?;
-        for input in recording.into_inputs() {
-            run.input(input)?;
-        }
+        recording.into_inputs().into_iter().try_for_each(|input| run.input(input))?;
         let provenance = run.provenance(params);
-        // Every file the scene named (OBJ, MTL, textures, photometry) is an
-        // input too: none may be overwritten. A built-in scene's files are
-        // inside the binary, which the Makefile already lists.
-        let read: Vec<&str> = if self.builtin.is_some() { Vec::new() } else { provenance.inputs.iter().map(|i| i.path.as_str()).collect() };
-        run.check_outputs_against(&read.iter().map(Path::new).collect::<Vec<_>>())?;
-        let targets: Vec<String> = [Some(mesh_path), Some(manifest_path), self.surface.as_deref()].into_iter().flatten().map(|p| p.display().to_string()).collect();
-        let depfile = mesh_prep::depfile::rule(&targets.iter().map(String::as_str).collect::<Vec<_>>(), &read);
+        // The files the scene named are inputs too: none may be overwritten.
+        let (read, depfile) = files_read(&provenance, self.builtin.is_some(), &[Some(mesh_path), Some(manifest_path), self.surface.as_deref()]);
+        run.check_outputs_against(&read)?;
         let done = mesh_prep::report::summarise(&prepared);
         let surface = self.surface.as_ref().map(|_| prepared.surface_artifact(provenance.clone()));
         let (mesh, manifest) = prepared.into_artifacts(provenance);
