@@ -431,6 +431,15 @@ mod tests {
         assert!(run.input(surface("bbbb")).unwrap_err().to_string().starts_with("out/clusters.exr: does not belong with out/surface.exr"));
     }
 
+    #[test]
+    fn a_skipped_note_said_early_is_not_said_again() {
+        let mut run = Run::start("test", "0");
+        let notes = vec!["glossy reflection".to_string(), "refraction".to_string()];
+        run.say_skipped(&notes[..1]);
+        run.say_skipped(&notes);
+        assert_eq!(run.said, notes, "each note said once, in order");
+    }
+
     fn scratch(name: &str) -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("stage-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
