@@ -144,7 +144,7 @@ impl Run {
     /// Records an input file, refusing one that does not belong with the
     /// inputs recorded before it: where one of two inputs was made from an
     /// output of the stage that made the other, it must have been made from
-    /// that very file (see [`made_from_another`]). So a clusters file made
+    /// that very file (the check of `made_from_another`). So a clusters file made
     /// from another mesh than the one given, or a solution made from
     /// another run's manifest, is refused naming both files.
     pub fn input(&mut self, input: Input) -> Result<()> {
