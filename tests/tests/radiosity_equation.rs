@@ -192,9 +192,9 @@ fn open_box_leaves_satisfy_the_radiosity_equation() {
     check("radiosity_equation", false, 1.5e-3, 8.5e-3);
 }
 
-/// Measured (defaults, 3149 leaves): objects +0.02% to -0.13%; with
-/// senders' area means, -0.21% to -0.29%. The worst leaf, 8.2% (7.9%
-/// before), is one lit through a cluster link, whose factor is a 16-sample
+/// Measured (defaults, 3149 leaves): objects -0.045% to -0.112%; with
+/// senders' area means, -0.21% to -0.29%. The worst leaf, 5.1% (8.2% with
+/// a cluster's light pushed to all its triangles alike), is one lit through a cluster link, whose factor is a 16-sample
 /// estimate (hierarchical-solve's `transfer`): a spread of single leaves,
 /// not a bias of surfaces.
 #[test]

@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! G_n      = sum over links l into n of  V_l F_l B_{s(l)}        (irradiance, W/m²)
+//! G_t     += sum over links l into clusters above t of  V_l F_l sum_p w_tp B_p
 //! H_n      = G_n + H_{parent(n)}                                 (push down)
 //! B_leaf   = S_leaf + rho_leaf H_leaf,  S = E + rho D               (D: luminaires, crate::luminaires)
 //! B_inner  = sum over children c of (A_c / A_n) B_c              (pull up)
@@ -12,10 +13,12 @@
 //! repeated until a bound of the remaining error falls below `tolerance`
 //! times the largest radiosity ([`solve`]). `B_{s(l)}` of an inner element
 //! or cluster sender is, in the last pass, the kernel-weighted mean of its
-//! parts ([`SenderTerms`]), not their area mean. Irradiance gathered by a
-//! cluster is pushed to all its children alike (the isotropic push: the
-//! cluster's transfer was already averaged over its surfaces' real
-//! orientations, see [`crate::transfer`]); flux is conserved.
+//! parts ([`SenderTerms`]), not their area mean. The light of a
+//! link into a cluster of at most [`crate::receivers::MAX_RECEIVER_TRIANGLES`]
+//! triangles goes to each input triangle `t` below it by the triangle's own
+//! factor to each part `p` of the sender, `w_tp` ([`ReceiverTerms`]), not
+//! to all alike; the link's flux is conserved. A larger cluster still gathers its links and
+//! pushes their irradiance to all its children alike.
 //!
 //! Nodes are indexed densely, clusters first, then elements
 //! ([`Hierarchy::flat`]). A parent always has a smaller index than its
@@ -26,6 +29,7 @@
 use crate::elements::Hierarchy;
 use crate::links::Link;
 use crate::mirrors::Couplings;
+use crate::receivers::ReceiverTerms;
 use crate::rows::Rows;
 use radiometry::form_factor::point_to_one_sided_polygon;
 use rayon::prelude::*;
@@ -235,12 +239,14 @@ pub fn solve(
     max_iterations: usize,
     prior_rate: [f64; 3],
     senders: &SenderTerms,
+    receivers: &ReceiverTerms,
 ) -> Convergence {
     let n = b.len();
     let topology = Topology::new(h, n);
     // Each link's visibility-weighted form factor, once per solve.
     let coupling: Vec<f64> = links.iter().map(|l| l.form_factor * f64::from(l.visibility.unwrap_or(1.0))).collect();
-    let norm = max_norm(&topology, &coupling, offsets, specular);
+    let clusters = h.cluster_count();
+    let norm = max_norm(&topology, &coupling, offsets, specular, receivers, clusters);
     let mut h_down = vec![[0.0f64; 3]; n];
     let mut delta = vec![[0.0f64; 3]; n];
     let mut convergence =
@@ -252,10 +258,19 @@ pub fn solve(
             .map(|i| {
                 // Light through mirrors and glass (crate::mirrors).
                 let mut g = specular.map_or([0.0; 3], |s| s.gather(i, b));
-                for (l, &weight) in coupling.iter().enumerate().take(offsets[i + 1]).skip(offsets[i]) {
+                // A cluster's links light its triangles, each by its own
+                // weight (crate::receivers).
+                let own = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l));
+                let distributed = i.checked_sub(clusters).into_iter().flat_map(|t| receivers.of_triangle(t));
+                for l in own {
                     let sent = senders.radiosity(l, b);
                     for c in 0..3 {
-                        g[c] += weight * sent[c];
+                        g[c] += coupling[l] * sent[c];
+                    }
+                }
+                for (l, &(p, w)) in distributed {
+                    for c in 0..3 {
+                        g[c] += w * coupling[l] * b[p][c];
                     }
                 }
                 g
@@ -429,17 +444,7 @@ impl SenderTerms {
     fn of_link(h: &Hierarchy, l: &Link) -> Vec<(usize, f64)> {
         let whole = vec![(h.flat(l.sender), 1.0)];
         let Node::Element(r) = l.receiver else { return whole };
-        // The sender opened level by level (clusters down to their input
-        // triangles, elements to their children) while the parts are at
-        // most MAX_SENDER_PARTS.
-        let mut parts = vec![l.sender];
-        loop {
-            let next: Vec<Node> = parts.iter().flat_map(|&p| Some(h.children_if_any(p)).filter(|c| !c.is_empty()).unwrap_or_else(|| vec![p])).collect();
-            if next.len() == parts.len() || next.len() > MAX_SENDER_PARTS {
-                break;
-            }
-            parts = next;
-        }
+        let parts = h.parts(l.sender, MAX_SENDER_PARTS);
         let receiver = &h.elements[r as usize];
         let x = (receiver.points[0] + receiver.points[1] + receiver.points[2]) / 3.0;
         let n = h.normal(r);
@@ -586,15 +591,19 @@ impl Rate {
 }
 
 /// The max-norm of the iteration matrix per channel (see [`solve`]): the
-/// largest `rho_leaf sum V F` over the links into a leaf and its ancestors.
-fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: Option<&Couplings>) -> [f64; 3] {
+/// largest `rho_leaf sum V F` over the links into a leaf and its ancestors
+/// (a cluster's links counted on its input triangles, times their weights `w_tp`).
+fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: Option<&Couplings>, receivers: &ReceiverTerms, clusters: usize) -> [f64; 3] {
     let n = topology.parent.len();
     // Visibility-weighted factor sum into each node and its ancestors
     // (parents come first, one forward sweep).
     let mut chain = vec![0.0f64; n];
     let mut norm = [0.0f64; 3];
     for i in 0..n {
-        let own: f64 = coupling[offsets[i]..offsets[i + 1]].iter().sum::<f64>() + specular.map_or(0.0, |s| s.row_sum(i));
+        let own: f64 = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| coupling[l]).sum();
+        let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum());
+        let links = own + distributed;
+        let own = links + specular.map_or(0.0, |s| s.row_sum(i));
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
             for c in 0..3 {

@@ -55,6 +55,7 @@ pub mod links;
 pub mod luminaires;
 pub mod mirrors;
 pub mod nodes;
+pub mod receivers;
 pub mod report;
 pub mod rows;
 pub mod shaft;
@@ -431,14 +432,15 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // kernel (gather::SenderTerms), judged on the means' solution,
         // within the same iteration cap (a capped solve keeps the means).
         senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
-        let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders);
+        let receivers = receivers::ReceiverTerms::new(&h, &all_links);
+        let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders, &receivers);
         let left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
             senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation });
             work.resolved_links = senders.resolved();
             let means = convergence;
-            convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders);
+            convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
             work.iterations += means.iterations;
             work.extrapolations += means.extrapolations;
         }

@@ -137,6 +137,32 @@ impl Hierarchy {
         }
     }
 
+    /// The input triangles below a node: a cluster's, or an element's own.
+    pub fn triangles_below(&self, node: Node) -> &[u32] {
+        match node {
+            Node::Element(e) => std::slice::from_ref(&self.elements[e as usize].triangle),
+            Node::Cluster(c) => {
+                let tree = self.tree();
+                let n = &tree.clusters.nodes[c as usize];
+                &tree.clusters.order[n.first_triangle as usize..(n.first_triangle + n.triangle_count) as usize]
+            }
+        }
+    }
+
+    /// A node opened level by level (clusters down to their input
+    /// triangles, elements to their children) while its parts are at most
+    /// `most`.
+    pub fn parts(&self, node: Node, most: usize) -> Vec<Node> {
+        let mut parts = vec![node];
+        loop {
+            let next: Vec<Node> = parts.iter().flat_map(|&p| Some(self.children_if_any(p)).filter(|c| !c.is_empty()).unwrap_or_else(|| vec![p])).collect();
+            if next.len() == parts.len() || next.len() > most {
+                return parts;
+            }
+            parts = next;
+        }
+    }
+
     /// The `k`-th of `n` random points on a node: stratified on an element,
     /// area-weighted over the triangles of a cluster.
     pub fn sample(&self, node: Node, k: usize, n: usize, stream: &mut Stream) -> SurfacePoint {
