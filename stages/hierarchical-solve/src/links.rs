@@ -317,7 +317,7 @@ pub struct Floors {
 /// term a cluster holding a lamp and the dim ceiling around it sends the
 /// mean of the two to the floor, which the lamp sees better than the
 /// ceiling does: a closed box lost 2.7% of its energy at eps 5e-2.
-/// Between elements, see [`decide_elements`].
+/// Between elements, see `decide_elements` below.
 ///
 /// `allowance` says what the error is compared with: one threshold for all
 /// receivers, or a fraction of each receiver's radiosity ([`Allowance`]).
