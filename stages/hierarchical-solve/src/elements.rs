@@ -7,6 +7,7 @@ use crate::detail::Detail;
 use crate::cluster_tree::ClusterTree;
 use crate::transmission::Transmission;
 use glam::DVec3;
+use radiometry::form_factor::point_to_one_sided_polygon;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Manifest, Mesh};
@@ -104,6 +105,13 @@ impl Hierarchy {
     /// Opaque fraction of element `e` (1 without an alpha mask).
     pub fn coverage(&self, e: u32) -> f64 {
         self.detail.as_ref().map_or(1.0, |d| d.average(e).coverage)
+    }
+
+    /// Lambert's factor from point `x` (normal `n`) to element `e`'s opaque
+    /// part: the one-sided point-to-polygon factor (002 Eq. 3) times its
+    /// coverage (an alpha-masked element sends through its opaque fraction).
+    pub fn factor_to_element(&self, x: DVec3, n: DVec3, e: u32) -> f64 {
+        point_to_one_sided_polygon(x, n, &self.elements[e as usize].points, self.normal(e)) * self.coverage(e)
     }
 
     /// Unit front normal of element `e` (its triangle's).

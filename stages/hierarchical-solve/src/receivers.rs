@@ -39,7 +39,7 @@ use crate::elements::Hierarchy;
 use crate::links::Link;
 use crate::nodes::key;
 use crate::rows::Rows;
-use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon};
+use radiometry::form_factor::point_kernel;
 use radiometry::sampling::Stream;
 use rayon::prelude::*;
 use schemas::solution::Node;
@@ -107,7 +107,7 @@ fn weights(h: &Hierarchy, l: &Link) -> Vec<(u32, usize, f64)> {
         .map(|&t| {
             let g = &h.triangles[t as usize];
             let points = receiver_points(g);
-            let f = parts.iter().map(|p| points.iter().map(|&x| p.factor(x, g.normal)).sum::<f64>() / points.len() as f64).collect();
+            let f = parts.iter().map(|p| points.iter().map(|&x| p.factor(h, x, g.normal)).sum::<f64>() / points.len() as f64).collect();
             (h.area(Node::Element(t)), f)
         })
         .collect();
@@ -137,10 +137,10 @@ fn receiver_points(g: &radiometry::geometry::TriangleGeometry) -> Vec<glam::DVec
     parts.iter().map(|p| g.point([0, 1].map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0))).collect()
 }
 
-/// A sender part as a triangle's centroid sees it.
+/// A sender part, as a receiving triangle's points see it.
 enum Part {
-    /// An element: its corners, front normal and coverage.
-    Polygon([glam::DVec3; 3], glam::DVec3, f64),
+    /// An element.
+    Element(u32),
     /// A cluster: its area and points `(position, normal)` on its surfaces.
     Points(f64, Vec<(glam::DVec3, glam::DVec3)>),
 }
@@ -148,7 +148,7 @@ enum Part {
 impl Part {
     fn new(h: &Hierarchy, node: Node, seed: u64) -> Self {
         match node {
-            Node::Element(e) => Part::Polygon(h.elements[e as usize].points, h.normal(e), h.coverage(e)),
+            Node::Element(e) => Part::Element(e),
             Node::Cluster(_) => {
                 let mut stream = Stream::new(seed ^ 0x7ece_1e5e, key(node), 0);
                 let points = (0..CLUSTER_PART_SAMPLES).map(|k| h.sample(node, k, CLUSTER_PART_SAMPLES, &mut stream)).map(|p| (p.point, p.normal)).collect();
@@ -158,9 +158,9 @@ impl Part {
     }
 
     /// Factor from point `x` (normal `n`) to the part.
-    fn factor(&self, x: glam::DVec3, n: glam::DVec3) -> f64 {
+    fn factor(&self, h: &Hierarchy, x: glam::DVec3, n: glam::DVec3) -> f64 {
         match self {
-            Part::Polygon(points, normal, coverage) => point_to_one_sided_polygon(x, n, points, *normal) * coverage,
+            Part::Element(e) => h.factor_to_element(x, n, *e),
             Part::Points(area, points) => area * points.iter().map(|&(y, ny)| point_kernel(x, n, y, ny)).sum::<f64>() / (PI * points.len() as f64),
         }
     }

@@ -38,7 +38,7 @@
 
 use crate::elements::Hierarchy;
 use crate::nodes::key;
-use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon, WeightedVisibility};
+use radiometry::form_factor::{point_kernel, WeightedVisibility};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use schemas::solution::Node;
@@ -77,7 +77,7 @@ pub fn estimate(h: &Hierarchy, scene: Option<&SceneRays>, receiver: Node, sender
         let pair = (sender_area * point_kernel(x.point, x.normal, y.point, y.normal) / PI).min(1.0);
         let value = match sender {
             // An element's opaque part, by its coverage (crate::detail).
-            Node::Element(e) => point_to_one_sided_polygon(x.point, x.normal, &h.elements[e as usize].points, h.normal(e)) * h.coverage(e),
+            Node::Element(e) => h.factor_to_element(x.point, x.normal, e),
             Node::Cluster(_) => pair,
         };
         sum += value;
