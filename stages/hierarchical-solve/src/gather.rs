@@ -31,7 +31,6 @@ use crate::links::Link;
 use crate::mirrors::Couplings;
 use crate::receivers::ReceiverTerms;
 use crate::rows::Rows;
-use radiometry::form_factor::point_to_one_sided_polygon;
 use rayon::prelude::*;
 use schemas::solution::Node;
 
@@ -372,8 +371,13 @@ pub enum Senders<'a> {
 /// elements to their descendants, level by level while they are at most
 /// [`MAX_SENDER_PARTS`]) are weighted by their share of the kernel seen from
 /// an element receiver's centroid, Lambert's point-to-polygon factor (002
-/// Eq. 3, one-sided: the parts of a cluster that face away weigh nothing),
-/// not by their area. The two differ by the covariance over the sender of
+/// Eq. 3, one-sided: the parts of a cluster that face away weigh nothing)
+/// times the part's opaque fraction under an alpha mask
+/// ([`Hierarchy::factor_to_element`], as the link's own factor counts it:
+/// a part's radiosity is per opaque area, so a transparent part, radiosity
+/// 0, weighed by its geometry alone diluted what the opaque ones send, a
+/// receiver of an alpha-striped floor 0.41% dark in all, test
+/// `surface_solver.rs`), not by their area. The two differ by the covariance over the sender of
 /// the kernel and the radiosity, which has one sign wherever the parts of a
 /// sender nearer the receiver are brighter (or darker) than its mean, and
 /// so adds up over the links into a receiver instead of averaging out: on
@@ -451,7 +455,7 @@ impl SenderTerms {
         let mut terms = Vec::with_capacity(parts.len());
         for part in parts {
             let Node::Element(e) = part else { return whole };
-            terms.push((h.flat(part), point_to_one_sided_polygon(x, n, &h.elements[e as usize].points, h.normal(e))));
+            terms.push((h.flat(part), h.factor_to_element(x, n, e)));
         }
         let total: f64 = terms.iter().map(|t| t.1).sum();
         if terms.len() < 2 || total <= 0.0 || !total.is_finite() {
