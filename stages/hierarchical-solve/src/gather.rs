@@ -31,6 +31,8 @@ use crate::links::Link;
 use crate::mirrors::Couplings;
 use crate::receivers::ReceiverTerms;
 use crate::rows::Rows;
+use crate::visibility;
+use radiometry::rays::SceneRays;
 use rayon::prelude::*;
 use schemas::solution::Node;
 
@@ -339,8 +341,14 @@ pub const MAX_SENDER_PARTS: usize = 16;
 /// reflected radiosity.
 pub const UNIFORM_SENDER: f64 = 1e-3;
 
+/// Rays per part of a partly occluded link's sender for the part's own
+/// visibility ([`SenderTerms`]). On the built-in Cornell box at `EPS` 3e-3
+/// (full gather against Mitsuba): 2 rays 1.43% relative RMSE, 4 1.288%, 8
+/// 1.282%, 16 1.294%.
+pub const PART_VISIBILITY_RAYS: usize = 8;
+
 /// What radiosity a link's sender sends in a solve.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy)]
 pub enum Senders<'a> {
     /// The sender's area mean `B_s` (one term per link): enough to decide
     /// refinement, and the cheapest.
@@ -355,6 +363,10 @@ pub enum Senders<'a> {
         radiosity: &'a [[f64; 3]],
         /// Per element, its leaves' largest deviation from its radiosity.
         deviation: &'a [[f64; 3]],
+        /// The scene, for the parts' visibility.
+        scene: &'a SceneRays,
+        /// Seed of the parts' visibility rays.
+        seed: u64,
     },
 }
 
@@ -393,9 +405,23 @@ pub enum Senders<'a> {
 /// resolves senders: refinement needs the radiosity's shape, not this
 /// last fraction of a percent. Cluster receivers, leaf senders, clusters
 /// of more input triangles than that and links no part of which the
-/// receiver sees keep the sender's mean. The weights are geometric,
-/// computed once per solve, and sum to 1, so `||M||` and the stopping rule
-/// are unchanged.
+/// receiver sees keep the sender's mean. The weights are computed once per
+/// solve and sum to 1, so `||M||` and the stopping rule are unchanged.
+///
+/// **Partly occluded links weigh each part by its own visibility.** The
+/// transfer is `sum_j F_rj V_rj B_j` and the link carries `F_rs V_rs`, so
+/// where `0 < V_rs < 1` the weights are `w_j = F_rj V_rj / sum_k F_rk
+/// V_rk`, `V_rj` the kernel-weighted visible fraction between the receiver
+/// and part `j` ([`crate::visibility::estimate`], [`PART_VISIBILITY_RAYS`]
+/// pairs). Visibility and radiosity are correlated over a sender: an
+/// occluder hides from a receiver the parts it also shadows from the
+/// light (the floor behind a block, seen from the ceiling beside the
+/// lamp), so the unoccluded weights send a mean darker than the visible
+/// parts', and the error has one sign on every such link. On the built-in
+/// Cornell box (full gather against Mitsuba) the relative RMSE went from
+/// 1.74% to 1.36% at `EPS` 5e-3, 1.62% to 1.28% at 3e-3 and 1.08% to
+/// 0.85% at 1e-3 (ceiling -1.95% -> -1.12% at 3e-3); the leaves' reflected
+/// power at 3e-3, unclustered, from 0.55% to 0.17% under the fine solve's.
 ///
 /// **Uniform senders keep their mean.** With weights `w_j >= 0` summing
 /// to 1, `|sum_j w_j B_j - B_s| <= max_j |B_j - B_s|`, at most the largest
@@ -414,21 +440,29 @@ pub struct SenderTerms {
     senders: Vec<usize>,
     /// Per link, its sender's kernel-weighted parts; none: the mean.
     parts: Rows<f64>,
+    /// Visibility rays cast for the parts.
+    rays: usize,
 }
 
 impl SenderTerms {
     /// The terms of every link of `links` (in order), resolved or not.
     pub fn new(h: &Hierarchy, links: &[Link], senders: Senders) -> Self {
-        let parts = match senders {
-            Senders::Means => Rows::default(),
-            Senders::Resolved { radiosity, deviation } => Rows::from_lists(
-                links
+        let (parts, rays) = match senders {
+            Senders::Means => (Rows::default(), 0),
+            Senders::Resolved { radiosity, deviation, scene, seed } => {
+                let (lists, rays): (Vec<_>, Vec<usize>) = links
                     .par_iter()
-                    .map(|l| if Self::uniform(h, l, radiosity, deviation) { Vec::new() } else { Self::of_link(h, l) })
-                    .collect::<Vec<_>>(),
-            ),
+                    .map(|l| if Self::uniform(h, l, radiosity, deviation) { (Vec::new(), 0) } else { Self::of_link(h, l, scene, seed) })
+                    .unzip();
+                (Rows::from_lists(lists), rays.iter().sum())
+            }
         };
-        SenderTerms { senders: links.iter().map(|l| h.flat(l.sender)).collect(), parts }
+        SenderTerms { senders: links.iter().map(|l| h.flat(l.sender)).collect(), parts, rays }
+    }
+
+    /// Visibility rays cast for the parts of partly occluded links.
+    pub fn rays(&self) -> usize {
+        self.rays
     }
 
     /// Whether link `l`'s sender is an element whose leaves all lie within
@@ -444,24 +478,33 @@ impl SenderTerms {
         (0..self.senders.len()).filter(|&l| self.parts.row(l).next().is_some()).count()
     }
 
-    /// The terms `(dense index, w_j)` of link `l`'s sender.
-    fn of_link(h: &Hierarchy, l: &Link) -> Vec<(usize, f64)> {
-        let whole = vec![(h.flat(l.sender), 1.0)];
+    /// The terms `(dense index, w_j)` of link `l`'s sender, and the rays
+    /// cast for them (a partly occluded link's parts' visibility, traced
+    /// through `scene` with `seed`).
+    fn of_link(h: &Hierarchy, l: &Link, scene: &SceneRays, seed: u64) -> (Vec<(usize, f64)>, usize) {
+        let whole = (vec![(h.flat(l.sender), 1.0)], 0);
         let Node::Element(r) = l.receiver else { return whole };
         let parts = h.parts(l.sender, MAX_SENDER_PARTS);
         let receiver = &h.elements[r as usize];
         let x = (receiver.points[0] + receiver.points[1] + receiver.points[2]) / 3.0;
         let n = h.normal(r);
-        let mut terms = Vec::with_capacity(parts.len());
+        let partly_occluded = l.visibility.is_some_and(|v| v > 0.0 && v < 1.0);
+        let (mut terms, mut rays) = (Vec::with_capacity(parts.len()), 0);
         for part in parts {
             let Node::Element(e) = part else { return whole };
-            terms.push((h.flat(part), h.factor_to_element(x, n, e)));
+            let mut weight = h.factor_to_element(x, n, e);
+            if partly_occluded && weight > 0.0 {
+                let v = visibility::estimate(h, scene, r, e, PART_VISIBILITY_RAYS, seed);
+                weight *= f64::from(v.visibility);
+                rays += v.rays;
+            }
+            terms.push((h.flat(part), weight));
         }
         let total: f64 = terms.iter().map(|t| t.1).sum();
         if terms.len() < 2 || total <= 0.0 || !total.is_finite() {
-            return whole;
+            return (whole.0, rays);
         }
-        terms.iter().map(|&(node, f)| (node, f / total)).collect()
+        (terms.iter().map(|&(node, f)| (node, f / total)).collect(), rays)
     }
 
     /// The radiosity each link sends with radiosity `b`, as the solve

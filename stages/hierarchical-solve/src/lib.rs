@@ -437,7 +437,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
-            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation });
+            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &scene, seed: params.seed });
+            work.rays += senders.rays() as u64;
             work.resolved_links = senders.resolved();
             let means = convergence;
             convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
