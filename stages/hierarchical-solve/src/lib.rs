@@ -430,15 +430,18 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // The passes refine with senders' area means; the last one then
         // solves on with the senders whose radiosity varies resolved by the
         // kernel (gather::SenderTerms), judged on the means' solution,
-        // within the same iteration cap (a capped solve keeps the means).
+        // within the same iteration cap (a capped solve keeps the means),
+        // and partly occluded links into clusters weighing each face by
+        // its visibility (receivers).
         senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
-        let receivers = receivers::ReceiverTerms::new(&h, &all_links);
+        let mut receivers = receivers::ReceiverTerms::new(&h, &all_links, None);
         let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders, &receivers);
         let left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
             senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &scene, seed: params.seed });
-            work.rays += senders.rays() as u64;
+            receivers = receivers::ReceiverTerms::new(&h, &all_links, Some((&scene, params.seed)));
+            work.rays += (senders.rays() + receivers.rays) as u64;
             work.resolved_links = senders.resolved();
             let means = convergence;
             convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
