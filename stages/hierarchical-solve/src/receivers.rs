@@ -95,7 +95,7 @@ impl ReceiverTerms {
     /// each pair by its visibility (module docs).
     pub fn new(h: &Hierarchy, links: &[Link], visibility: Option<(&SceneRays, u64)>) -> Self {
         let distributed: Vec<bool> = links.iter().map(|l| matches!(l.receiver, Node::Cluster(_)) && h.triangles_below(l.receiver).len() <= MAX_RECEIVER_TRIANGLES).collect();
-        let (weighted, rays): (Vec<Vec<(u32, usize, f64)>>, Vec<usize>) =
+        let (weighted, rays): (Vec<Weights>, Vec<usize>) =
             links.par_iter().zip(&distributed).map(|(l, &d)| if d { weights(h, l, visibility) } else { (Vec::new(), 0) }).unzip();
         let mut lists: Vec<Vec<(usize, (usize, f64))>> = vec![Vec::new(); h.triangles.len()];
         for (l, list) in weighted.iter().enumerate() {
@@ -118,10 +118,13 @@ impl ReceiverTerms {
     }
 }
 
+/// `(t, p, w_tp)`: triangle, part (flat node index), weight.
+type Weights = Vec<(u32, usize, f64)>;
+
 /// `(t, p, w_tp)` for the triangles `t` below link `l`'s cluster receiver
 /// and the parts `p` (flat node index) of its sender, and the rays cast
 /// for them (with `visibility`, where the link is partly occluded).
-fn weights(h: &Hierarchy, l: &Link, visibility: Option<(&SceneRays, u64)>) -> (Vec<(u32, usize, f64)>, usize) {
+fn weights(h: &Hierarchy, l: &Link, visibility: Option<(&SceneRays, u64)>) -> (Weights, usize) {
     let v_link = f64::from(l.visibility.unwrap_or(1.0));
     let visibility = visibility.filter(|_| v_link > 0.0 && v_link < 1.0);
     let mut rays = 0;
