@@ -193,6 +193,10 @@ pub struct Work {
     /// Links whose sender the last solve resolved into parts
     /// ([`gather::SenderTerms`]).
     pub resolved_links: usize,
+    /// Visibility rays the last solve cast to weigh a partly occluded
+    /// link's sender parts and receiving faces ([`gather::SenderTerms`],
+    /// [`receivers`]); not in `rays`, whose rate is the links' visibility.
+    pub part_rays: u64,
     /// Couplings through mirrors and panes in the last pass.
     pub specular_couplings: usize,
     /// Rays cast to build them, all passes.
@@ -441,7 +445,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
             let deviation = links::leaf_deviation(&h, &b);
             senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &scene, seed: params.seed });
             receivers = receivers::ReceiverTerms::new(&h, &all_links, Some((&scene, params.seed)));
-            work.rays += (senders.rays() + receivers.rays) as u64;
+            work.part_rays = (senders.rays() + receivers.rays) as u64;
             work.resolved_links = senders.resolved();
             let means = convergence;
             convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
