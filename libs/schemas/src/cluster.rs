@@ -48,6 +48,11 @@ impl ClusterNode {
     pub fn is_leaf(&self) -> bool {
         self.child_count == 0
     }
+
+    /// Where its triangles lie in [`Clusters::order`].
+    pub fn triangle_range(&self) -> std::ops::Range<usize> {
+        self.first_triangle as usize..(self.first_triangle + self.triangle_count) as usize
+    }
 }
 
 /// The hierarchy.
@@ -67,6 +72,11 @@ impl Schema for Clusters {
 }
 
 impl Clusters {
+    /// The input triangles below cluster `c`.
+    pub fn triangles_of(&self, c: u32) -> &[u32] {
+        &self.order[self.nodes[c as usize].triangle_range()]
+    }
+
     /// Writes `clusters.exr`: layers `cluster` and `order`.
     pub fn write(&self, path: &Path) -> Result<()> {
         let n = &self.nodes;

@@ -109,7 +109,7 @@ fn split(slice: &mut [u32], first: usize, c: usize, centroids: &[DVec3], leaf_si
 /// Bounding box of every node, from the corners of its triangles.
 fn bound(h: &mut Hierarchy, triangles: &[TriangleGeometry]) {
     for node in &mut h.nodes {
-        let range = &h.order[node.first_triangle as usize..(node.first_triangle + node.triangle_count) as usize];
+        let range = &h.order[node.triangle_range()];
         let (lo, hi) = range.iter().flat_map(|&t| triangles[t as usize].corners).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
         node.bounds_min = lo.as_vec3().to_array();
         node.bounds_max = hi.as_vec3().to_array();
@@ -123,7 +123,7 @@ fn bound(h: &mut Hierarchy, triangles: &[TriangleGeometry]) {
 /// hemisphere, the cluster is marked isotropic (`cos = -1`).
 fn summarise(h: &mut Hierarchy, triangles: &[TriangleGeometry], reflectance: &[[f64; 3]]) {
     for node in &mut h.nodes {
-        let range = &h.order[node.first_triangle as usize..(node.first_triangle + node.triangle_count) as usize];
+        let range = &h.order[node.triangle_range()];
         let (mut area, mut rho_area, mut normal_sum) = (0.0f64, [0.0f64; 3], glam::DVec3::ZERO);
         for &t in range {
             let g = &triangles[t as usize];
@@ -193,7 +193,7 @@ mod tests {
                 assert!((kids.iter().map(|k| k.reflectance_area[1]).sum::<f32>() - 0.25 * n.area).abs() <= 1e-3 * n.area);
             }
             let (lo, hi) = bounds(n);
-            for &t in &h.order[n.first_triangle as usize..(n.first_triangle + n.triangle_count) as usize] {
+            for &t in &h.order[n.triangle_range()] {
                 for p in tris[t as usize].corners {
                     let p = p.as_vec3();
                     assert!(p.cmpge(lo - 1e-4).all() && p.cmple(hi + 1e-4).all(), "triangle {t} outside cluster {i}");

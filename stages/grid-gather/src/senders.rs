@@ -92,7 +92,7 @@ impl<'a> Senders<'a> {
         if let Some(c) = clusters {
             for (i, node) in c.nodes.iter().enumerate() {
                 if node.is_leaf() {
-                    for &t in &c.order[node.first_triangle as usize..(node.first_triangle + node.triangle_count) as usize] {
+                    for &t in &c.order[node.triangle_range()] {
                         leaf_cluster[t as usize] = i as u32;
                     }
                 }
@@ -218,10 +218,7 @@ impl<'a> Senders<'a> {
     /// Input triangles under a sender.
     pub fn triangles_of(&self, node: Node) -> &[u32] {
         match (node, self.clusters) {
-            (Node::Cluster(c), Some(cl)) => {
-                let n = &cl.nodes[c as usize];
-                &cl.order[n.first_triangle as usize..(n.first_triangle + n.triangle_count) as usize]
-            }
+            (Node::Cluster(c), Some(cl)) => cl.triangles_of(c),
             (Node::Element(e), _) => std::slice::from_ref(&self.solution.elements[e as usize].triangle),
             _ => &[],
         }

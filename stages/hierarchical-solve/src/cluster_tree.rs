@@ -42,7 +42,7 @@ impl ClusterTree {
         let mut area = Vec::with_capacity(clusters.nodes.len());
         let mut reflectance = Vec::with_capacity(clusters.nodes.len());
         for (c, node) in clusters.nodes.iter().enumerate() {
-            let range = node.first_triangle as usize..(node.first_triangle + node.triangle_count) as usize;
+            let range = node.triangle_range();
             let a = cumulative[range.end] - cumulative[range.start];
             let mut rho = [0.0; 3];
             for &t in &clusters.order[range.clone()] {
@@ -73,7 +73,8 @@ impl ClusterTree {
     /// proportional to its area.
     pub fn sample_triangle(&self, c: u32, stream: &mut Stream) -> u32 {
         let node = &self.clusters.nodes[c as usize];
-        let (first, last) = (node.first_triangle as usize, (node.first_triangle + node.triangle_count) as usize);
+        let range = node.triangle_range();
+        let (first, last) = (range.start, range.end);
         let (lo, hi) = (self.cumulative[first], self.cumulative[last]);
         let target = lo + stream.next_f64() * (hi - lo);
         let k = self.cumulative[first + 1..last].partition_point(|&x| x <= target);

@@ -100,8 +100,7 @@ impl Hierarchy {
                 let tree = self.tree();
                 let n = &tree.clusters.nodes[c as usize];
                 if n.is_leaf() {
-                    let range = n.first_triangle as usize..(n.first_triangle + n.triangle_count) as usize;
-                    tree.clusters.order[range].iter().map(|&t| Node::Element(t)).collect()
+                    tree.clusters.triangles_of(c).iter().map(|&t| Node::Element(t)).collect()
                 } else {
                     (n.first_child..n.first_child + n.child_count).map(Node::Cluster).collect()
                 }
@@ -141,11 +140,7 @@ impl Hierarchy {
     pub fn triangles_below(&self, node: Node) -> &[u32] {
         match node {
             Node::Element(e) => std::slice::from_ref(&self.elements[e as usize].triangle),
-            Node::Cluster(c) => {
-                let tree = self.tree();
-                let n = &tree.clusters.nodes[c as usize];
-                &tree.clusters.order[n.first_triangle as usize..(n.first_triangle + n.triangle_count) as usize]
-            }
+            Node::Cluster(c) => self.tree().clusters.triangles_of(c),
         }
     }
 
