@@ -341,12 +341,6 @@ pub const MAX_SENDER_PARTS: usize = 16;
 /// reflected radiosity.
 pub const UNIFORM_SENDER: f64 = 1e-3;
 
-/// Rays per part of a partly occluded link's sender for the part's own
-/// visibility ([`SenderTerms`]). On the built-in Cornell box at `EPS` 3e-3
-/// (full gather against Mitsuba): 2 rays 1.43% relative RMSE, 4 1.288%, 8
-/// 1.282%, 16 1.294%.
-pub const PART_VISIBILITY_RAYS: usize = 8;
-
 /// What radiosity a link's sender sends in a solve.
 #[derive(Clone, Copy)]
 pub enum Senders<'a> {
@@ -412,14 +406,13 @@ pub enum Senders<'a> {
 /// transfer is `sum_j F_rj V_rj B_j` and the link carries `F_rs V_rs`, so
 /// where `0 < V_rs < 1` the weights are `w_j = F_rj V_rj / sum_k F_rk
 /// V_rk`, `V_rj` the kernel-weighted visible fraction between the receiver
-/// and part `j` ([`crate::visibility::estimate`], [`PART_VISIBILITY_RAYS`]
-/// pairs). Visibility and radiosity are correlated over a sender: an
+/// and part `j` ([`visibility::visible_factor`]). Visibility and radiosity are correlated over a sender: an
 /// occluder hides from a receiver the parts it also shadows from the
 /// light (the floor behind a block, seen from the ceiling beside the
 /// lamp), so the unoccluded weights send a mean darker than the visible
 /// parts', and the error has one sign on every such link. On the built-in
 /// Cornell box (full gather against Mitsuba) the relative RMSE went from
-/// 1.74% to 1.36% at `EPS` 5e-3, 1.62% to 1.28% at 3e-3 and 1.08% to
+/// 1.74% to 1.36% at `EPS` 5e-3, 1.62% to 1.30% at 3e-3 and 1.08% to
 /// 0.85% at 1e-3 (ceiling -1.95% -> -1.12% at 3e-3); the leaves' reflected
 /// power at 3e-3, unclustered, from 0.55% to 0.17% under the fine solve's.
 ///
@@ -493,10 +486,10 @@ impl SenderTerms {
         for part in parts {
             let Node::Element(e) = part else { return whole };
             let mut weight = h.factor_to_element(x, n, e);
-            if partly_occluded && weight > 0.0 {
-                let v = visibility::estimate(h, scene, r, e, PART_VISIBILITY_RAYS, seed);
-                weight *= f64::from(v.visibility);
-                rays += v.rays;
+            if partly_occluded {
+                let cast;
+                (weight, cast) = visibility::visible_factor(h, scene, r, e, weight, seed);
+                rays += cast;
             }
             terms.push((h.flat(part), weight));
         }
@@ -647,10 +640,9 @@ fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: 
     let mut chain = vec![0.0f64; n];
     let mut norm = [0.0f64; 3];
     for i in 0..n {
-        let own: f64 = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| coupling[l]).sum();
+        let links: f64 = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| coupling[l]).sum();
         let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum());
-        let links = own + distributed;
-        let own = links + specular.map_or(0.0, |s| s.row_sum(i));
+        let own = links + distributed + specular.map_or(0.0, |s| s.row_sum(i));
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
             for c in 0..3 {

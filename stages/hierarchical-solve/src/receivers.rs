@@ -28,9 +28,9 @@
 //!
 //! In the last solve (after the means' solve that decides refinement) a
 //! partly occluded link (`0 < V < 1`) also weighs each pair by its own
-//! visibility, `F_tp V_tp` in place of `F_tp` ([`crate::visibility::estimate`]
-//! between triangle `t` and an element part, [`PART_VISIBILITY_RAYS`]
-//! pairs; a part that is still a cluster takes the link's `V`): the
+//! visibility, `F_tp V_tp` in place of `F_tp` ([`visibility::visible_factor`]
+//! between triangle `t` and an element part; a part that is still a
+//! cluster takes the link's `V`): the
 //! link's `V` says how much of its light gets through, not to which of
 //! the cluster's faces, and a face hidden from the sender by another
 //! object got its unoccluded share. On the built-in Cornell box at `EPS`
@@ -51,7 +51,6 @@
 //! +85% in the preview against Mitsuba (issue 10).
 
 use crate::elements::Hierarchy;
-use crate::gather::PART_VISIBILITY_RAYS;
 use crate::links::Link;
 use crate::nodes::key;
 use crate::rows::Rows;
@@ -143,10 +142,10 @@ fn weights(h: &Hierarchy, l: &Link, visibility: Option<(&SceneRays, u64)>) -> (W
                 .map(|(p, &node)| {
                     let f = points.iter().map(|&x| p.factor(h, x, g.normal)).sum::<f64>() / points.len() as f64;
                     match (visibility, node) {
-                        (Some((scene, seed)), Node::Element(e)) if f > 0.0 => {
-                            let v = visibility::estimate(h, scene, t, e, PART_VISIBILITY_RAYS, seed);
-                            rays += v.rays;
-                            f * f64::from(v.visibility)
+                        (Some((scene, seed)), Node::Element(e)) => {
+                            let (visible, cast) = visibility::visible_factor(h, scene, t, e, f, seed);
+                            rays += cast;
+                            visible
                         }
                         (Some(_), Node::Cluster(_)) => f * v_link,
                         _ => f,

@@ -83,6 +83,26 @@ pub fn settle(h: &Hierarchy, scene: &SceneRays, occluders: &Occluders, link: &mu
     cast
 }
 
+/// Rays per pair of [`visible_factor`]. On the built-in Cornell box at
+/// `EPS` 3e-3 (full gather against Mitsuba, the sender parts' weights of a
+/// first version, with other random streams): 2 rays 1.43% relative RMSE,
+/// 4 1.288%, 8 1.282%, 16 1.294%.
+pub const PART_VISIBILITY_RAYS: usize = 8;
+
+/// `factor`, receiver element `receiver`'s factor to element `part`, times
+/// the kernel-weighted visible fraction between the two ([`estimate`] with
+/// [`PART_VISIBILITY_RAYS`] pairs), and the rays cast: how a partly
+/// occluded link weighs the parts of its sender
+/// ([`crate::gather::SenderTerms`]) and the faces of a receiving cluster
+/// ([`crate::receivers`]). A factor of 0 stays 0 and casts none.
+pub fn visible_factor(h: &Hierarchy, scene: &SceneRays, receiver: u32, part: u32, factor: f64, seed: u64) -> (f64, usize) {
+    if factor <= 0.0 {
+        return (factor, 0);
+    }
+    let v = estimate(h, scene, receiver, part, PART_VISIBILITY_RAYS, seed);
+    (factor * f64::from(v.visibility), v.rays)
+}
+
 /// Whether `point` of `triangle` exists: not on a transparent texel of
 /// its alpha mask ([`crate::detail`]; a pair with an end that does not
 /// exist carries no light, and no weight).
