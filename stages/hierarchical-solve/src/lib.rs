@@ -343,6 +343,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let mut specular: Option<mirrors::Couplings> = None;
     // What each link's sender sent in the last solve (gather::SenderTerms).
     let mut senders = gather::SenderTerms::new(&h, &[], gather::Senders::Means);
+    // The weights of the links into clusters, kept from pass to pass (receivers).
+    let mut receiver_weights = receivers::WeightCache::default();
     for pass in 1..=passes {
         let started = Instant::now();
         let mut refined_any = false;
@@ -438,13 +440,13 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // and partly occluded links into clusters weighing each face by
         // its visibility (receivers).
         senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
-        let mut receivers = receivers::ReceiverTerms::new(&h, &all_links, None);
+        let mut receivers = receivers::ReceiverTerms::new(&h, &all_links, None, &mut receiver_weights);
         let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders, &receivers);
         let left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
             senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &scene, seed: params.seed });
-            receivers = receivers::ReceiverTerms::new(&h, &all_links, Some((&scene, params.seed)));
+            receivers = receivers::ReceiverTerms::new(&h, &all_links, Some((&scene, params.seed)), &mut receiver_weights);
             work.part_rays = (senders.rays() + receivers.rays) as u64;
             work.resolved_links = senders.resolved();
             let means = convergence;

@@ -37,9 +37,10 @@
 //! 3e-3 (full gather against Mitsuba) the relative RMSE went from 1.30% to
 //! 1.16% (short block +1.43% -> +0.69%, back wall -1.00% -> -0.72%; the
 //! unclustered solve: 1.00%). Only in the last solve because of its cost
-//! on large clustered scenes: plants-10k at `EPS` 1e-2 solves in 14.6 s
+//! on large clustered scenes: plants-10k at `EPS` 1e-2 solved in 14.6 s
 //! instead of 12.5 s; in every pass, 22.9 s (and 1.08% on the Cornell
-//! box).
+//! box); both before the weights without visibility were kept from pass
+//! to pass ([`WeightCache`]: 14.9 s -> 10.5 s, the same solution).
 //!
 //! Only clusters of at most [`MAX_RECEIVER_TRIANGLES`] triangles are
 //! distributed so; larger ones keep the isotropic push (below).
@@ -60,6 +61,7 @@ use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use rayon::prelude::*;
 use schemas::solution::Node;
+use std::collections::HashMap;
 use std::f64::consts::PI;
 
 /// Most parts a sender is opened into to weigh a cluster receiver's
@@ -76,6 +78,15 @@ pub const CLUSTER_PART_SAMPLES: usize = 16;
 /// triangle box (591k links) took 236 s per solve, against seconds.
 pub const MAX_RECEIVER_TRIANGLES: usize = 16;
 
+/// The weights of the links into clusters of the last build, by link ends,
+/// with the sender's parts they were computed for: a link that refinement
+/// kept, whose sender still opens into the same parts, has the same weights
+/// (those without visibility), so the next pass's build takes them from
+/// here instead of computing the Lambert factors again (on plants-10k at
+/// `EPS` 1e-2 a build took about 1 s of every pass).
+#[derive(Default)]
+pub struct WeightCache(HashMap<(Node, Node), (Vec<Node>, Weights)>);
+
 /// Per input triangle, the links into clusters above it, each with its
 /// sender's parts and their weights `w_tp`.
 pub struct ReceiverTerms {
@@ -91,18 +102,42 @@ pub struct ReceiverTerms {
 impl ReceiverTerms {
     /// The terms of every link of `links` whose receiver is a cluster; with
     /// `visibility` (the scene and a seed), partly occluded links weigh
-    /// each pair by its visibility (module docs).
-    pub fn new(h: &Hierarchy, links: &[Link], visibility: Option<(&SceneRays, u64)>) -> Self {
+    /// each pair by its visibility (module docs). Weights without
+    /// visibility come from `cache` where it holds them, and a build
+    /// without visibility leaves its own there for the next.
+    pub fn new(h: &Hierarchy, links: &[Link], visibility: Option<(&SceneRays, u64)>, cache: &mut WeightCache) -> Self {
         let distributed: Vec<bool> = links.iter().map(|l| matches!(l.receiver, Node::Cluster(_)) && h.triangles_below(l.receiver).len() <= MAX_RECEIVER_TRIANGLES).collect();
-        let (weighted, rays): (Vec<Weights>, Vec<usize>) =
-            links.par_iter().zip(&distributed).map(|(l, &d)| if d { weights(h, l, visibility) } else { (Vec::new(), 0) }).unzip();
+        let built: Vec<Option<(Vec<Node>, Weights, usize)>> = links
+            .par_iter()
+            .zip(&distributed)
+            .map(|(l, &d)| {
+                if !d {
+                    return None;
+                }
+                let nodes = h.parts(l.sender, MAX_PARTS);
+                let v = f64::from(l.visibility.unwrap_or(1.0));
+                let visibility = visibility.filter(|_| v > 0.0 && v < 1.0);
+                Some(match cache.0.get(&(l.receiver, l.sender)) {
+                    Some((cached, w)) if visibility.is_none() && *cached == nodes => (nodes, w.clone(), 0),
+                    _ => {
+                        let (w, rays) = weights(h, l, &nodes, visibility);
+                        (nodes, w, rays)
+                    }
+                })
+            })
+            .collect();
+        let rays = built.iter().flatten().map(|b| b.2).sum();
         let mut lists: Vec<Vec<(usize, (usize, f64))>> = vec![Vec::new(); h.triangles.len()];
-        for (l, list) in weighted.iter().enumerate() {
+        for (l, (_, list, _)) in built.iter().enumerate().filter_map(|(l, b)| Some((l, b.as_ref()?))) {
             for &(t, p, w) in list {
                 lists[t as usize].push((l, (p, w)));
             }
         }
-        ReceiverTerms { rays: rays.iter().sum(), rows: Rows::from_lists(lists), distributed }
+        // The next pass reads the weights of a build without visibility.
+        if visibility.is_none() {
+            cache.0 = links.iter().zip(built).filter_map(|(l, b)| b.map(|(nodes, w, _)| ((l.receiver, l.sender), (nodes, w)))).collect();
+        }
+        ReceiverTerms { rays, rows: Rows::from_lists(lists), distributed }
     }
 
     /// Whether link `l`'s light goes to its receiver's triangles by weight.
@@ -121,14 +156,13 @@ impl ReceiverTerms {
 type Weights = Vec<(u32, usize, f64)>;
 
 /// `(t, p, w_tp)` for the triangles `t` below link `l`'s cluster receiver
-/// and the parts `p` (flat node index) of its sender, and the rays cast
-/// for them (with `visibility`, where the link is partly occluded).
-fn weights(h: &Hierarchy, l: &Link, visibility: Option<(&SceneRays, u64)>) -> (Weights, usize) {
+/// and the parts `p` (flat node index) of its sender, `nodes`, and the
+/// rays cast for them (with `visibility`, given where the link is partly
+/// occluded).
+fn weights(h: &Hierarchy, l: &Link, nodes: &[Node], visibility: Option<(&SceneRays, u64)>) -> (Weights, usize) {
     let v_link = f64::from(l.visibility.unwrap_or(1.0));
-    let visibility = visibility.filter(|_| v_link > 0.0 && v_link < 1.0);
     let mut rays = 0;
     let triangles = h.triangles_below(l.receiver);
-    let nodes = h.parts(l.sender, MAX_PARTS);
     let sender_area = h.area(l.sender);
     let parts: Vec<Part> = nodes.iter().map(|&p| Part::new(h, p, key(l.receiver))).collect();
     let factors: Vec<(f64, Vec<f64>)> = triangles
@@ -138,7 +172,7 @@ fn weights(h: &Hierarchy, l: &Link, visibility: Option<(&SceneRays, u64)>) -> (W
             let points = receiver_points(g);
             let f = parts
                 .iter()
-                .zip(&nodes)
+                .zip(nodes)
                 .map(|(p, &node)| {
                     let f = points.iter().map(|&x| p.factor(h, x, g.normal)).sum::<f64>() / points.len() as f64;
                     match (visibility, node) {
