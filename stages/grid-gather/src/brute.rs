@@ -2,7 +2,11 @@
 //! link of the hit point's element chain at every camera sample, the exact
 //! point form factor times the kernel-weighted visible fraction
 //! ([`crate::full_gather`]) of `brute_samples` rays to uniform random points on
-//! the sender, drawn anew per camera sample.
+//! the sender, drawn anew per camera sample, times the radiosity the link
+//! sends ([`Senders::link_radiosity`], as the full gather). With the
+//! sender's area mean instead, the yardstick itself was off: on the Cornell
+//! box's unclustered solve at `EPS` 1e-2 it read 3.7% relative RMSE against
+//! Mitsuba where the full gather read 1.6% (1.6% with the link's).
 
 use crate::classification::LinkClass;
 use crate::diagnostics::Work;
@@ -54,7 +58,7 @@ pub fn brute_irradiance(
         }
         work.count(LinkClass::ResampleBoth);
         let v = visible.fraction().unwrap_or(1.0);
-        let b = senders.radiosity(s);
+        let b = senders.link_radiosity(l);
         (0..3).for_each(|c| h[c] += b[c] * f * v);
     }
     h
