@@ -130,10 +130,14 @@ fn errors(test: &str, args: &[&str]) -> (f64, f64) {
 /// parts weighted by their unoccluded kernel alone it was 1.73% and 0.69%
 /// low (8.1% at 1e-2, now 5.7%: what is left there is inside leaf
 /// senders). At the default threshold the total is within 0.1% and every
-/// leaf within 5% (3.4% measured; B's leaves near the wall's penumbra).
+/// leaf within 1.5%: 3.4% measured (B's leaves near the wall's penumbra)
+/// while a link into an inner element lit all its leaves alike, 0.78%
+/// since it lights each part by its own factor and visibility
+/// (hierarchical-solve's `receivers`; totals -0.80% and -0.16% at 5e-3 and
+/// 3e-3).
 #[test]
 fn a_receiver_behind_an_occluder_that_also_shadows_the_sender_gets_the_visible_parts_light() {
-    for (eps, limit, leaf_limit) in [("5e-3", 0.012, f64::INFINITY), ("3e-3", 0.004, f64::INFINITY), ("2e-4", 0.001, 0.05)] {
+    for (eps, limit, leaf_limit) in [("5e-3", 0.012, f64::INFINITY), ("3e-3", 0.004, f64::INFINITY), ("2e-4", 0.001, 0.015)] {
         let (total, worst) = errors(&format!("occluded_senders_{eps}"), &["--eps", eps]);
         eprintln!("occluded senders, EPS {eps}: B's total {:+.3}% off the quadrature, worst leaf {:.2}%", 100.0 * total, 100.0 * worst);
         assert!(total.abs() <= limit, "EPS {eps}: B's total is {:+.3}% off the reference", 100.0 * total);

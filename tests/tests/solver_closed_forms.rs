@@ -394,7 +394,10 @@ fn one_bounce_errors(test: &str, rho_b: f64, args: &[&str]) -> Vec<f64> {
 /// and 0.05. The absolute criterion (error in units of the lamp's
 /// exitance) leaves links onto B carrying the mean radiosity of large parts
 /// of A, whose radiosity falls off from above the lamp to above B's far
-/// edge: measured, B's worst leaf 71% off. A per-link allowance of
+/// edge: measured, B's worst leaf 71% off while a coarse link lit all its
+/// receiver's leaves alike; since it lights each part by its own factor
+/// (hierarchical-solve's `receivers`), 11.6% at rho_B 0.05 and 1.4% at
+/// 0.5, so the absolute criterion's failure is asserted at 0.05. A per-link allowance of
 /// `eps_relative` of the receiver's radiosity let the links' same-signed
 /// errors add up: worst leaf 8.9%, rms 2.1%. Shared among the links
 /// (hierarchical-solve's `Allowance::for_link`): worst 1.1%.
@@ -409,7 +412,9 @@ fn one_bounce_receiver_leaves_within_two_percent_of_quadrature() {
             eprintln!("one bounce, rho_B {rho_b}, {criterion}: {} leaves of B, largest relative error {:.2e}, rms {rms:.2e}", errors.len(), worst[k]);
         }
         assert!(worst[1] <= 0.02, "rho_B {rho_b}: a leaf of B is {:.2e} off the quadrature reference", worst[1]);
-        assert!(worst[0] > 0.02, "rho_B {rho_b}: the absolute criterion also meets 2% ({:.2e}); the test no longer tells them apart", worst[0]);
+        if rho_b < 0.1 {
+            assert!(worst[0] > 0.02, "rho_B {rho_b}: the absolute criterion also meets 2% ({:.2e}); the test no longer tells them apart", worst[0]);
+        }
     }
 }
 

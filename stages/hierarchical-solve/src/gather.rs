@@ -18,7 +18,9 @@
 //! triangles goes to each input triangle `t` below it by the triangle's own
 //! factor to each part `p` of the sender, `w_tp` ([`ReceiverTerms`]), not
 //! to all alike; the link's flux is conserved. A larger cluster still gathers its links and
-//! pushes their irradiance to all its children alike.
+//! pushes their irradiance to all its children alike. In the last pass a
+//! link into an inner element likewise lights the element's parts each by
+//! its own factor to the sender ([`ReceiverTerms`]).
 //!
 //! Nodes are indexed densely, clusters first, then elements
 //! ([`Hierarchy::flat`]). A parent always has a smaller index than its
@@ -254,6 +256,8 @@ pub fn solve(
         Convergence { iterations: 0, relative_change: f64::INFINITY, error_bound: f64::INFINITY, contraction: f64::NAN, converged: false, extrapolations: 0, rates: [0.0; 3] };
     let mut rate = Rate::new(prior_rate);
     while convergence.iterations < max_iterations {
+        // What each link into an inner element sends, once for its parts.
+        let sent_to_parts: Vec<[f64; 3]> = receivers.part_links.par_iter().map(|&l| senders.radiosity(l, b)).collect();
         let gathered: Vec<[f64; 3]> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -272,6 +276,12 @@ pub fn solve(
                 for (l, &(p, w)) in distributed {
                     for c in 0..3 {
                         g[c] += w * coupling[l] * b[p][c];
+                    }
+                }
+                for (k, &w) in i.checked_sub(clusters).into_iter().flat_map(|e| receivers.of_element(e)) {
+                    let l = receivers.part_links[k];
+                    for c in 0..3 {
+                        g[c] += w * coupling[l] * sent_to_parts[k][c];
                     }
                 }
                 g
@@ -641,7 +651,7 @@ fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: 
     let mut norm = [0.0f64; 3];
     for i in 0..n {
         let links: f64 = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| coupling[l]).sum();
-        let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum());
+        let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum::<f64>() + receivers.of_element(t).map(|(k, &w)| w * coupling[receivers.part_links[k]]).sum::<f64>());
         let own = links + distributed + specular.map_or(0.0, |s| s.row_sum(i));
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
