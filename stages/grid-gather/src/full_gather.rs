@@ -52,37 +52,6 @@ use radiometry::rays::SceneRays;
 use schemas::solution::{Node, NONE};
 use std::sync::OnceLock;
 
-/// One link's part of the irradiance at a surface point: `B (resampled V
-/// + fixed)`, `V` its sender's visibility resampled at each camera sample
-/// with `samples` rays (none: `V` is not needed).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlanTerm {
-    /// The link's sender.
-    pub sender: Node,
-    /// The radiosity the link sends ([`Senders::link_radiosity`]), W/m², RGB.
-    pub radiosity: [f64; 3],
-    /// The factor the resampled visibility multiplies.
-    pub resampled: f64,
-    /// The factor times visibility taken from the grid or the link.
-    pub fixed: f64,
-    /// Visibility samples per camera sample.
-    pub samples: u32,
-    /// The class counted for the link ([`Work::count`]).
-    pub class: crate::classification::LinkClass,
-}
-
-/// What the irradiance at a surface point needs besides the visibility
-/// rays (form factors, classes, sample counts), per link: the same for
-/// every camera sample of a pixel that lands on the same leaf
-/// ([`FullGather::plan`]).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Plan {
-    /// Per link, in the order of the links.
-    pub terms: Vec<PlanTerm>,
-    /// Made by the surface-based gather.
-    pub surface: bool,
-}
-
 /// Per-triangle material: reflectance and emitted radiosity.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Surface {
@@ -152,43 +121,19 @@ impl<'a> FullGather<'a> {
 
     /// Irradiance H at `p` (W/m², RGB) on `triangle` (front normal
     /// `normal`, in leaf element `leaf`) from the links in `links`, for
-    /// camera sample `pass` of its pixel: [`Self::evaluate`] of
-    /// [`Self::plan`] at `p`.
+    /// camera sample `pass` of its pixel: by the surface-based gather where
+    /// the leaf is smaller than the grid's cells at `p` (and the
+    /// `surface_gather` parameter is on), else by the grid; 0 outside the
+    /// grid.
     #[allow(clippy::too_many_arguments)]
     pub fn irradiance(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], pass: u32, work: &mut Work) -> [f64; 3] {
-        let plan = self.plan(p, normal, triangle, leaf, links, work);
-        self.evaluate(&plan, p, normal, triangle, pass, work)
-    }
-
-    /// What [`Self::evaluate`] needs at `p` on `triangle` (front normal
-    /// `normal`, in leaf element `leaf`) from the links in `links`: by the
-    /// surface-based gather where the leaf is smaller than the grid's cells
-    /// at `p` (and the `surface_gather` parameter is on), else by the grid;
-    /// nothing outside the grid.
-    pub fn plan(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], work: &mut Work) -> Plan {
-        let Some(location) = self.grid.locate(p) else { return Plan::default() };
+        let Some(location) = self.grid.locate(p) else { return [0.0; 3] };
+        let contrast = self.contrast_at(&location);
         let leaf_size = self.senders.size(Node::Element(leaf));
         if self.params.surface_gather && leaf_size < self.grid.spacing_at(p) {
-            let contrast = self.contrast_at(&location);
-            return self.surface_plan(p, normal, triangle, leaf, links, contrast, work);
+            return self.surface_irradiance(p, normal, triangle, leaf, links, contrast, pass, work);
         }
-        self.interpolated_plan(p, normal, &location, links, work)
-    }
-
-    /// `H = sum over the plan's terms of B (resampled V + fixed)` at `p`,
-    /// `V` the visibility of the term's sender resampled from `p` for
-    /// camera sample `pass` ([`Self::fixed_visibility`]) where the term has
-    /// samples.
-    pub fn evaluate(&self, plan: &Plan, p: DVec3, normal: DVec3, triangle: u32, pass: u32, work: &mut Work) -> [f64; 3] {
-        work.surface = u64::from(plan.surface);
-        let mut h = [0.0; 3];
-        for term in &plan.terms {
-            let v = if term.samples > 0 { self.fixed_visibility(p, normal, triangle, term.sender, term.samples, pass, work) } else { 0.0 };
-            let fv = term.resampled * v + term.fixed;
-            work.count(term.class);
-            (0..3).for_each(|c| h[c] += term.radiosity[c] * fv);
-        }
-        h
+        self.interpolated_irradiance(p, normal, triangle, &location, links, pass, work)
     }
 
     /// Visible fraction from `p` on triangle `triangle` of `n` fixed

@@ -23,18 +23,17 @@
 
 use crate::classification::{LinkClass, VertexData};
 use crate::diagnostics::Work;
-use crate::full_gather::{FullGather, Plan, PlanTerm};
+use crate::full_gather::FullGather;
 use crate::grid::Location;
 use glam::DVec3;
 
 impl FullGather<'_> {
-    /// The plan of `H(p)` on `triangle` (normal `normal`) at `location` in
-    /// the grid, from the links `links` (module docs): per link, the sum
-    /// over the vertices that resample visibility of `w_i F_i` (to be
-    /// multiplied by the visibility resampled at each camera sample) and
-    /// over the others of `w_i F_i vis_i`.
-    pub(crate) fn interpolated_plan(&self, p: DVec3, normal: DVec3, location: &Location, links: &[usize], work: &mut Work) -> Plan {
-        let mut plan = Plan { terms: Vec::with_capacity(links.len()), surface: false };
+    /// `H(p)`, W/m² RGB, on `triangle` (normal `normal`) at `location` in
+    /// the grid, from the links `links`, for camera sample `pass` (module
+    /// docs).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn interpolated_irradiance(&self, p: DVec3, normal: DVec3, triangle: u32, location: &Location, links: &[usize], pass: u32, work: &mut Work) -> [f64; 3] {
+        let mut h = [0.0; 3];
         let w = location.interpolation_weights();
         let data: [&VertexData; 4] = location.vertices.map(|v| self.vertex(v));
         let heaviest = (0..4).max_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap_or(0);
@@ -64,29 +63,22 @@ impl FullGather<'_> {
             } else {
                 0.0
             };
-            let (mut resampled, mut fixed) = (0.0, 0.0);
+            let v_exact = if need_v { self.fixed_visibility(p, normal, triangle, s, (n_vis.ceil() as u32).max(1), pass, work) } else { 1.0 };
+            let mut fv = 0.0;
             for i in 0..4 {
-                match entries[i] {
-                    None => resampled += w[i] * f_exact,
-                    Some(e) => {
-                        let f = if e.resample_form_factor { f_exact } else { e.factor * normal.dot(e.direction).max(0.0) };
-                        if e.resample_visibility {
-                            resampled += w[i] * f;
-                        } else {
-                            fixed += w[i] * f * e.visibility;
-                        }
-                    }
-                }
+                let (f, v) = match entries[i] {
+                    None => (f_exact, v_exact),
+                    Some(e) => (
+                        if e.resample_form_factor { f_exact } else { e.factor * normal.dot(e.direction).max(0.0) },
+                        if e.resample_visibility { v_exact } else { e.visibility },
+                    ),
+                };
+                fv += w[i] * f * v;
             }
-            plan.terms.push(PlanTerm {
-                sender: s,
-                radiosity: self.senders.link_radiosity(l),
-                resampled,
-                fixed,
-                samples: if need_v { (n_vis.ceil() as u32).max(1) } else { 0 },
-                class: entries[heaviest].map_or(LinkClass::ResampleBoth, |e| e.class()),
-            });
+            work.count(entries[heaviest].map_or(LinkClass::ResampleBoth, |e| e.class()));
+            let b = self.senders.link_radiosity(l);
+            (0..3).for_each(|c| h[c] += b[c] * fv);
         }
-        plan
+        h
     }
 }

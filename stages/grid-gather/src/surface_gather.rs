@@ -28,7 +28,7 @@
 
 use crate::classification::{budget, LinkClass};
 use crate::diagnostics::Work;
-use crate::full_gather::{FullGather, Plan, PlanTerm};
+use crate::full_gather::FullGather;
 use glam::DVec3;
 use radiometry::color::luminance;
 use radiometry::form_factor::WeightedVisibility;
@@ -133,12 +133,11 @@ impl FullGather<'_> {
         })
     }
 
-    /// The plan of the surface-based gather at `p` (module docs) with
-    /// contrast threshold `contrast`: per link its point factor, times the
-    /// visibility resampled at each camera sample where it is resampled,
-    /// else times the link's (or the leaf check's) visibility.
+    /// The surface-based gather at `p` (module docs) with contrast
+    /// threshold `contrast`.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn surface_plan(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], contrast: f64, work: &mut Work) -> Plan {
+    pub(crate) fn surface_irradiance(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], contrast: f64, pass: u32, work: &mut Work) -> [f64; 3] {
+        work.surface = 1;
         let solution = &self.senders.solution;
         let check = self.leaf_check(leaf, triangle, links);
         let rho = luminance(self.surfaces[triangle as usize].reflectance);
@@ -165,21 +164,24 @@ impl FullGather<'_> {
         for (k, r) in partial.iter().zip(budget(&d_vis, tau)) {
             resample[*k] = r;
         }
-        let mut plan = Plan { terms: Vec::with_capacity(terms.len()), surface: true };
+        let mut h = [0.0; 3];
         for (term, resampled) in terms.iter().zip(resample) {
             if term.visibility <= 0.0 {
                 continue;
             }
             let sender = solution.links[term.link].sender;
-            let radiosity = self.senders.link_radiosity(term.link);
-            plan.terms.push(if resampled {
+            let v = if resampled {
+                work.count(LinkClass::ResampleBoth);
                 let occluder = f64::from(solution.links[term.link].occluder_distance);
-                let samples = self.shadow_samples(p, sender, occluder, term.contribution, tau, self.params.max_shadow_samples);
-                PlanTerm { sender, radiosity, resampled: term.factor, fixed: 0.0, samples, class: LinkClass::ResampleBoth }
+                let n = self.shadow_samples(p, sender, occluder, term.contribution, tau, self.params.max_shadow_samples);
+                self.fixed_visibility(p, normal, triangle, sender, n, pass, work)
             } else {
-                PlanTerm { sender, radiosity, resampled: 0.0, fixed: term.factor * term.visibility, samples: 0, class: LinkClass::ResampleFormFactor }
-            });
+                work.count(LinkClass::ResampleFormFactor);
+                term.visibility
+            };
+            let b = self.senders.link_radiosity(term.link);
+            (0..3).for_each(|c| h[c] += b[c] * term.factor * v);
         }
-        plan
+        h
     }
 }
