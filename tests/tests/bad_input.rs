@@ -139,3 +139,22 @@ fn output_directory_that_cannot_be_written() {
         &[],
     );
 }
+
+/// A scene whose emission is within f32's range but whose interreflected
+/// radiosity is not (rho 0.9 multiplies it by up to 10): hierarchical-solve
+/// wrote a solution holding inf, with exit 0, and grid-gather refused it
+/// ("field B.R is inf"); the solver now refuses, saying what to change.
+#[test]
+fn a_radiosity_beyond_the_solutions_float_range_is_refused_by_the_solver() {
+    let dir = scratch("radiosity_overflow");
+    let scene = closed_box(1.0, 0.9, 3e38).write(&dir);
+    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
+    run_ok("mesh-prep", &[s(&scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let solution = dir.join("solution.exr");
+    assert_refused(
+        "hierarchical-solve",
+        &["--mesh", s(&mesh), "--manifest", s(&manifest), "--eps", "1e-2", "-o", s(&solution)],
+        &["mesh.exr", "32-bit floats", "scale the emission down"],
+        &[&solution],
+    );
+}

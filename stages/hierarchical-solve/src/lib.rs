@@ -473,6 +473,11 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     work.cluster_links = all_links.iter().filter(|l| matches!(l.receiver, Node::Cluster(_)) || matches!(l.sender, Node::Cluster(_))).count();
     work.elements = h.elements.len();
     work.leaves = h.elements.iter().filter(|e| e.is_leaf()).count();
+    // The solution stores 32-bit floats: a radiosity beyond their range
+    // would be written as inf, and every reader would refuse the file.
+    if let Some(v) = b.iter().flatten().find(|v| !(v.is_finite() && v.abs() <= f64::from(f32::MAX))) {
+        return Err(format!("a radiosity of {v:e} W/m² does not fit the solution's 32-bit floats (largest {:e}): scale the emission down", f32::MAX));
+    }
     let clusters_out = (0..h.cluster_count())
         .map(|c| solution::ClusterRadiosity { area: h.area(Node::Cluster(c as u32)) as f32, radiosity: f32x3(b[c]) })
         .collect();
