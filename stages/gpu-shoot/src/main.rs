@@ -74,8 +74,14 @@ impl Stage for Args {
         })
         .map_err(|m| Error::invalid(mesh_path, None, m))?;
         bar.finish_and_clear();
-        eprintln!("gpu-shoot: {}", solved.summary(&adapter));
         let artifacts = Artifacts::of(&solved, &mesh, &manifest, params, run.provenance(params), &adapter);
+        // The radiosity is shot in 32-bit floats: one beyond their range is
+        // inf, a file every reader refuses; refuse it here, writing nothing.
+        let radiosities = artifacts.solution.elements.iter().map(|e| e.radiosity).chain(artifacts.lightmap.radiosity.iter().copied());
+        if let Some(v) = radiosities.flatten().find(|v| !v.is_finite()) {
+            return Err(Error::invalid(mesh_path, None, format!("a radiosity of {v} W/m² does not fit 32-bit floats (largest {:e}): scale the emission down", f32::MAX)));
+        }
+        eprintln!("gpu-shoot: {}", solved.summary(&adapter));
         artifacts.write(outputs, required(&self.output, "-o")?, self.lightmap.as_deref(), self.convergence_log.as_deref(), self.plot.as_deref())?;
         Ok(solved.done(&manifest.effects, surface.is_some(), self.surface.is_some(), &adapter))
     }
