@@ -491,7 +491,7 @@ impl SenderTerms {
         let receiver = &h.elements[r as usize];
         let x = (receiver.points[0] + receiver.points[1] + receiver.points[2]) / 3.0;
         let n = h.normal(r);
-        let partly_occluded = l.visibility.is_some_and(|v| v > 0.0 && v < 1.0);
+        let partly_occluded = l.partly_occluded();
         let (mut terms, mut rays) = (Vec::with_capacity(parts.len()), 0);
         for part in parts {
             let Node::Element(e) = part else { return whole };

@@ -38,6 +38,13 @@ pub struct Link {
     pub clear: bool,
 }
 
+impl Link {
+    /// Whether its rays found it partly occluded (`0 < V < 1`).
+    pub fn partly_occluded(&self) -> bool {
+        self.visibility.is_some_and(|v| v > 0.0 && v < 1.0)
+    }
+}
+
 /// What to do with a link.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Split {

@@ -144,7 +144,7 @@ impl ReceiverTerms {
     pub fn new(h: &Hierarchy, links: &[Link], visibility: Option<(&SceneRays, u64)>, cache: &mut WeightCache) -> Self {
         let to_parts: Vec<bool> = links.iter().map(|l| visibility.is_some() && matches!(l.receiver, Node::Element(e) if !h.elements[e as usize].is_leaf())).collect();
         let part_built: Vec<Option<(PartWeights, usize)>> =
-            links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l, visibility.filter(|_| partly_occluded(l))))).collect();
+            links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l, visibility.filter(|_| l.partly_occluded())))).collect();
         let mut by_element: Vec<Vec<(usize, f64)>> = vec![Vec::new(); h.elements.len()];
         let mut part_links = Vec::new();
         for (l, (list, _)) in part_built.iter().enumerate().filter_map(|(l, b)| Some((l, b.as_ref()?))) {
@@ -163,7 +163,7 @@ impl ReceiverTerms {
                     return None;
                 }
                 let nodes = h.parts(l.sender, MAX_PARTS);
-                let visibility = visibility.filter(|_| partly_occluded(l));
+                let visibility = visibility.filter(|_| l.partly_occluded());
                 Some(match cache.0.get(&(l.receiver, l.sender)) {
                     Some((cached, w)) if visibility.is_none() && *cached == nodes => (nodes, w.clone(), 0),
                     _ => {
@@ -211,10 +211,21 @@ impl ReceiverTerms {
 /// Most parts an inner element receiver is opened into.
 pub const MAX_RECEIVER_PARTS: usize = 16;
 
-/// Whether link `l` is partly occluded (`0 < V < 1`).
-fn partly_occluded(l: &Link) -> bool {
-    let v = l.visibility.unwrap_or(1.0);
-    v > 0.0 && v < 1.0
+/// `f`, receiving element `receiver`'s factor to sender part `part`,
+/// weighed where `visibility` is given (a partly occluded link, `v_link`
+/// its visible fraction) by visibility: an element part's own
+/// ([`visibility::visible_factor`]), a cluster part the link's. Adds the
+/// rays cast to `rays`.
+fn seen_factor(h: &Hierarchy, visibility: Option<(&SceneRays, u64)>, receiver: u32, part: Node, f: f64, v_link: f64, rays: &mut usize) -> f64 {
+    match (visibility, part) {
+        (Some((scene, seed)), Node::Element(e)) => {
+            let (visible, cast) = visibility::visible_factor(h, scene, receiver, e, f, seed);
+            *rays += cast;
+            visible
+        }
+        (Some(_), Node::Cluster(_)) => f * v_link,
+        (None, _) => f,
+    }
 }
 
 /// `(j, w_j)`: part (element index), weight.
@@ -238,15 +249,9 @@ fn part_weights(h: &Hierarchy, l: &Link, visibility: Option<(&SceneRays, u64)>) 
             let Node::Element(j) = p else { return None };
             let points = &h.elements[j as usize].points;
             let f = sender.factor(h, (points[0] + points[1] + points[2]) / 3.0, n);
-            let f = match (visibility, l.sender) {
-                (Some((scene, seed)), Node::Element(s)) => {
-                    let (visible, cast) = visibility::visible_factor(h, scene, j, s, f, seed);
-                    rays += cast;
-                    visible
-                }
-                _ => f,
-            };
-            Some((j, h.area(p), f))
+            // A cluster sender: every part sees the same one, so the link's
+            // fraction would scale all weights alike; it is left out.
+            Some((j, h.area(p), seen_factor(h, visibility, j, l.sender, f, 1.0, &mut rays)))
         })
         .collect();
     let area: f64 = parts.iter().map(|p| p.1).sum();
@@ -278,15 +283,7 @@ fn weights(h: &Hierarchy, l: &Link, nodes: &[Node], visibility: Option<(&SceneRa
                 .zip(nodes)
                 .map(|(p, &node)| {
                     let f = points.iter().map(|&x| p.factor(h, x, g.normal)).sum::<f64>() / points.len() as f64;
-                    match (visibility, node) {
-                        (Some((scene, seed)), Node::Element(e)) => {
-                            let (visible, cast) = visibility::visible_factor(h, scene, t, e, f, seed);
-                            rays += cast;
-                            visible
-                        }
-                        (Some(_), Node::Cluster(_)) => f * v_link,
-                        _ => f,
-                    }
+                    seen_factor(h, visibility, t, node, f, v_link, &mut rays)
                 })
                 .collect();
             (h.area(Node::Element(t)), f)
