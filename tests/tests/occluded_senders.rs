@@ -20,7 +20,7 @@
 //! (lamp 2 cm, floor 5 mm). B reflects 10%; its light back on the floor,
 //! about 0.1% of the floor's, is left out.
 
-use end_to_end::{run_ok, s, scratch, solve_prepared};
+use end_to_end::{prepare_and_solve, scratch};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
@@ -97,10 +97,8 @@ fn reference(points: &[[f64; 3]]) -> Vec<f64> {
 /// worst leaf's relative error, solved with `args`.
 fn errors(test: &str, args: &[&str]) -> (f64, f64) {
     let dir = scratch(test);
-    let scene_path = scene().write(&dir);
-    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
-    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
-    let solution = Solution::read(&solve_prepared(&dir, args, None)).unwrap().0;
+    let (mesh, manifest, solution) = prepare_and_solve(&dir, &scene().write(&dir), args);
+    let solution = Solution::read(&solution).unwrap().0;
     let mesh = Mesh::read(&mesh).unwrap().0;
     let manifest = read_ron::<Manifest>(&manifest).unwrap().value;
     let b_object = manifest.objects.iter().position(|o| o == "B").unwrap() as u32;

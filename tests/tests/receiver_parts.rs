@@ -13,7 +13,7 @@
 //! its reference is the midpoint rule over the lamp (5 mm cells) with the
 //! segment test against the square written here.
 
-use end_to_end::{run_ok, s, scratch, solve_prepared};
+use end_to_end::{prepare_and_solve, scratch};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
@@ -79,10 +79,8 @@ fn exact(p: [f64; 3], occluded: bool) -> f64 {
 /// with `args`.
 fn errors(test: &str, occluded: bool, args: &[&str]) -> (f64, f64) {
     let dir = scratch(test);
-    let scene_path = scene(occluded).write(&dir);
-    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
-    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
-    let solution = Solution::read(&solve_prepared(&dir, args, None)).unwrap().0;
+    let (mesh, manifest, solution) = prepare_and_solve(&dir, &scene(occluded).write(&dir), args);
+    let solution = Solution::read(&solution).unwrap().0;
     let mesh = Mesh::read(&mesh).unwrap().0;
     let manifest = read_ron::<Manifest>(&manifest).unwrap().value;
     let floor = manifest.objects.iter().position(|o| o == "floor").unwrap() as u32;
