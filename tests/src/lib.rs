@@ -79,7 +79,11 @@ pub fn gpu_missing(out: &Output, test: &str) -> bool {
 /// Runs `stage`, expects failure with exit 2, one stderr line containing
 /// every `needle`, and none of `outputs` on disk.
 pub fn assert_refused(stage: &str, args: &[&str], needles: &[&str], outputs: &[&Path]) {
-    let out = run(stage, args);
+    assert_refusal(stage, &run(stage, args), needles, outputs);
+}
+
+/// [`assert_refused`] for a run of `stage` already made (`out`).
+pub fn assert_refusal(stage: &str, out: &Output, needles: &[&str], outputs: &[&Path]) {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stage} should exit 2; stderr: {stderr}");
     assert_eq!(stderr.trim_end().lines().count(), 1, "one line expected, got:\n{stderr}");

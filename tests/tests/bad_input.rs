@@ -1,7 +1,7 @@
 //! Bad input gets a one-line error naming the file (and the line where
 //! known), exit code 2, and no output file.
 
-use end_to_end::{assert_refused, gpu_missing, run, run_ok, s, scratch};
+use end_to_end::{assert_refusal, assert_refused, gpu_missing, run, run_ok, s, scratch};
 use std::path::{Path, PathBuf};
 use test_support::scenes::{closed_box, rectangle, QuadScene};
 
@@ -147,9 +147,7 @@ fn output_directory_that_cannot_be_written() {
 #[test]
 fn a_radiosity_beyond_the_solutions_float_range_is_refused_by_the_solver() {
     let dir = scratch("radiosity_overflow");
-    let scene = closed_box(1.0, 0.9, 3e38).write(&dir);
-    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
-    run_ok("mesh-prep", &[s(&scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let (mesh, manifest) = prepared(&dir, &closed_box(1.0, 0.9, 3e38).write(&dir));
     let solution = dir.join("solution.exr");
     assert_refused(
         "hierarchical-solve",
@@ -170,19 +168,11 @@ fn a_radiosity_beyond_32_bit_floats_is_refused_by_gpu_shoot() {
     scene.material("floor", 0.9, 0.0).material("lamp", 0.9, 3.4e38);
     scene.quad("floor", "floor", rectangle(2, 0.0, [0.0, 0.0], [1.0, 1.0]), [0.0, 0.0, 1.0]);
     scene.quad("lamp", "lamp", rectangle(2, 0.4, [0.1, 0.1], [0.25, 0.25]), [0.0, 0.0, -1.0]);
-    let scene = scene.write(&dir);
-    let (mesh, manifest) = (dir.join("mesh.exr"), dir.join("manifest.ron"));
-    run_ok("mesh-prep", &[s(&scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let (mesh, manifest) = prepared(&dir, &scene.write(&dir));
     let solution = dir.join("solution.exr");
     let out = run("gpu-shoot", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution)]);
     if gpu_missing(&out, "a_radiosity_beyond_32_bit_floats_is_refused_by_gpu_shoot") {
         return;
     }
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "gpu-shoot should exit 2; stderr: {stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "one line expected, got:\n{stderr}");
-    for needle in ["mesh.exr", "32-bit floats", "scale the emission down"] {
-        assert!(stderr.contains(needle), "error should mention {needle:?}: {stderr}");
-    }
-    assert!(!solution.exists(), "the solution was written despite the error");
+    assert_refusal("gpu-shoot", &out, &["mesh.exr", "32-bit floats", "scale the emission down"], &[&solution]);
 }

@@ -63,8 +63,7 @@ struct Leaf {
 
 /// The closed box of the closed-form tests (1 m, the ceiling's middle
 /// ninth a lamp) without its wall `y = 0`: an open, convex room, lit
-/// unevenly, as the Cornell box without its blocks.
-/// The open box's leaves, the flux `sum A_r V E_u` the solution's links
+/// unevenly, as the Cornell box without its blocks. Returns its leaves, the flux `sum A_r V E_u` the solution's links
 /// into elements bring each input triangle, and the scratch directory.
 fn open_box(test: &str, args: &[&str], clustered: bool) -> (Vec<Leaf>, Vec<f64>, PathBuf) {
     let mut scene = closed_box(1.0, 0.7, 10.0);
