@@ -18,7 +18,7 @@ use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
 use test_support::artifacts::leaf_world_corners;
-use test_support::closed_form::{lambert_polygon, mean_over_triangle};
+use test_support::closed_form::{lambert_polygon, mean_over_triangle, midpoint_square_lamp};
 use test_support::scenes::{rectangle, QuadScene};
 
 const RHO: f64 = 0.5;
@@ -58,20 +58,7 @@ fn exact(p: [f64; 3], occluded: bool) -> f64 {
     if !occluded {
         return RHO * EMISSION * lambert_polygon(p, [0.0, 0.0, 1.0], &lamp);
     }
-    let n = 30;
-    let cell = (LAMP.0[1] - LAMP.0[0]) / n as f64;
-    let mut sum = 0.0;
-    for i in 0..n {
-        for j in 0..n {
-            let q = [LAMP.0[0] + (i as f64 + 0.5) * cell, LAMP.0[0] + (j as f64 + 0.5) * cell, LAMP.1];
-            if !blocked(p, q) {
-                let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                sum += d[2] * d[2] / (std::f64::consts::PI * r2 * r2) * cell * cell;
-            }
-        }
-    }
-    RHO * EMISSION * sum
+    RHO * EMISSION * midpoint_square_lamp(p, (LAMP.0[0], LAMP.0[1]), LAMP.1, 30, &blocked)
 }
 
 /// The floor leaves' relative L2 error against [`exact`] (`sqrt(sum A

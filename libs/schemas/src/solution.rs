@@ -27,10 +27,15 @@ pub struct Element {
     /// Barycentric `(u, v)` of each corner in the input triangle: the point
     /// is `(1-u-v) P0 + u P1 + v P2`. Dyadic fractions, exact in f32.
     pub corners: [[f32; 2]; 3],
-    /// Area, m².
+    /// Area, m², of the element's surface open to the scene: hierarchical-
+    /// solve leaves out the part buried inside a solid (a floor under a
+    /// block), so a leaf crossing the block's footprint has less than its
+    /// geometric area and one wholly under it none; inner elements the sum
+    /// of their children's.
     pub area: f32,
-    /// Radiosity B (exitance: emitted plus reflected), W/m², RGB; for inner
-    /// elements the area-weighted mean of their children.
+    /// Radiosity B (exitance: emitted plus reflected), W/m², RGB, of the
+    /// element's open part; for inner elements the area-weighted mean of
+    /// their children.
     pub radiosity: [f32; 3],
 }
 

@@ -14,8 +14,11 @@
 //! normal (`n_i . n_j >= cos(crease)`; `i` itself always belongs), and,
 //! with material seams on (the default), the same material as leaf `i`.
 //! `A_j` is
-//! the leaf's area in m² (its triangle's area over `4^level`, exact for the
-//! 1:4 rule), `B_j` its radiosity in W/m². A crease (wall against floor)
+//! the leaf's area in m² as the solution gives it: the part of the leaf
+//! open to the scene (hierarchical-solve leaves out what lies buried under
+//! a solid, whose leaf shows its exposed part's radiosity, so a leaf wholly
+//! under a block does not darken the floor's corners around it), `B_j`
+//! its radiosity in W/m². A crease (wall against floor)
 //! therefore stays sharp, while the two triangles of a flat wall or the
 //! facets of a tessellated sphere blend. Material seams keep a flat
 //! boundary between materials sharp too: there the irradiance H is
@@ -126,8 +129,7 @@ impl Gouraud {
             leaves.iter().flat_map(|l| triangles[l.triangle as usize].element(&l.corners)).collect();
         let normal: Vec<DVec3> = leaves.iter().map(|l| triangles[l.triangle as usize].normal).collect();
         let material: Vec<u32> = leaves.iter().map(|l| materials[l.triangle as usize]).collect();
-        let area: Vec<f64> =
-            leaves.iter().map(|l| triangles[l.triangle as usize].area * 0.25f64.powi(l.level as i32)).collect();
+        let area: Vec<f64> = leaves.iter().map(|l| f64::from(elements[l.element as usize].area)).collect();
         let radiosity: Vec<[f64; 3]> = leaves.par_iter().map(|l| value(&l.corners, &elements[l.element as usize])).collect();
 
         let cell = weld_cell(triangles, smoothing.weld_tolerance);

@@ -14,6 +14,17 @@ use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::NONE;
 use schemas::surface::Surface;
 
+/// What the irradiance averaged over a node is divided by to give its
+/// exposed part's ([`crate::exposure`]): its exposure, or 1 where it is
+/// wholly buried (its links bring it nothing to spread).
+pub fn exposed(exposure: f64) -> f64 {
+    if exposure > 0.0 {
+        exposure
+    } else {
+        1.0
+    }
+}
+
 /// One element.
 #[derive(Clone, Debug)]
 pub struct Element {
@@ -57,6 +68,9 @@ pub struct Hierarchy {
     /// W/m² (the same in R, G, B; [`crate::luminaires`]); elements past its
     /// end have not been lit yet.
     pub direct: Vec<f64>,
+    /// Exposed fraction of each element's area ([`crate::exposure`]);
+    /// elements past its end count as wholly exposed until measured.
+    pub exposure: Vec<f64>,
     /// Textures and alpha masks with each element's averages, where the
     /// scene has them.
     pub detail: Option<Detail>,
@@ -99,7 +113,7 @@ impl Hierarchy {
         let clusters = clusters.map(|c| ClusterTree::new(c, &areas, &reflectance));
         let emission = mesh.triangles.iter().map(|t| material(t).emission).collect();
         let transmission = Transmission::new(mesh, manifest);
-        Hierarchy { elements, reflectance, emission, triangles, clusters, direct: Vec::new(), detail, transmission }
+        Hierarchy { elements, reflectance, emission, triangles, clusters, direct: Vec::new(), exposure: Vec::new(), detail, transmission }
     }
 
     /// Opaque fraction of element `e` (1 without an alpha mask).
@@ -128,17 +142,23 @@ impl Hierarchy {
 
     /// The source term of element `e`, W/m²: its emission plus its
     /// reflected direct light from the luminaires, `E + rho D`, plus, on a
-    /// translucent face, the direct light its twin transmits, `tau D_twin`
-    /// ([`crate::transmission`]).
+    /// translucent face, the direct light its twin transmits, `tau D_twin`;
+    /// the direct light, averaged over the whole element, divided by its
+    /// exposure, as the links' light is ([`crate::exposure`]).
     pub fn source(&self, e: u32) -> [f64; 3] {
         let t = self.elements[e as usize].triangle as usize;
-        let direct = |e: u32| self.direct.get(e as usize).copied().unwrap_or(0.0);
+        let direct = |e: u32| self.direct.get(e as usize).copied().unwrap_or(0.0) / exposed(self.exposure(e));
         let rho = self.reflectance_of(e);
         let mut s = [0, 1, 2].map(|c| self.emission[t][c] + rho[c] * direct(e));
         if let Some((tau, twin)) = self.transmission_of(e) {
             (0..3).for_each(|c| s[c] += tau[c] * direct(twin));
         }
         s
+    }
+
+    /// Exposed fraction of element `e`'s area ([`crate::exposure`]).
+    pub fn exposure(&self, e: u32) -> f64 {
+        self.exposure.get(e as usize).copied().unwrap_or(1.0)
     }
 
     /// Creates the four children of `e` if it has none; returns the first.

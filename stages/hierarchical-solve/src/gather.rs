@@ -28,7 +28,7 @@
 //! is one forward sweep and pull one backward sweep: every sum has a fixed
 //! order, and the result does not depend on threads.
 
-use crate::elements::Hierarchy;
+use crate::elements::{exposed, Hierarchy};
 use crate::links::Link;
 use crate::mirrors::Couplings;
 use crate::receivers::ReceiverTerms;
@@ -80,6 +80,10 @@ struct Topology {
     child_start: Vec<usize>,
     children: Vec<usize>,
     area: Vec<f64>,
+    /// Exposed fraction of each node's area ([`crate::exposure`]): a
+    /// leaf's as measured, an inner node's its children's weighted by
+    /// area.
+    exposure: Vec<f64>,
     /// Reflectance and source (emission plus reflected luminaire light,
     /// [`Hierarchy::source`]) of leaf elements; `None` for inner nodes.
     leaf: Vec<Option<([f64; 3], [f64; 3])>>,
@@ -90,7 +94,7 @@ struct Topology {
 
 impl Topology {
     fn new(h: &Hierarchy, n: usize) -> Self {
-        let mut t = Topology { parent: vec![usize::MAX; n], child_start: vec![0; n + 1], children: Vec::new(), area: vec![0.0; n], leaf: vec![None; n], transmit: Vec::new() };
+        let mut t = Topology { parent: vec![usize::MAX; n], child_start: vec![0; n + 1], children: Vec::new(), area: vec![0.0; n], exposure: vec![1.0; n], leaf: vec![None; n], transmit: Vec::new() };
         if h.transmission.is_some() {
             t.transmit = (0..n)
                 .map(|i| match node(h, i) {
@@ -113,18 +117,36 @@ impl Topology {
             }
             t.child_start[i + 1] = t.children.len();
         }
+        // Children follow their parents in the dense order.
+        for i in (0..n).rev() {
+            t.exposure[i] = match node(h, i) {
+                Node::Element(e) if h.elements[e as usize].is_leaf() => h.exposure(e),
+                _ => {
+                    let children = &t.children[t.child_start[i]..t.child_start[i + 1]];
+                    let area: f64 = children.iter().map(|&c| t.area[c]).sum();
+                    if area > 0.0 {
+                        children.iter().map(|&c| t.area[c] * t.exposure[c]).sum::<f64>() / area
+                    } else {
+                        1.0
+                    }
+                }
+            };
+        }
         t
     }
 
-    /// Pull: every inner node's radiosity from its children, leaves kept.
+    /// Pull: every inner node's radiosity from its children, leaves kept:
+    /// their mean weighted by exposed area `A x` (the radiosity of the
+    /// node's exposed part, [`crate::exposure`]).
     fn pull(&self, b: &mut [[f64; 3]]) {
         for i in (0..b.len()).rev() {
             if self.leaf[i].is_some() {
                 continue;
             }
             let mut mean = [0.0; 3];
+            let exposed = self.area[i] * self.exposure[i];
             for &child in &self.children[self.child_start[i]..self.child_start[i + 1]] {
-                let weight = if self.area[i] > 0.0 { self.area[child] / self.area[i] } else { 0.0 };
+                let weight = if exposed > 0.0 { self.area[child] * self.exposure[child] / exposed } else if self.area[i] > 0.0 { self.area[child] / self.area[i] } else { 0.0 };
                 for c in 0..3 {
                     mean[c] += weight * b[child][c];
                 }
@@ -284,7 +306,8 @@ pub fn solve(
                         g[c] += w * coupling[l] * sent_to_parts[k][c];
                     }
                 }
-                g
+                // The exposed part's irradiance (crate::exposure).
+                g.map(|x| x / exposed(topology.exposure[i]))
             })
             .collect();
         let (mut change, mut largest) = ([0.0f64; 3], 0.0f64);
@@ -652,7 +675,7 @@ fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: 
     for i in 0..n {
         let links: f64 = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| coupling[l]).sum();
         let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum::<f64>() + receivers.of_element(t).map(|(k, &w)| w * coupling[receivers.part_links[k]]).sum::<f64>());
-        let own = links + distributed + specular.map_or(0.0, |s| s.row_sum(i));
+        let own = (links + distributed + specular.map_or(0.0, |s| s.row_sum(i))) / exposed(topology.exposure[i]);
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
             for c in 0..3 {

@@ -50,6 +50,7 @@
 pub mod cluster_tree;
 pub mod detail;
 pub mod elements;
+pub mod exposure;
 pub mod gather;
 pub mod links;
 pub mod luminaires;
@@ -188,6 +189,8 @@ pub struct Work {
     pub gather_seconds: f64,
     /// Shadow rays cast to luminaires.
     pub luminaire_rays: u64,
+    /// Rays cast to measure the elements' exposure ([`exposure`]).
+    pub exposure_rays: u64,
     /// Seconds lighting elements from luminaires.
     pub luminaire_seconds: f64,
     /// Links whose sender the last solve resolved into parts
@@ -413,6 +416,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         work.luminaire_seconds += started.elapsed().as_secs_f64();
 
         let started = Instant::now();
+        work.exposure_rays += exposure::extend(&mut h, &scene, params.seed);
         let rays: usize = all_links
             .par_iter_mut()
             .filter(|l| l.visibility.is_none())
@@ -558,13 +562,14 @@ fn output_elements(h: &Hierarchy, b: &[[f64; 3]]) -> Vec<solution::Element> {
     h.elements
         .iter()
         .zip(&b[h.cluster_count()..])
-        .map(|(e, b)| solution::Element {
+        .zip(exposure::exposed_areas(h))
+        .map(|((e, b), area)| solution::Element {
             triangle: e.triangle,
             parent: e.parent,
             first_child: e.first_child,
             level: e.level,
             corners: e.corners.map(|c| c.map(|x| x as f32)),
-            area: e.area as f32,
+            area: area as f32,
             radiosity: f32x3(*b),
         })
         .collect()

@@ -32,6 +32,7 @@ pub fn done(work: &Work, params: &Params, mesh: &Mesh, manifest: &Manifest, surf
         ("gather_seconds", w.gather_seconds),
         ("luminaires", manifest.goniometric_lights.len() as f64),
         ("luminaire_rays", w.luminaire_rays as f64),
+        ("exposure_rays", w.exposure_rays as f64),
         ("luminaire_seconds", w.luminaire_seconds),
         ("visibility_rays_per_second", w.rays as f64 / w.visibility_seconds.max(1e-9)),
     ]);

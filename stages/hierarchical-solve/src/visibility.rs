@@ -106,7 +106,7 @@ pub fn visible_factor(h: &Hierarchy, scene: &SceneRays, receiver: u32, part: u32
 /// Whether `point` of `triangle` exists: not on a transparent texel of
 /// its alpha mask ([`crate::detail`]; a pair with an end that does not
 /// exist carries no light, and no weight).
-fn exists(h: &Hierarchy, triangle: u32, point: glam::DVec3) -> bool {
+pub(crate) fn exists(h: &Hierarchy, triangle: u32, point: glam::DVec3) -> bool {
     h.detail.as_ref().is_none_or(|d| d.exists(triangle, h.triangles[triangle as usize].uv_of(point)))
 }
 
