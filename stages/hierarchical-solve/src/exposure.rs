@@ -28,6 +28,12 @@
 //! emission is not (a buried part of a lamp is a lamp whose light the solid
 //! absorbs).
 //!
+//! The division can lift a leaf's row of the iteration matrix (`rho sum V
+//! F / x`) over 1 where its exposure and its links' visibility, estimated
+//! apart, disagree by their noise; the stopping rule then takes the rate
+//! from the ratios of successive changes ([`crate::gather::solve`]), as for
+//! a closed scene.
+//!
 //! A point is buried when every one of [`EXPOSURE_RAYS`] rays from it into
 //! its front hemisphere (cosine-distributed, stratified in azimuth) meets
 //! the back face of a surface first: inside a closed solid every ray does,
