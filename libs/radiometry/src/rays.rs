@@ -126,6 +126,17 @@ fn vec3a(p: DVec3) -> Vec3A {
     Vec3A::new(p.x as f32, p.y as f32, p.z as f32)
 }
 
+/// A ray direction for obvhs, its negative zeros made positive (`-0 + 0 =
+/// +0`). obvhs picks a node's near and far planes by the octant of the
+/// direction (a component below 0) but inverts a zero component by its
+/// sign bit (`signum(-0) = -1`): for a component of -0 the two disagree and
+/// the ray misses every box. A floor's normal computed by a cross product
+/// came out `(-0, 0, 1)`, and the ray straight up from under a block went
+/// through the block.
+fn direction(d: DVec3) -> Vec3A {
+    vec3a(d) + Vec3A::ZERO
+}
+
 impl SceneRays {
     /// Builds the BVH over `triangles` (vertex positions, mesh frame).
     /// Must be given at least one triangle.
@@ -193,7 +204,7 @@ impl SceneRays {
     /// The nearest hit along `origin + t direction` for `t` in
     /// `(t_min, t_max)`, skipping the mesh triangles in `skip`.
     pub fn closest_hit(&self, origin: DVec3, direction: DVec3, t_min: f32, t_max: f32, skip: [u32; 2]) -> Option<Hit> {
-        let ray = Ray::new(vec3a(origin), vec3a(direction), t_min, t_max);
+        let ray = Ray::new(vec3a(origin), self::direction(direction), t_min, t_max);
         let sheared = ShearedRay::new(ray.origin, ray.direction);
         let mut hit = RayHit::none();
         let found = self.bvh.ray_traverse(ray, &mut hit, |ray, id| self.intersect(ray, &sheared, id, skip));
@@ -222,7 +233,7 @@ impl SceneRays {
         if length <= 0.0 {
             return true;
         }
-        let ray = Ray::new(vec3a(from), vec3a(d / length), (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32);
+        let ray = Ray::new(vec3a(from), direction(d / length), (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32);
         let sheared = ShearedRay::new(ray.origin, ray.direction);
         self.bvh.ray_traverse_miss(ray, |ray, id| self.intersect(ray, &sheared, id, skip))
     }
@@ -251,6 +262,16 @@ mod tests {
         assert!(!rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 3.0), [u32::MAX; 2]));
         assert!(rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 0.9), [u32::MAX; 2]));
         assert!(rays.closest_hit(dvec3(5.0, 5.0, 0.0), DVec3::Z, 0.0, f32::INFINITY, [u32::MAX; 2]).is_none());
+    }
+
+    #[test]
+    fn a_direction_with_negative_zeros_hits_what_positive_zeros_hit() {
+        let rays = SceneRays::new(&quad(1.0, 1.0));
+        for d in [dvec3(-0.0, 0.0, 1.0), dvec3(0.0, -0.0, 1.0), dvec3(-0.0, -0.0, 1.0), dvec3(0.0, 0.0, 1.0)] {
+            let hit = rays.closest_hit(dvec3(0.1, 0.2, 0.0), d, 0.0, f32::INFINITY, [u32::MAX; 2]);
+            assert_eq!(hit.map(|h| h.t), Some(1.0), "direction {d:?}");
+            assert!(!rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 0.0) + 2.0 * d, [u32::MAX; 2]), "direction {d:?}");
+        }
     }
 
     #[test]
