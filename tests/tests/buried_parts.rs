@@ -130,8 +130,8 @@ fn summary(eps: &str) -> (f64, f64, f64, usize) {
 
 /// Measured (straddling leaves: bias, L2; open leaves over 1 cm from the
 /// footprint: worst): with the light spread over the buried part, -21.5%,
-/// 29.5%, 2.6% at `EPS` 1e-2; divided by the exposure, -0.14%, 8.5%, 3.0%,
-/// and at the default `EPS` -2.1%, 11.7%, 0.03%. What is left on a single
+/// 29.5%, 2.6% at `EPS` 1e-2; divided by the exposure, +0.5%, 8.4%, 2.5%,
+/// and at the default `EPS` -1.4%, 11.5%, 0.03%. What is left on a single
 /// straddling leaf is the noise of its links' 16 visibility rays, of which
 /// the buried part stops some.
 #[test]

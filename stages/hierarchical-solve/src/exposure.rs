@@ -76,7 +76,9 @@ pub const EXPOSURE_RAYS: usize = 1 + GRAZING_RAYS;
 /// faces. With 6 rays drawn by the cosine (mostly steep), 703 of the 9,000
 /// one-sided leaves of `plants-10k` were found partly buried under the
 /// backs of the leaves above them (false: light reaches them from the
-/// sides); with these, ...
+/// sides); with 8 grazing rays 51, with 16 six (exposure 0.94 to 0.99),
+/// for half the rays (the ray along the normal settles most open points
+/// at once).
 pub const GRAZING_RAYS: usize = 16;
 
 /// Cosine to the normal of the grazing rays (about 6 degrees above the
