@@ -9,8 +9,12 @@
 pub mod fuzz;
 pub mod stages;
 
+use schemas::mesh::{Manifest, Mesh};
+use schemas::ron_io::read_ron;
+use schemas::solution::{Element, Solution};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use test_support::artifacts::leaf_world_corners;
 
 /// Path of the stage binary `name` next to this test executable.
 pub fn bin(name: &str) -> PathBuf {
@@ -107,6 +111,33 @@ pub fn prepare_and_solve(dir: &Path, scene: &Path, solve_args: &[&str]) -> (Path
     run_ok("mesh-prep", &[s(scene), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
     let solution = solve_prepared(dir, solve_args, None);
     (mesh, manifest, solution)
+}
+
+/// A scene prepared and solved by [`prepare_and_solve`], its artifacts read
+/// back.
+pub struct Solved {
+    /// The prepared mesh.
+    pub mesh: Mesh,
+    /// Its manifest.
+    pub manifest: Manifest,
+    /// hierarchical-solve's solution.
+    pub solution: Solution,
+}
+
+impl Solved {
+    /// [`prepare_and_solve`] on `scene` in `dir` with `solve_args`.
+    pub fn new(dir: &Path, scene: &Path, solve_args: &[&str]) -> Self {
+        let (mesh, manifest, solution) = prepare_and_solve(dir, scene, solve_args);
+        Solved { mesh: Mesh::read(&mesh).unwrap().0, manifest: read_ron::<Manifest>(&manifest).unwrap().value, solution: Solution::read(&solution).unwrap().0 }
+    }
+
+    /// The leaf elements on the triangles of object `name`, each with its
+    /// world corners.
+    pub fn leaves_of(&self, name: &str) -> Vec<(&Element, [[f64; 3]; 3])> {
+        let object = self.manifest.objects.iter().position(|o| o == name).unwrap_or_else(|| panic!("no object {name}")) as u32;
+        let on_object = |e: &&Element| e.is_leaf() && self.mesh.triangles[e.triangle as usize].object == object;
+        self.solution.elements.iter().filter(on_object).map(|e| (e, leaf_world_corners(&self.mesh, self.manifest.world_from_mesh_translation, e))).collect()
+    }
 }
 
 /// hierarchical-solve on the mesh and manifest already in `dir`, clustered

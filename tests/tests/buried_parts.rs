@@ -14,11 +14,7 @@
 //! against the slab's box written here); a leaf's reference is the mean of
 //! that over its part outside the footprint.
 
-use end_to_end::{prepare_and_solve, scratch};
-use schemas::mesh::{Manifest, Mesh};
-use schemas::ron_io::read_ron;
-use schemas::solution::Solution;
-use test_support::artifacts::leaf_world_corners;
+use end_to_end::{scratch, Solved};
 use test_support::closed_form::{mean_over_triangle, midpoint_square_lamp};
 use test_support::scenes::{rectangle, QuadScene};
 
@@ -89,14 +85,9 @@ fn distance_to_footprint(p: &[f64; 3]) -> f64 {
 /// exposed part (64 points).
 fn leaf_errors(test: &str, args: &[&str], min_exposure: f64) -> Vec<(f64, bool, f64)> {
     let dir = scratch(test);
-    let (mesh, manifest, solution) = prepare_and_solve(&dir, &scene().write(&dir), args);
-    let solution = Solution::read(&solution).unwrap().0;
-    let mesh = Mesh::read(&mesh).unwrap().0;
-    let manifest = read_ron::<Manifest>(&manifest).unwrap().value;
-    let floor = manifest.objects.iter().position(|o| o == "floor").unwrap() as u32;
+    let solved = Solved::new(&dir, &scene().write(&dir), args);
     let mut out = Vec::new();
-    for e in solution.elements.iter().filter(|e| e.first_child == u32::MAX && mesh.triangles[e.triangle as usize].object == floor) {
-        let corners = leaf_world_corners(&mesh, manifest.world_from_mesh_translation, e);
+    for (e, corners) in solved.leaves_of("floor") {
         let fraction = mean_over_triangle(&corners, 3, &|p| f64::from(u8::from(exposed(p))));
         if fraction < min_exposure {
             continue;

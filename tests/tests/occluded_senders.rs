@@ -20,11 +20,7 @@
 //! (lamp 2 cm, floor 5 mm). B reflects 10%; its light back on the floor,
 //! about 0.1% of the floor's, is left out.
 
-use end_to_end::{prepare_and_solve, scratch};
-use schemas::mesh::{Manifest, Mesh};
-use schemas::ron_io::read_ron;
-use schemas::solution::Solution;
-use test_support::artifacts::leaf_world_corners;
+use end_to_end::{scratch, Solved};
 use test_support::closed_form::mean_over_triangle;
 use test_support::scenes::{rectangle, QuadScene};
 
@@ -97,16 +93,11 @@ fn reference(points: &[[f64; 3]]) -> Vec<f64> {
 /// worst leaf's relative error, solved with `args`.
 fn errors(test: &str, args: &[&str]) -> (f64, f64) {
     let dir = scratch(test);
-    let (mesh, manifest, solution) = prepare_and_solve(&dir, &scene().write(&dir), args);
-    let solution = Solution::read(&solution).unwrap().0;
-    let mesh = Mesh::read(&mesh).unwrap().0;
-    let manifest = read_ron::<Manifest>(&manifest).unwrap().value;
-    let b_object = manifest.objects.iter().position(|o| o == "B").unwrap() as u32;
-    let leaves: Vec<_> = solution.elements.iter().filter(|e| e.first_child == u32::MAX && mesh.triangles[e.triangle as usize].object == b_object).collect();
+    let solved = Solved::new(&dir, &scene().write(&dir), args);
+    let leaves = solved.leaves_of("B");
     let points = std::cell::RefCell::new(Vec::new());
-    for e in &leaves {
-        let corners = leaf_world_corners(&mesh, manifest.world_from_mesh_translation, e);
-        mean_over_triangle(&corners, 1, &|x| {
+    for (_, corners) in &leaves {
+        mean_over_triangle(corners, 1, &|x| {
             points.borrow_mut().push(x);
             0.0
         });
@@ -114,7 +105,7 @@ fn errors(test: &str, args: &[&str]) -> (f64, f64) {
     let points = points.into_inner();
     let exact: Vec<f64> = reference(&points).chunks(4).map(|r| r.iter().sum::<f64>() / 4.0).collect();
     let (mut got, mut want, mut worst) = (0.0, 0.0, 0.0f64);
-    for (e, x) in leaves.iter().zip(&exact) {
+    for ((e, _), x) in leaves.iter().zip(&exact) {
         let (a, b) = (f64::from(e.area), f64::from(e.radiosity[0]));
         got += a * b;
         want += a * x;

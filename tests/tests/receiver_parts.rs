@@ -13,11 +13,7 @@
 //! its reference is the midpoint rule over the lamp (5 mm cells) with the
 //! segment test against the square written here.
 
-use end_to_end::{prepare_and_solve, scratch};
-use schemas::mesh::{Manifest, Mesh};
-use schemas::ron_io::read_ron;
-use schemas::solution::Solution;
-use test_support::artifacts::leaf_world_corners;
+use end_to_end::{scratch, Solved};
 use test_support::closed_form::{lambert_polygon, mean_over_triangle, midpoint_square_lamp};
 use test_support::scenes::{rectangle, QuadScene};
 
@@ -66,14 +62,9 @@ fn exact(p: [f64; 3], occluded: bool) -> f64 {
 /// with `args`.
 fn errors(test: &str, occluded: bool, args: &[&str]) -> (f64, f64) {
     let dir = scratch(test);
-    let (mesh, manifest, solution) = prepare_and_solve(&dir, &scene(occluded).write(&dir), args);
-    let solution = Solution::read(&solution).unwrap().0;
-    let mesh = Mesh::read(&mesh).unwrap().0;
-    let manifest = read_ron::<Manifest>(&manifest).unwrap().value;
-    let floor = manifest.objects.iter().position(|o| o == "floor").unwrap() as u32;
+    let solved = Solved::new(&dir, &scene(occluded).write(&dir), args);
     let (mut squares, mut area, mut worst) = (0.0, 0.0, 0.0f64);
-    for e in solution.elements.iter().filter(|e| e.first_child == u32::MAX && mesh.triangles[e.triangle as usize].object == floor) {
-        let corners = leaf_world_corners(&mesh, manifest.world_from_mesh_translation, e);
+    for (e, corners) in solved.leaves_of("floor") {
         let want = mean_over_triangle(&corners, 2, &|x| exact(x, occluded));
         let error = f64::from(e.radiosity[0]) - want;
         squares += f64::from(e.area) * error * error;

@@ -102,6 +102,27 @@ pub fn mean_over_triangle(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -
     [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]].iter().map(|t| mean_over_triangle(t, levels - 1, f)).sum::<f64>() / 4.0
 }
 
+/// The factor from point `p` facing up (`+z`) to a square lamp facing down
+/// at height `z`, `x, y in [lo, hi]`, by the midpoint rule over `n x n`
+/// cells, leaving out the cells `blocked(p, q)` (`q` a cell's centre) says
+/// are hidden: the quadrature reference of a floor shadowed by an occluder
+/// that a test writes its own segment test for.
+pub fn midpoint_square_lamp(p: [f64; 3], (lo, hi): (f64, f64), z: f64, n: usize, blocked: &dyn Fn([f64; 3], [f64; 3]) -> bool) -> f64 {
+    let cell = (hi - lo) / n as f64;
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let q = [lo + (i as f64 + 0.5) * cell, lo + (j as f64 + 0.5) * cell, z];
+            if !blocked(p, q) {
+                let d = sub(q, p);
+                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                sum += d[2] * d[2] / (PI * r2 * r2) * cell * cell;
+            }
+        }
+    }
+    sum
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,25 +147,4 @@ mod tests {
         assert_eq!(half.len(), 4);
         assert!((lambert_polygon([0.0; 3], [0.0, 0.0, 1.0], &half) - 0.5 * centre).abs() < 1e-14);
     }
-}
-
-/// The factor from point `p` facing up (`+z`) to a square lamp facing down
-/// at height `z`, `x, y in [lo, hi]`, by the midpoint rule over `n x n`
-/// cells, leaving out the cells `blocked(p, q)` (`q` a cell's centre) says
-/// are hidden: the quadrature reference of a floor shadowed by an occluder
-/// that a test writes its own segment test for.
-pub fn midpoint_square_lamp(p: [f64; 3], (lo, hi): (f64, f64), z: f64, n: usize, blocked: &dyn Fn([f64; 3], [f64; 3]) -> bool) -> f64 {
-    let cell = (hi - lo) / n as f64;
-    let mut sum = 0.0;
-    for i in 0..n {
-        for j in 0..n {
-            let q = [lo + (i as f64 + 0.5) * cell, lo + (j as f64 + 0.5) * cell, z];
-            if !blocked(p, q) {
-                let d = sub(q, p);
-                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                sum += d[2] * d[2] / (PI * r2 * r2) * cell * cell;
-            }
-        }
-    }
-    sum
 }

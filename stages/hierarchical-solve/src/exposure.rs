@@ -37,9 +37,8 @@
 //! A point is buried when every one of [`EXPOSURE_RAYS`] rays from it into
 //! its front hemisphere (along its normal, and [`GRAZING_RAYS`] nearly
 //! along its surface) meets the back face of a surface first: inside a
-//! closed solid every ray does,
-//! and a ray that leaves the scene or meets a front face shows the point
-//! open to the room. A two-sided surface has no back face for rays (they
+//! closed solid every ray does, and a ray that leaves the scene or meets a
+//! front face shows the point open to the room. A two-sided surface has no back face for rays (they
 //! see its twin's front, [`radiometry::rays`]), so nothing is buried under
 //! a sheet, only inside solids. `x` is the fraction of stratified points of
 //! the element (those that exist under an alpha mask) that are not buried
@@ -158,7 +157,6 @@ pub fn extend(h: &mut Hierarchy, scene: &SceneRays, seed: u64) -> u64 {
     h.exposure.extend(measured.iter().map(|m| m.0));
     measured.iter().map(|m| m.1).sum()
 }
-
 
 /// Each element's exposed area, m²: a leaf's area times its exposure, an
 /// inner element's the sum of its children's (what the solution file's

@@ -144,9 +144,15 @@ impl Topology {
                 continue;
             }
             let mut mean = [0.0; 3];
-            let exposed = self.area[i] * self.exposure[i];
+            let open_area = self.area[i] * self.exposure[i];
             for &child in &self.children[self.child_start[i]..self.child_start[i + 1]] {
-                let weight = if exposed > 0.0 { self.area[child] * self.exposure[child] / exposed } else if self.area[i] > 0.0 { self.area[child] / self.area[i] } else { 0.0 };
+                let weight = if open_area > 0.0 {
+                    self.area[child] * self.exposure[child] / open_area
+                } else if self.area[i] > 0.0 {
+                    self.area[child] / self.area[i]
+                } else {
+                    0.0
+                };
                 for c in 0..3 {
                     mean[c] += weight * b[child][c];
                 }

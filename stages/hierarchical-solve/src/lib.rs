@@ -415,8 +415,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         work.luminaire_rays += luminaires::extend(&mut h, &direct, params.quadrature_depth);
         work.luminaire_seconds += started.elapsed().as_secs_f64();
 
-        let started = Instant::now();
         work.exposure_rays += exposure::extend(&mut h, &scene, params.seed);
+        let started = Instant::now();
         let rays: usize = all_links
             .par_iter_mut()
             .filter(|l| l.visibility.is_none())
