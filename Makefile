@@ -45,6 +45,8 @@ SEED ?= 1
 WIDTH ?=
 HEIGHT ?=
 SPP ?= 4
+# Full gather: pixels between its lattice's points; empty: grid-gather's default.
+LATTICE_SPACING ?=
 OPERATOR ?= reinhard
 
 BIN := target/release

@@ -69,7 +69,7 @@ $(OUT)/threshold.exr: $(BIN)/mask $(OUT)/params/mask.ron $(OUT)/image.png
 	$(BIN)/mask --params $(OUT)/params/mask.ron $(OUT)/image.png -o $@ --report $(OUT)/mask.report.ron
 
 $(OUT)/params/grid-gather-full.ron: $(BIN)/grid-gather FORCE | $(OUT)/params
-	@$(BIN)/grid-gather --print-params --mode full --spp $(SPP) $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT)) $(GATHER_FLAGS) > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
+	@$(BIN)/grid-gather --print-params --mode full --spp $(SPP) $(if $(LATTICE_SPACING),--lattice-spacing $(LATTICE_SPACING)) $(if $(WIDTH),--width $(WIDTH)) $(if $(HEIGHT),--height $(HEIGHT)) $(GATHER_FLAGS) > $@.new && { cmp -s $@.new $@ && rm $@.new || mv $@.new $@; }
 
 $(OUT)/final.exr $(OUT)/final.diagnostics.exr &: $(BIN)/grid-gather $(OUT)/params/grid-gather-full.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(OUT)/solution.exr $(if $(MASK),$(OUT)/threshold.exr) $(CLUSTERS_EXR)
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather-full.ron \

@@ -29,7 +29,8 @@ SWEEP_SOLVER ?= hierarchical
 SWEEP_GATHER ?=
 # One knob and its values, e.g. SWEEP_KNOB=EPS SWEEP_VALUES=1e-2,1e-3.
 # Knobs: EPS, MIN_AREA, VISIBILITY_RAYS, TOLERANCE (hierarchical);
-# GPU_TEXELS, GPU_CONVERGENCE, GPU_RESOLUTION, GPU_SHOOT_LEVEL (gpu); SPP.
+# GPU_TEXELS, GPU_CONVERGENCE, GPU_RESOLUTION, GPU_SHOOT_LEVEL (gpu); SPP;
+# LATTICE_SPACING (the full gather's).
 SWEEP_KNOB ?=
 SWEEP_VALUES ?=
 # Several knobs, space-separated NAME=v1,v2 (the grid is their product).

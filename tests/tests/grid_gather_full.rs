@@ -81,7 +81,10 @@ fn a_clustered_solution_of_a_convex_room_interpolates_visibility_and_matches_bru
     let cluster_senders = solution.links.iter().filter(|l| matches!(l.sender, Node::Cluster(_))).count();
     assert!(cluster_senders > 0, "the solve made cluster links");
     let size = Params { width: Some(32), height: Some(32), spp: 2, ..Params::default() };
-    let full = Params { mode: Mode::Full, grid_pixels: 8, grid_depth: 6, ..size.clone() };
+    // The grid's interpolation per camera sample, as paper 000 has it; the
+    // image lattice on top of it has its own tests (grid-gather's
+    // `lattice` module and `tests::full`).
+    let full = Params { mode: Mode::Full, grid_pixels: 8, grid_depth: 6, lattice: false, ..size.clone() };
     let (image, diagnostics) = run_clustered(&mesh, &manifest, &solution, Some(&clusters), &full);
     assert!(!diagnostics.vertices.is_empty());
     for v in &diagnostics.vertices {
@@ -195,7 +198,9 @@ fn the_full_gather_resamples_a_straddling_sender_to_its_front_part() {
             l.visibility = 0.5;
         }
     }
-    let full = Params { mode: Mode::Full, spp: 2, grid_pixels: 8, grid_depth: 4, ..Params::default() };
+    // Per camera sample (no image lattice, which interpolates between
+    // pixels): the visibility itself is under test.
+    let full = Params { mode: Mode::Full, spp: 2, grid_pixels: 8, grid_depth: 4, lattice: false, ..Params::default() };
     let (image, _) = run(&room, &full);
     assert!(image.counters["visibility_rays"] > 0.0, "the partly visible links were resampled");
     let brute = Params { mode: Mode::Brute, spp: 2, brute_samples: 64, ..Params::default() };

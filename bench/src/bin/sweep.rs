@@ -21,7 +21,8 @@ use std::process::ExitCode;
 /// Runs the pipeline's stages over a grid of knob values and tabulates and
 /// plots error against time. Knobs (Makefile names): EPS, MIN_AREA,
 /// VISIBILITY_RAYS, TOLERANCE (hierarchical); GPU_TEXELS, GPU_CONVERGENCE,
-/// GPU_RESOLUTION, GPU_SHOOT_LEVEL (gpu); SPP (both).
+/// GPU_RESOLUTION, GPU_SHOOT_LEVEL (gpu); SPP (both); LATTICE_SPACING (the
+/// full gather's).
 #[derive(Parser, Debug)]
 #[command(name = "sweep", version)]
 struct Args {

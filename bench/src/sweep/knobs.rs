@@ -189,6 +189,7 @@ pub const KNOBS: &[Knob] = &[
     Knob { name: "PHOTON_TARGET_ERROR", target: Target::Solve, flag: "--target-error", solvers: &[Solver::Photon], integer: false, tighten: Tighten::Divide(2.0), meaning: "photons until every vertex's relative error is under this" },
     Knob { name: "STRUCTURED_LEVELS", target: Target::Solve, flag: "--levels", solvers: &[Solver::Structured], integer: true, tighten: Tighten::Multiply(2.0), meaning: "isolux bands per surface" },
     Knob { name: "SPP", target: Target::Gather, flag: "--spp", solvers: &[Solver::Hierarchical, Solver::Gpu, Solver::Photon], integer: true, tighten: Tighten::Multiply(4.0), meaning: "camera rays per pixel" },
+    Knob { name: "LATTICE_SPACING", target: Target::Gather, flag: "--lattice-spacing", solvers: &[Solver::Hierarchical], integer: false, tighten: Tighten::Divide(2.0), meaning: "pixels between the full gather's lattice points" },
 ];
 
 /// grid-gather's camera rays per pixel where SPP is not swept: the

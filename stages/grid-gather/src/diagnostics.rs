@@ -21,6 +21,9 @@ pub struct Work {
     pub classes: [u64; 4],
     /// 1 when the surface-based gather shaded the sample.
     pub surface: u64,
+    /// 1 when the sample's irradiance was interpolated on the lattice
+    /// ([`crate::lattice`]).
+    pub interpolated: u64,
 }
 
 impl Work {
@@ -29,6 +32,7 @@ impl Work {
         self.visibility_rays += o.visibility_rays;
         self.form_factors += o.form_factors;
         self.surface += o.surface;
+        self.interpolated += o.interpolated;
         for k in 0..4 {
             self.classes[k] += o.classes[k];
         }
@@ -54,6 +58,8 @@ pub struct Tally<'a> {
     pub hits: u64,
     /// Rays continued through mirrors and glass, in a scene that has some.
     pub specular: Option<Followed>,
+    /// Points of the irradiance lattice, where the gather has one.
+    pub lattice_points: Option<u64>,
 }
 
 /// The diagnostics and the report's counters of an image whose work was
@@ -100,7 +106,7 @@ pub fn record(tally: &Tally, gather: &FullGather) -> (Diagnostics, BTreeMap<Stri
     let mut c = BTreeMap::new();
     c.insert("pixels".into(), pixels);
     c.insert("samples_per_pixel".into(), f64::from(spp));
-    c.insert("rays_cast".into(), pixels * f64::from(spp) + pixels);
+    c.insert("rays_cast".into(), pixels * f64::from(spp) + pixels + tally.lattice_points.unwrap_or(0) as f64);
     c.insert("ray_hits".into(), hits as f64);
     c.insert("visibility_rays".into(), total.visibility_rays as f64);
     c.insert("form_factor_evaluations".into(), total.form_factors as f64);
@@ -112,6 +118,10 @@ pub fn record(tally: &Tally, gather: &FullGather) -> (Diagnostics, BTreeMap<Stri
     c.insert("grid_vertices".into(), grid.vertex_count() as f64);
     c.insert("grid_vertices_built".into(), d.vertices.len() as f64);
     c.insert("senders_skipped_occluded".into(), skipped as f64);
+    if let Some(points) = tally.lattice_points {
+        c.insert("lattice_points".into(), points as f64);
+        c.insert("samples_interpolated".into(), total.interpolated as f64);
+    }
     if let Some(specular) = tally.specular {
         crate::specular::count(&mut c, specular);
     }

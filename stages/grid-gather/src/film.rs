@@ -48,6 +48,8 @@ pub struct Lens<'a> {
 pub struct CameraHit {
     /// The camera sample's number in its pixel, `0..spp`.
     pub k: u32,
+    /// Its image position (pixels, `x` right, `y` down).
+    pub at: [f64; 2],
     /// Unit direction of the ray from the eye.
     pub direction: DVec3,
     /// The closest hit.
@@ -139,14 +141,15 @@ pub fn expose<S: Shader>(lens: &Lens, sampling: Sampling, shader: &S, rows_done:
                 let (mut sum, mut covered, mut tally) = ([0.0f64; 3], 0u32, PixelTally::new(lens.crease_angle_deg));
                 for k in 0..spp {
                     let (jx, jy) = pixel_offset(k, spp, &mut stream);
-                    let direction = camera.direction(f64::from(x) + jx, f64::from(y) + jy);
+                    let at = [f64::from(x) + jx, f64::from(y) + jy];
+                    let direction = camera.direction(at[0], at[1]);
                     let Some(hit) = lens.rays.and_then(|rays| rays.closest_hit(camera.eye, direction, 0.0, f32::INFINITY, [u32::MAX; 2])) else {
                         tally.other();
                         continue;
                     };
                     covered += 1;
                     row.hits += 1;
-                    if shader.shade(&mut state, &CameraHit { k, direction, hit }, &mut sum, &mut row.followed) {
+                    if shader.shade(&mut state, &CameraHit { k, at, direction, hit }, &mut sum, &mut row.followed) {
                         tally.front(lens.surfaces[hit.triangle as usize], lens.triangles[hit.triangle as usize].normal);
                     } else {
                         row.back_face_hits += 1;

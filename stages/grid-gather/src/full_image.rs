@@ -11,6 +11,7 @@ use crate::diagnostics::{record, Tally, Work};
 use crate::film::{expose, CameraHit, Lens, Sampling, Shader};
 use crate::full_gather::{FullGather, Surface};
 use crate::grid::Grid;
+use crate::lattice::{IrradianceLattice, LatticePoint, Target};
 use crate::pixel_surfaces::{self, SurfaceId};
 use crate::senders::Senders;
 use crate::specular::{Followed, Seen, Specular};
@@ -157,6 +158,11 @@ struct Shading<'a> {
     gather: &'a FullGather<'a>,
     grid: &'a Grid,
     luminaires: &'a DirectLight<'a>,
+    /// The links' irradiance on the image lattice, where the full gather
+    /// interpolates it ([`crate::lattice`]).
+    lattice: Option<&'a IrradianceLattice>,
+    /// The camera's view axis (unit), for the lattice points' depths.
+    forward: DVec3,
 }
 
 /// A pixel's state in the full and brute gathers.
@@ -175,7 +181,8 @@ impl Shader for Shading<'_> {
     type Pixel = GatherPixel;
 
     fn pixel(&self, index: u64) -> GatherPixel {
-        GatherPixel { stream: Stream::new(self.params.seed, index, 1 + u64::from(self.params.brute_samples)), work: Work::default(), links: (Vec::new(), Vec::new()) }
+        let work = self.lattice.map_or_else(Work::default, |l| l.work_of_pixel(index as usize));
+        GatherPixel { stream: Stream::new(self.params.seed, index, 1 + u64::from(self.params.brute_samples)), work, links: (Vec::new(), Vec::new()) }
     }
 
     /// Shades the front face seen directly, or what the ray reaches through
@@ -185,13 +192,13 @@ impl Shader for Shading<'_> {
         let front = camera.direction.dot(scene.triangles[hit.triangle as usize].normal) <= 0.0;
         let mut sample = Work::default();
         let GatherPixel { stream, links: (links, back_links), .. } = pixel;
-        let mut shade = |seen: &Seen| {
-            let radiance = self.radiance(seen, camera.k, (&mut *links, &mut *back_links), stream, &mut sample);
+        let mut shade = |seen: &Seen, at: Option<[f64; 2]>| {
+            let radiance = self.radiance(seen, camera.k, at, (&mut *links, &mut *back_links), stream, &mut sample);
             (0..3).for_each(|c| sum[c] += seen.weight[c] * radiance[c]);
         };
         match scene.specular.filter(|s| s.is_specular(hit.triangle)) {
-            Some(specular) => followed.add(specular.follow(self.rays, scene.triangles, eye, camera.direction, hit, &mut shade)),
-            None if front => shade(&Seen { hit, origin: eye, direction: camera.direction, weight: [1.0; 3], depth: 0 }),
+            Some(specular) => followed.add(specular.follow(self.rays, scene.triangles, eye, camera.direction, hit, &mut |seen| shade(seen, None))),
+            None if front => shade(&Seen { hit, origin: eye, direction: camera.direction, weight: [1.0; 3], depth: 0 }, Some(camera.at)),
             None => {}
         }
         pixel.work.add(&sample);
@@ -200,6 +207,27 @@ impl Shader for Shading<'_> {
 }
 
 impl Shading<'_> {
+    /// The lattice point at image position `at`: the links' irradiance where
+    /// the camera ray through it meets the front of a surface that is no
+    /// mirror or pane, gathered with visibility block `block`.
+    fn lattice_point(&self, at: [f64; 2], block: u32, work: &mut Work) -> Option<LatticePoint> {
+        let scene = self.scene;
+        let direction = scene.camera.direction(at[0], at[1]);
+        let hit = self.rays.closest_hit(scene.camera.eye, direction, 0.0, f32::INFINITY, [u32::MAX; 2])?;
+        let (triangle, tri) = (hit.triangle, &scene.triangles[hit.triangle as usize]);
+        if direction.dot(tri.normal) > 0.0 || scene.specular.is_some_and(|s| s.is_specular(triangle)) {
+            return None;
+        }
+        let point = scene.camera.eye + direction * f64::from(hit.t);
+        let uv = tri.uv_of(point);
+        let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
+        let mut links = Vec::new();
+        let leaf = self.senders.chain(triangle, uv, &mut links);
+        let irradiance = self.gather.irradiance(point, normal, triangle, leaf, &links, block, work);
+        let depth = (point - scene.camera.eye).dot(self.forward);
+        Some(LatticePoint { point, normal, surface: scene.ids[triangle as usize], depth, irradiance })
+    }
+
     /// Irradiance at `p` on `triangle` (normal `normal`) from the links in
     /// `links`: the brute gather in brute mode, and for a point seen
     /// through mirrors or glass that lies outside the grid (the grid covers
@@ -215,8 +243,14 @@ impl Shading<'_> {
 
     /// Radiance `B / pi` leaving the point `seen` reached towards its ray,
     /// for camera sample `pass`: `E + rho (H + H_lights) + tau H_back`
-    /// (004 Eq. 4.4 for the last term); black on a back face.
-    fn radiance(&self, seen: &Seen, pass: u32, (links, back_links): (&mut Vec<usize>, &mut Vec<usize>), stream: &mut Stream, work: &mut Work) -> [f64; 3] {
+    /// (004 Eq. 4.4 for the last term); black on a back face. A point the
+    /// camera sees directly, at image position `at`, takes `H` from the
+    /// lattice where the lattice can interpolate it there. (Where it cannot,
+    /// taking the `H` another sample of the pixel gathered instead, on the
+    /// same surface and plane, put 3.5% into pixels at a floor's far edge,
+    /// where one pixel spans 15 cm of it.)
+    #[allow(clippy::too_many_arguments)]
+    fn radiance(&self, seen: &Seen, pass: u32, at: Option<[f64; 2]>, (links, back_links): (&mut Vec<usize>, &mut Vec<usize>), stream: &mut Stream, work: &mut Work) -> [f64; 3] {
         let (scene, triangle) = (self.scene, seen.hit.triangle);
         let tri = &scene.triangles[triangle as usize];
         if seen.direction.dot(tri.normal) > 0.0 {
@@ -224,9 +258,18 @@ impl Shading<'_> {
         }
         let p = seen.origin + seen.direction * f64::from(seen.hit.t);
         let uv = tri.uv_of(p);
-        let leaf = self.senders.chain(triangle, uv, links);
         let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
-        let mut irradiance = self.irradiance(p, normal, triangle, leaf, links, seen, pass, stream, work);
+        let interpolated = self.lattice.zip(at).and_then(|(lattice, at)| lattice.interpolate(&Target { at, point: p, normal, surface: scene.ids[triangle as usize] }));
+        let mut irradiance = match interpolated {
+            Some(h) => {
+                work.interpolated += 1;
+                h
+            }
+            None => {
+                let leaf = self.senders.chain(triangle, uv, links);
+                self.irradiance(p, normal, triangle, leaf, links, seen, pass, stream, work)
+            }
+        };
         if let Some(windows) = scene.window_light {
             let light = windows.radiosity(triangle, uv);
             (0..3).for_each(|c| irradiance[c] += light[c]);
@@ -284,11 +327,16 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let vertex_contrast = vertex_contrast(params.contrast, &grid, &centres, w, h, scene.threshold);
     let gather = FullGather::new(&senders, &grid, &rays, scene.surfaces, params, vertex_contrast, width);
     let luminaires = DirectLight { lights: scene.lights, rays: &rays };
-    let shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires };
+    let mut shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires, lattice: None, forward: camera.direction(0.5 * f64::from(width), 0.5 * f64::from(height)) };
+    let lattice = (params.mode == Mode::Full && params.lattice).then(|| {
+        let spacing = params.lattice_spacing.unwrap_or_else(|| IrradianceLattice::default_spacing(params.spp));
+        IrradianceLattice::gather(width, height, spacing, params.crease_angle_deg, &|at, block, work| shading.lattice_point(at, block, work))
+    });
+    shading.lattice = lattice.as_ref();
     let lens = Lens { camera, triangles: scene.triangles, rays: Some(&rays), surfaces: scene.ids, crease_angle_deg: params.crease_angle_deg };
     let film = expose(&lens, Sampling { width, height, spp: params.spp, seed: params.seed }, &shading, rows_done);
     let work: Vec<Work> = film.pixels.iter().map(|p| p.work).collect();
-    let tally = Tally { width, height, spp: params.spp, pixels: &work, hits: film.hits, specular: scene.specular.map(|_| film.specular) };
+    let tally = Tally { width, height, spp: params.spp, pixels: &work, hits: film.hits, specular: scene.specular.map(|_| film.specular), lattice_points: lattice.as_ref().map(|l| l.point_count() as u64) };
     let (diagnostics, counters) = record(&tally, &gather);
     FullImage { rgb: film.rgb, coverage: film.coverage, surfaces: film.surfaces, diagnostics, counters }
 }
