@@ -423,13 +423,20 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
         None => progress(&reference.label),
     }
 
-    // The points.
+    // The points, in a `runs` folder of this sweep's alone: a point left
+    // there by an earlier sweep of other knobs would be read as one of
+    // this sweep's (`make bench-peer` reads the best point's surfaces from
+    // it).
+    let runs = out.join("runs");
+    if runs.exists() {
+        std::fs::remove_dir_all(&runs).map_err(|e| Error::io(&runs, e))?;
+    }
     let runs_total: usize = plans.iter().map(|p| p.settings.len() * config.reps).sum();
     let mut done = 0;
     let mut points = Vec::new();
     for plan in plans {
         for setting in &plan.settings {
-            let point_dir = out.join("runs").join(plan.solver.name()).join(setting_dir(setting));
+            let point_dir = runs.join(plan.solver.name()).join(setting_dir(setting));
             let mut reps: Vec<RepFigures> = Vec::new();
             for rep in 0..config.reps {
                 let dir = point_dir.join(format!("rep{rep}"));

@@ -181,8 +181,7 @@ impl Shader for Shading<'_> {
     type Pixel = GatherPixel;
 
     fn pixel(&self, index: u64) -> GatherPixel {
-        let work = self.lattice.map_or_else(Work::default, |l| l.work_of_pixel(index as usize));
-        GatherPixel { stream: Stream::new(self.params.seed, index, 1 + u64::from(self.params.brute_samples)), work, links: (Vec::new(), Vec::new()) }
+        GatherPixel { stream: Stream::new(self.params.seed, index, 1 + u64::from(self.params.brute_samples)), work: Work::default(), links: (Vec::new(), Vec::new()) }
     }
 
     /// Shades the front face seen directly, or what the ray reaches through
@@ -259,7 +258,7 @@ impl Shading<'_> {
         let p = seen.origin + seen.direction * f64::from(seen.hit.t);
         let uv = tri.uv_of(p);
         let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
-        let interpolated = self.lattice.zip(at).and_then(|(lattice, at)| lattice.interpolate(&Target { at, point: p, normal, surface: scene.ids[triangle as usize] }));
+        let interpolated = self.lattice.zip(at).and_then(|(lattice, at)| lattice.interpolate(&Target { at, point: p, normal, surface: scene.ids[triangle as usize] }, &|at, block, work| self.lattice_point(at, block, work)));
         let mut irradiance = match interpolated {
             Some(h) => {
                 work.interpolated += 1;
@@ -335,7 +334,10 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     shading.lattice = lattice.as_ref();
     let lens = Lens { camera, triangles: scene.triangles, rays: Some(&rays), surfaces: scene.ids, crease_angle_deg: params.crease_angle_deg };
     let film = expose(&lens, Sampling { width, height, spp: params.spp, seed: params.seed }, &shading, rows_done);
-    let work: Vec<Work> = film.pixels.iter().map(|p| p.work).collect();
+    let mut work: Vec<Work> = film.pixels.iter().map(|p| p.work).collect();
+    if let Some(lattice) = &lattice {
+        work.iter_mut().zip(lattice.work_per_pixel()).for_each(|(w, points)| w.add(&points));
+    }
     let tally = Tally { width, height, spp: params.spp, pixels: &work, hits: film.hits, specular: scene.specular.map(|_| film.specular), lattice_points: lattice.as_ref().map(|l| l.point_count() as u64) };
     let (diagnostics, counters) = record(&tally, &gather);
     FullImage { rgb: film.rgb, coverage: film.coverage, surfaces: film.surfaces, diagnostics, counters }

@@ -18,11 +18,14 @@
 //! exact for an `H` linear over a plane however grazing the view), where
 //! all four lie on its surface (same object and material), face its way
 //! (normals within the crease angle) and lie in its tangent plane (the
-//! chord within [`PLANE_SLOPE`] of it). Anywhere else (a silhouette, a
-//! crease, a sliver, the image's border) the sample is gathered itself, as
-//! without the lattice: the lattice interpolates between its points and
-//! never extrapolates, which had left a floor's far edge 4% off where a
-//! sample's only neighbours lay on one side of it. The light of
+//! chord within [`PLANE_SLOPE`] of it); where one of them does not (an edge
+//! crossing the cell), the linear interpolation over a half of the cell
+//! (split along either diagonal) that holds the sample and whose three
+//! corners do. Anywhere else (an edge closer to the sample, a sliver, the
+//! image's border) the sample is gathered itself, as without the lattice:
+//! the lattice interpolates between its points and never extrapolates,
+//! which had left a floor's far edge 4% off where a sample's only
+//! neighbours lay on one side of it. The light of
 //! luminaires, windows and translucent twins is added per sample as
 //! before; only the links' gather is interpolated.
 //!
@@ -40,6 +43,7 @@ use crate::diagnostics::Work;
 use crate::pixel_surfaces::SurfaceId;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// Largest `|n . (q - p)| / |q - p|` for a lattice point `q` to count as in
 /// the tangent plane at the sample `p` (the sine of 5 degrees): a curved
@@ -83,19 +87,49 @@ pub struct Target {
     pub surface: SurfaceId,
 }
 
+/// One level of the lattice: its points `spacing` pixels apart, the first
+/// half a spacing from the image's top left corner, each gathered once
+/// (eagerly for the coarse level, on first use for the fine one) with the
+/// work it took.
+struct Level {
+    spacing: f64,
+    columns: usize,
+    rows: usize,
+    points: Vec<OnceLock<(Option<LatticePoint>, Work)>>,
+}
+
+impl Level {
+    fn new(width: u32, height: u32, spacing: f64) -> Self {
+        let along = |pixels: u32| (f64::from(pixels) / spacing).ceil().max(1.0) as usize;
+        let (columns, rows) = (along(width), along(height));
+        Level { spacing, columns, rows, points: (0..columns * rows).map(|_| OnceLock::new()).collect() }
+    }
+
+    /// Image position of point `index`.
+    fn at(&self, index: usize) -> [f64; 2] {
+        [((index % self.columns) as f64 + 0.5) * self.spacing, ((index / self.columns) as f64 + 0.5) * self.spacing]
+    }
+
+    /// Point `index`, gathered by `gather` on first use with its
+    /// interleaved visibility block (module docs).
+    fn point(&self, index: usize, gather: &GatherPoint) -> Option<LatticePoint> {
+        self.points[index]
+            .get_or_init(|| {
+                let block = (index % self.columns % 2 + 2 * (index / self.columns % 2)) as u32;
+                let mut work = Work::default();
+                (gather(self.at(index), block, &mut work), work)
+            })
+            .0
+    }
+}
+
 /// The lattice over an image ([`IrradianceLattice::gather`]).
 pub struct IrradianceLattice {
-    /// Pixels between neighbouring lattice points.
-    spacing: f64,
-    /// Lattice points per row.
-    columns: usize,
-    /// Rows of lattice points.
-    rows: usize,
-    /// Per lattice point, row-major: what it saw, `None` where it has no
-    /// gather (a miss, a back face, a mirror or pane).
-    points: Vec<Option<LatticePoint>>,
-    /// Per pixel, row-major: the work of its lattice points.
-    work: Vec<Work>,
+    /// The coarse level, then, where it is coarser than the pixels, the
+    /// pixel centres.
+    levels: Vec<Level>,
+    /// Image width and height, pixels.
+    size: [u32; 2],
     /// Cosine of the crease angle.
     crease_cos: f64,
 }
@@ -107,73 +141,79 @@ impl IrradianceLattice {
         (2.0 / f64::from(spp.max(1)).sqrt()).min(1.0)
     }
 
-    /// Gathers the lattice of a `width` x `height` image, its points
-    /// `spacing` pixels apart, the first half a spacing from the top left
-    /// corner: `point(at, block, work)` casts the camera ray through image
-    /// position `at` and gathers there with visibility block `block`, or
-    /// says there is nothing to gather. Points in parallel; the result does
-    /// not depend on the thread count.
-    pub fn gather(
-        width: u32,
-        height: u32,
-        spacing: f64,
-        crease_angle_deg: f64,
-        point: &GatherPoint,
-    ) -> Self {
-        let along = |pixels: u32| (f64::from(pixels) / spacing).ceil().max(1.0) as usize;
-        let (columns, rows) = (along(width), along(height));
-        let at = |index: usize| [((index % columns) as f64 + 0.5) * spacing, ((index / columns) as f64 + 0.5) * spacing];
-        let gathered: Vec<(Option<LatticePoint>, Work)> = (0..columns * rows)
-            .into_par_iter()
-            .map(|index| {
-                let block = (index % columns % 2 + 2 * (index / columns % 2)) as u32;
-                let mut work = Work::default();
-                (point(at(index), block, &mut work), work)
-            })
-            .collect();
-        let mut work = vec![Work::default(); width as usize * height as usize];
-        for (index, (_, w)) in gathered.iter().enumerate() {
-            let [x, y] = at(index).map(|c| c as usize);
-            work[y.min(height as usize - 1) * width as usize + x.min(width as usize - 1)].add(w);
+    /// The lattice of a `width` x `height` image, its points `spacing`
+    /// pixels apart, gathered by `gather` (`gather(at, block, work)` casts
+    /// the camera ray through image position `at` and gathers there with
+    /// visibility block `block`, or says there is nothing to gather). The
+    /// points are gathered now, in parallel; the pixel centres of a lattice
+    /// coarser than the pixels are gathered where a sample needs them. The
+    /// values do not depend on the thread count.
+    pub fn gather(width: u32, height: u32, spacing: f64, crease_angle_deg: f64, gather: &GatherPoint) -> Self {
+        let coarse = Level::new(width, height, spacing);
+        (0..coarse.points.len()).into_par_iter().for_each(|index| {
+            coarse.point(index, gather);
+        });
+        let mut levels = vec![coarse];
+        if spacing > 1.0 {
+            levels.push(Level::new(width, height, 1.0));
         }
-        let points = gathered.into_iter().map(|(p, _)| p).collect();
-        IrradianceLattice { spacing, columns, rows, points, work, crease_cos: crease_angle_deg.to_radians().cos() }
+        IrradianceLattice { levels, size: [width, height], crease_cos: crease_angle_deg.to_radians().cos() }
     }
 
-    /// The number of lattice points.
+    /// The number of points gathered.
     pub fn point_count(&self) -> usize {
-        self.points.len()
+        self.levels.iter().map(|l| l.points.iter().filter(|p| p.get().is_some()).count()).sum()
     }
 
-    /// The work of pixel `index`'s lattice points (row-major).
-    pub fn work_of_pixel(&self, index: usize) -> Work {
-        self.work.get(index).copied().unwrap_or_default()
-    }
-
-    /// The irradiance at `target`, interpolated between the lattice points
-    /// around it where they all lie on its surface and plane (module docs);
-    /// `None` elsewhere.
-    pub fn interpolate(&self, target: &Target) -> Option<[f64; 3]> {
-        let (fx, fy) = (target.at[0] / self.spacing - 0.5, target.at[1] / self.spacing - 0.5);
-        let (x0, y0) = (fx.floor(), fy.floor());
-        let (tx, ty) = (fx - x0, fy - y0);
-        let (mut sum, mut total) = ([0.0; 3], 0.0);
-        for (dy, wy) in [(0.0, 1.0 - ty), (1.0, ty)] {
-            for (dx, wx) in [(0.0, 1.0 - tx), (1.0, tx)] {
-                if wx * wy <= 0.0 {
-                    continue;
+    /// Per pixel (row-major), the work of the lattice points in it.
+    pub fn work_per_pixel(&self) -> Vec<Work> {
+        let [w, h] = self.size.map(|n| n as usize);
+        let mut work = vec![Work::default(); w * h];
+        for level in &self.levels {
+            for (index, point) in level.points.iter().enumerate() {
+                if let Some((_, done)) = point.get() {
+                    let [x, y] = level.at(index).map(|c| c as usize);
+                    work[y.min(h - 1) * w + x.min(w - 1)].add(done);
                 }
-                let (x, y) = (x0 + dx, y0 + dy);
-                if x < 0.0 || y < 0.0 || x >= self.columns as f64 || y >= self.rows as f64 {
-                    return None;
-                }
-                let q = self.points[y as usize * self.columns + x as usize].filter(|q| self.matches(q, target))?;
-                let w = wx * wy / q.depth;
-                total += w;
-                (0..3).for_each(|c| sum[c] += w * q.irradiance[c]);
             }
         }
-        Some(sum.map(|s| s / total))
+        work
+    }
+
+    /// The irradiance at `target`, interpolated between the coarse level's
+    /// points around it where they lie on its surface and plane, else
+    /// between the pixel centres' (gathered by `gather` where not yet)
+    /// (module docs); `None` where neither can.
+    pub fn interpolate(&self, target: &Target, gather: &GatherPoint) -> Option<[f64; 3]> {
+        self.levels.iter().find_map(|level| self.interpolate_on(level, target, gather))
+    }
+
+    fn interpolate_on(&self, level: &Level, target: &Target, gather: &GatherPoint) -> Option<[f64; 3]> {
+        let (fx, fy) = (target.at[0] / level.spacing - 0.5, target.at[1] / level.spacing - 0.5);
+        let (x0, y0) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - x0, fy - y0);
+        // The cell's corners (0, 0), (1, 0), (0, 1), (1, 1), where they
+        // lie on the image and on the target's surface and plane, gathered
+        // as needed.
+        let corner = |k: usize| {
+            let (x, y) = (x0 + (k % 2) as f64, y0 + (k / 2) as f64);
+            let inside = x >= 0.0 && y >= 0.0 && x < level.columns as f64 && y < level.rows as f64;
+            inside.then(|| level.point(y as usize * level.columns + x as usize, gather)).flatten().filter(|q| self.matches(q, target))
+        };
+        let corners: [OnceLock<Option<LatticePoint>>; 4] = Default::default();
+        let bilinear = [(0, (1.0 - tx) * (1.0 - ty)), (1, tx * (1.0 - ty)), (2, (1.0 - tx) * ty), (3, tx * ty)];
+        let along_03 = if tx >= ty { [(0, 1.0 - tx), (1, tx - ty), (3, ty)] } else { [(0, 1.0 - ty), (2, ty - tx), (3, tx)] };
+        let along_12 = if tx + ty <= 1.0 { [(0, 1.0 - tx - ty), (1, tx), (2, ty)] } else { [(1, 1.0 - ty), (2, 1.0 - tx), (3, tx + ty - 1.0)] };
+        let blend = |weights: &[(usize, f64)]| -> Option<[f64; 3]> {
+            let (mut sum, mut total) = ([0.0; 3], 0.0);
+            for &(k, w) in weights.iter().filter(|(_, w)| *w > 0.0) {
+                let q = (*corners[k].get_or_init(|| corner(k)))?;
+                total += w / q.depth;
+                (0..3).for_each(|c| sum[c] += w / q.depth * q.irradiance[c]);
+            }
+            Some(sum.map(|s| s / total))
+        };
+        blend(&bilinear).or_else(|| blend(&along_03)).or_else(|| blend(&along_12))
     }
 
     /// Whether lattice point `q` lies on `target`'s surface, faces its way
@@ -191,25 +231,32 @@ mod tests {
     const FLOOR: SurfaceId = SurfaceId { object: 0, material: 0, emits: false };
     const WALL: SurfaceId = SurfaceId { object: 1, material: 0, emits: false };
 
-    /// A lattice over a 4 x 4 image, one point per pixel, whose left half
-    /// sees a floor (z = 0, normal +z) with `H = 10 + x + 2 y` at image
-    /// position (x, y), at a depth of 1, and whose right half sees a wall.
-    fn half_floor() -> IrradianceLattice {
-        IrradianceLattice::gather(4, 4, 1.0, 30.0, &|at, _, work| {
+    /// A 4 x 4 image whose left half sees a floor (z = 0, normal +z) with
+    /// `H = 10 + x + 2 y` at image position (x, y), at a depth of 1, and
+    /// whose right half sees a wall; the floor is raised by 0.5 at the
+    /// points in `raised`.
+    fn floor_and_wall(raised: &[[f64; 2]]) -> impl Fn([f64; 2], u32, &mut Work) -> Option<LatticePoint> + Sync + '_ {
+        move |at, _, work| {
             work.visibility_rays += 1;
             let floor = at[0] < 2.0;
+            let z = if raised.contains(&at) { 0.5 } else { 0.0 };
             Some(LatticePoint {
-                point: if floor { DVec3::new(at[0], at[1], 0.0) } else { DVec3::new(2.0, at[1], at[0]) },
+                point: if floor { DVec3::new(at[0], at[1], z) } else { DVec3::new(2.0, at[1], at[0]) },
                 normal: if floor { DVec3::Z } else { DVec3::NEG_X },
                 surface: if floor { FLOOR } else { WALL },
                 depth: 1.0,
                 irradiance: [10.0 + at[0] + 2.0 * at[1]; 3],
             })
-        })
+        }
     }
 
     fn floor_at(x: f64, y: f64) -> Target {
         Target { at: [x, y], point: DVec3::new(x, y, 0.0), normal: DVec3::Z, surface: FLOOR }
+    }
+
+    fn exact(lattice: &IrradianceLattice, gather: &GatherPoint, x: f64, y: f64) {
+        let h = lattice.interpolate(&floor_at(x, y), gather).unwrap_or_else(|| panic!("nothing at ({x}, {y})"))[0];
+        assert!((h - (10.0 + x + 2.0 * y)).abs() < 1e-12, "({x}, {y}): {h}");
     }
 
     #[test]
@@ -218,19 +265,43 @@ mod tests {
     }
 
     /// Interpolation reproduces a linear function exactly between lattice
-    /// points of the sample's surface, and gives nothing where a point
-    /// around the sample is off that surface (the edge) or off the image.
+    /// points of the sample's surface; a cell with one corner off the
+    /// floor (a raised point) still interpolates in the half of it away
+    /// from that corner; nothing comes where the points around the sample
+    /// are off its surface (the edge) or off the image.
     #[test]
     fn interpolation_is_exact_for_linear_irradiance_and_stops_at_an_edge() {
-        let lattice = half_floor();
+        let gather = floor_and_wall(&[]);
+        let lattice = IrradianceLattice::gather(4, 4, 1.0, 30.0, &gather);
         for (x, y) in [(0.5, 0.5), (1.2, 1.7), (0.9, 3.3), (1.0, 2.25), (1.5, 3.5)] {
-            let h = lattice.interpolate(&floor_at(x, y)).unwrap()[0];
-            assert!((h - (10.0 + x + 2.0 * y)).abs() < 1e-12, "({x}, {y}): {h}");
+            exact(&lattice, &gather, x, y);
         }
         // At x = 1.8 the points at 1.5 (floor) and 2.5 (wall) surround it.
-        assert!(lattice.interpolate(&floor_at(1.8, 1.5)).is_none());
+        assert!(lattice.interpolate(&floor_at(1.8, 1.5), &gather).is_none());
         // At y = 3.7 the points below the last row are off the image.
-        assert!(lattice.interpolate(&floor_at(1.0, 3.7)).is_none());
+        assert!(lattice.interpolate(&floor_at(1.0, 3.7), &gather).is_none());
+        let raised = [[1.5, 1.5]];
+        let notched_gather = floor_and_wall(&raised);
+        let notched = IrradianceLattice::gather(4, 4, 1.0, 30.0, &notched_gather);
+        exact(&notched, &notched_gather, 0.7, 0.6);
+        exact(&notched, &notched_gather, 0.6, 1.2);
+        assert!(notched.interpolate(&floor_at(1.4, 1.3), &notched_gather).is_none());
+    }
+
+    /// Where a coarse lattice (every 2 pixels) has an edge in the cell, the
+    /// pixel centres are gathered and interpolated instead; the points
+    /// gathered then are the coarse ones and those centres only.
+    #[test]
+    fn a_coarse_lattice_falls_back_on_the_pixel_centres() {
+        let gather = floor_and_wall(&[]);
+        let lattice = IrradianceLattice::gather(4, 4, 2.0, 30.0, &gather);
+        assert_eq!(lattice.point_count(), 4);
+        // Coarse points at x = 1 (floor) and 3 (wall): the cell holding
+        // x = 1.2 crosses the edge; the centres at 0.5 and 1.5 do not.
+        exact(&lattice, &gather, 1.2, 1.0);
+        assert_eq!(lattice.point_count(), 4 + 4);
+        exact(&lattice, &gather, 1.2, 1.0);
+        assert_eq!(lattice.point_count(), 8, "a centre is gathered once");
     }
 
     /// Under perspective, `H` linear over a plane is linear in the image
@@ -244,29 +315,31 @@ mod tests {
             let (u, v) = (at[0] - 2.0, at[1] + 0.1);
             (u / v, 1.0 / v)
         };
-        let lattice = IrradianceLattice::gather(4, 4, 1.0, 30.0, &|at, _, _| {
+        let gather = |at: [f64; 2], _: u32, _: &mut Work| {
             let (x, z) = world(at);
             Some(LatticePoint { point: DVec3::new(x, z, 0.0), normal: DVec3::Z, surface: FLOOR, depth: z, irradiance: [3.0 + 2.0 * x + z; 3] })
-        });
+        };
+        let lattice = IrradianceLattice::gather(4, 4, 1.0, 30.0, &gather);
         for at in [[1.1, 0.9], [2.3, 1.2], [0.7, 2.6]] {
             let (x, z) = world(at);
-            let h = lattice.interpolate(&Target { at, point: DVec3::new(x, z, 0.0), normal: DVec3::Z, surface: FLOOR }).unwrap()[0];
+            let h = lattice.interpolate(&Target { at, point: DVec3::new(x, z, 0.0), normal: DVec3::Z, surface: FLOOR }, &gather).unwrap()[0];
             assert!((h - (3.0 + 2.0 * x + z)).abs() < 1e-9, "{at:?}: {h} vs {}", 3.0 + 2.0 * x + z);
         }
     }
 
     /// A sample off every neighbour's plane (a step of the same object) or
-    /// facing another way gets no interpolation; so does one outside the
-    /// image's lattice with no neighbour on its surface.
+    /// facing another way gets no interpolation; nor does one on another
+    /// surface.
     #[test]
     fn no_value_off_the_plane_or_facing_away() {
-        let lattice = half_floor();
+        let gather = floor_and_wall(&[]);
+        let lattice = IrradianceLattice::gather(4, 4, 1.0, 30.0, &gather);
         let raised = Target { point: DVec3::new(1.0, 1.0, 0.5), ..floor_at(1.0, 1.0) };
-        assert!(lattice.interpolate(&raised).is_none());
+        assert!(lattice.interpolate(&raised, &gather).is_none());
         let tilted = Target { normal: DVec3::new(0.0, 0.6, 0.8), ..floor_at(1.0, 1.0) };
-        assert!(lattice.interpolate(&tilted).is_none());
+        assert!(lattice.interpolate(&tilted, &gather).is_none());
         let wall_surface_on_floor = Target { surface: WALL, ..floor_at(1.0, 1.0) };
-        assert!(lattice.interpolate(&wall_surface_on_floor).is_none());
+        assert!(lattice.interpolate(&wall_surface_on_floor, &gather).is_none());
     }
 
     /// The four points around any sample hold the four visibility blocks,
@@ -288,6 +361,6 @@ mod tests {
                 assert_eq!(four, [0, 1, 2, 3], "at ({i}, {j})");
             }
         }
-        assert!((0..6).all(|p| lattice.work_of_pixel(p).visibility_rays == 4));
+        assert!(lattice.work_per_pixel().iter().all(|w| w.visibility_rays == 4));
     }
 }

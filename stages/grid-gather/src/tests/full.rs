@@ -247,8 +247,8 @@ fn the_surface_gather_checks_links_the_solver_called_fully_visible() {
 /// so what the lattice changes is all that differs: the full gather per
 /// sample matches it exactly; on the lattice, every pixel is within 0.5%
 /// (measured 0.20%) at one point per pixel and within 1.5% (0.71%) every
-/// 2 pixels, and most samples are interpolated, the rest (the floor's
-/// silhouette, the image's border) gathered.
+/// 2 pixels, and most samples are interpolated (94.6%, 97.1%), the rest
+/// (the floor's silhouette, the image's border) gathered.
 #[test]
 fn the_image_lattice_keeps_every_pixel_near_the_brute_force() {
     let mut room = room();
@@ -258,13 +258,16 @@ fn the_image_lattice_keeps_every_pixel_near_the_brute_force() {
     let worst = |image: &Rendered| image.rgb.iter().zip(&brute).filter(|(_, &b)| b > 0.0).map(|(x, &b)| (f64::from(x[0]) - b).abs() / b).fold(0.0, f64::max);
     let per_sample = run(&room, &Params { lattice: false, ..full.clone() }).0;
     assert!(worst(&per_sample) < 1e-6, "per sample: {}", worst(&per_sample));
-    for (spacing, limit, least_interpolated) in [(1.0, 0.005, 0.9), (2.0, 0.015, 0.85)] {
+    for (spacing, limit, least_interpolated) in [(1.0, 0.005, 0.9), (2.0, 0.015, 0.9)] {
         let image = run(&room, &Params { lattice_spacing: Some(spacing), ..full.clone() }).0;
         let interpolated = image.counters["samples_interpolated"] / image.counters["ray_hits"];
         let (w, e) = (worst(&image), relative_rmse(&floor_values(&image), &brute));
         eprintln!("lattice every {spacing} px: worst pixel {w:.2e}, relative RMSE {e:.2e}, {:.1}% of the samples interpolated", 100.0 * interpolated);
         assert!(w <= limit, "every {spacing} px: a pixel {w:.2e} off the brute force");
         assert!(interpolated >= least_interpolated, "every {spacing} px: only {interpolated} of the samples interpolated");
-        assert_eq!(image.counters["lattice_points"], (96.0 / spacing) * (64.0 / spacing));
+        // The coarse points, and at 2 px the pixel centres gathered where a
+        // coarse cell crosses an edge: a few of the 6,144.
+        let fine = image.counters["lattice_points"] - (96.0 / spacing) * (64.0 / spacing);
+        assert!(if spacing > 1.0 { (1.0..600.0).contains(&fine) } else { fine == 0.0 }, "{fine} pixel centres gathered");
     }
 }
