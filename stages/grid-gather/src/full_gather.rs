@@ -14,7 +14,9 @@
 //!   parameter, per vertex and at a point: [`crate::contrast`];
 //! - view-dependent shadow sample counts (Sec. 5.3):
 //!   [`crate::shadow_samples`];
-//! - the brute-force gather it is measured against: [`crate::brute`].
+//! - the brute-force gather it is measured against: [`crate::brute`];
+//! - beyond the paper, the image lattice that gathers once per lattice
+//!   point and interpolates to the camera samples: [`crate::lattice`].
 //!
 //! # Kernel-weighted visibility
 //!
