@@ -136,9 +136,9 @@ pub struct IrradianceLattice {
 
 impl IrradianceLattice {
     /// The default spacing for `spp` camera samples per pixel, pixels
-    /// (module docs).
+    /// (module docs), no finer than the parameter allows (1/16 pixel).
     pub fn default_spacing(spp: u32) -> f64 {
-        (2.0 / f64::from(spp.max(1)).sqrt()).min(1.0)
+        (2.0 / f64::from(spp.max(1)).sqrt()).clamp(1.0 / 16.0, 1.0)
     }
 
     /// The lattice of a `width` x `height` image, its points `spacing`
@@ -261,7 +261,7 @@ mod tests {
 
     #[test]
     fn one_point_per_pixel_up_to_4_spp_then_a_finer_lattice() {
-        assert_eq!([1, 2, 4, 16, 64].map(IrradianceLattice::default_spacing), [1.0, 1.0, 1.0, 0.5, 0.25]);
+        assert_eq!([1, 2, 4, 16, 64, 1 << 20].map(IrradianceLattice::default_spacing), [1.0, 1.0, 1.0, 0.5, 0.25, 0.0625]);
     }
 
     /// Interpolation reproduces a linear function exactly between lattice
