@@ -322,12 +322,12 @@ fn check_gathered(test: &str, dir: &std::path::Path, leaves: &[Leaf], want: &[f6
 /// walls -0.08% to +0.02%, worst pixel 5.1%; with each link's sender at its
 /// area mean in the gather (its radiosity, not what the solve sent through
 /// the link), -0.04% to -0.19%. On the image lattice (the default, a point
-/// per pixel): walls -0.14% to -0.25%, worst pixel 5.5%. The lattice's bias
-/// is first order in its spacing in the scene: against the per-sample
-/// image, -0.57%, -0.21%, -0.11%, -0.06% at 2, 1, 0.5, 0.25 pixels, and
-/// -0.04% at one point per pixel of a 256 x 256 image, 86% of that within
-/// a pixel of the box's creases, where the irradiance rises towards the
-/// crease with an unbounded slope that linear interpolation undershoots.
+/// per pixel): walls -0.14% to -0.24%, worst pixel 5.5%. Against the
+/// per-sample image, the lattice darkens the whole image by -0.55%, -0.17%,
+/// -0.08%, -0.03% at 2, 1, 0.5, 0.25 pixels, and by -0.03% at one point per
+/// pixel of a 256 x 256 image, 76% of that within a pixel of the box's
+/// creases, where the irradiance rises towards the crease with an unbounded
+/// slope that linear interpolation undershoots.
 #[test]
 fn open_box_full_gather_pixels_match_the_equation() {
     check_full_gather(
