@@ -206,6 +206,13 @@ impl Shader for Shading<'_> {
 }
 
 impl Shading<'_> {
+    /// The normal `triangle` shades with at barycentric `uv`: its normal
+    /// map's where it has one, else its face normal.
+    fn shading_normal(&self, triangle: u32, uv: [f64; 2]) -> DVec3 {
+        let face = self.scene.triangles[triangle as usize].normal;
+        self.scene.detail.map_or(face, |detail| detail.normal(triangle, uv, face))
+    }
+
     /// The lattice point at image position `at`: the links' irradiance where
     /// the camera ray through it meets the front of a surface that is no
     /// mirror or pane, gathered with visibility block `block`.
@@ -219,7 +226,7 @@ impl Shading<'_> {
         }
         let point = scene.camera.eye + direction * f64::from(hit.t);
         let uv = tri.uv_of(point);
-        let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
+        let normal = self.shading_normal(triangle, uv);
         let mut links = Vec::new();
         let leaf = self.senders.chain(triangle, uv, &mut links);
         let irradiance = self.gather.irradiance(point, normal, triangle, leaf, &links, block, work);
@@ -257,7 +264,7 @@ impl Shading<'_> {
         }
         let p = seen.origin + seen.direction * f64::from(seen.hit.t);
         let uv = tri.uv_of(p);
-        let normal = scene.detail.map_or(tri.normal, |detail| detail.normal(triangle, uv, tri.normal));
+        let normal = self.shading_normal(triangle, uv);
         let interpolated = self.lattice.zip(at).and_then(|(lattice, at)| lattice.interpolate(&Target { at, point: p, normal, surface: scene.ids[triangle as usize] }, &|at, block, work| self.lattice_point(at, block, work)));
         let mut irradiance = match interpolated {
             Some(h) => {

@@ -54,9 +54,6 @@ use std::sync::OnceLock;
 /// between parallel faces of one object does not.
 pub const PLANE_SLOPE: f64 = 0.087;
 
-/// The visibility blocks interleaved over the lattice (2 x 2).
-pub const BLOCKS: u32 = 4;
-
 /// What gathers one lattice point: `(image position, visibility block,
 /// work) -> what it saw`, `None` where there is nothing to gather.
 pub type GatherPoint<'a> = dyn Fn([f64; 2], u32, &mut Work) -> Option<LatticePoint> + Sync + 'a;
