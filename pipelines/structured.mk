@@ -62,8 +62,8 @@ $(STRUCTURED_OUT)/compare.ron: $(BIN)/compare $(STRUCTURED_OUT)/image.exr $(OUT)
 # Mitsuba reference, 8 without (the converged reference). A benchmark
 # only: never in `make test`.
 BENCH_STRUCTURED_OUT ?= out/bench-structured
-BENCH_STRUCTURED_EPS ?= 0.3,0.1,0.07,0.05,0.03,0.02,0.01,0.003,0.001
-BENCH_STRUCTURED_CORNELL_EPS ?= 0.01,0.003,0.001,0.0003
+BENCH_STRUCTURED_EPS ?= 0.0125,0.004,0.003,0.002,0.00125,0.0008,0.0004,0.000125,0.00004
+BENCH_STRUCTURED_CORNELL_EPS ?= 0.0004,0.000125,0.00004,0.0000125
 BENCH_STRUCTURED_REFERENCE ?= $(wildcard out/cornell/peer/reference.exr)
 BENCH_STRUCTURED_CORNELL_SURFACES := --surface floor=floor --surface walls=back_wall,green_wall,red_wall \
   --surface ceiling=ceiling --surface blocks=short_block,tall_block

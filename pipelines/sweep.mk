@@ -12,7 +12,7 @@
 #
 # The pipeline's own knobs (EPS, SPP, ...) are not read here: the sweep
 # sets them per point. Examples:
-#   make sweep                                   # Cornell box, EPS 1e-2 .. 1e-4, preview and full
+#   make sweep                                   # Cornell box, EPS 1e-3 .. 1e-5, preview and full
 #   make sweep SWEEP_KNOB=EPS SWEEP_VALUES=1e-2,1e-3,1e-4 SWEEP_GATHER=preview
 #   make sweep SWEEP_KNOBS="EPS=1e-3,3e-4 SPP=4,16"   # a 2 x 2 grid
 #   make sweep SCENE=sphere-1k SWEEP_REPS=1      # closed-form reference
@@ -34,7 +34,7 @@ SWEEP_GATHER ?=
 SWEEP_KNOB ?=
 SWEEP_VALUES ?=
 # Several knobs, space-separated NAME=v1,v2 (the grid is their product).
-# With no knob, each solver sweeps its default (EPS=1e-2,3e-3,1e-3,3e-4,1e-4;
+# With no knob, each solver sweeps its default (EPS=1e-3,3e-4,1e-4,3e-5,1e-5;
 # GPU_CONVERGENCE=0.8,0.9,0.99,0.999).
 SWEEP_KNOBS ?=
 # Runs per point; every figure is the median over them.

@@ -75,7 +75,7 @@ fn worst(label: &str, got: &Faces, want: &Faces) -> (f64, f64) {
 fn a_coarse_clustered_solve_lights_every_face_by_its_own_orientation() {
     let dir = scratch("cluster_orientation");
     run_ok("mesh-prep", &["--builtin", "cornell-box", "--mesh", s(&dir.join("mesh.exr")), "--manifest", s(&dir.join("manifest.ron"))]);
-    let reference = solve_prepared(&dir, &["--eps", "2e-4"], None);
+    let reference = solve_prepared(&dir, &["--eps", "1.5e-5"], None);
     let kept = dir.join("reference.exr");
     std::fs::rename(&reference, &kept).unwrap();
     let expected = face_means(&dir, &kept);
@@ -89,7 +89,11 @@ fn a_coarse_clustered_solve_lights_every_face_by_its_own_orientation() {
     // weighted by its visibility (receivers.rs) 7.1% and 2.5% (surfaces 2.8%
     // and 1.1%); with the links into inner elements lighting each part by
     // its own factor (both solves) 5.5% and 2.4% (surfaces 2.4% and 1.1%).
-    for (eps, face_tolerance, surface_tolerance) in [("1e-2", 0.07, 0.03), ("1e-3", 0.03, 0.016)] {
+    // Those EPS were 24 times the ones below, which have the same relative
+    // threshold since hierarchical-solve's RELATIVE_AT went from 3 to 1/8
+    // with the absolute threshold as a cap: 5.4% and 0.24% (surfaces 1.3%
+    // and 0.05%).
+    for (eps, face_tolerance, surface_tolerance) in [("4e-4", 0.07, 0.03), ("4e-5", 0.03, 0.016)] {
         let clustered = solve_prepared(&dir, &["--eps", eps], Some(8));
         let (face, surface) = worst(&format!("EPS {eps}"), &face_means(&dir, &clustered), &expected);
         assert!(face < face_tolerance, "EPS {eps}: a face's mean radiosity {:.1}% off the unclustered solve", 100.0 * face);

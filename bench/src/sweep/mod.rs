@@ -673,7 +673,7 @@ mod tests {
         assert_eq!(plans[1].settings.len(), 2, "gpu: SPP only");
         assert_eq!(plans[1].gathers, [Gather::Preview], "gpu-shoot's solution has no links");
         let defaults = plan(&config(&both, &[], None)).unwrap();
-        assert_eq!(knobs::label(&defaults[0].settings[0]), "EPS=0.01");
+        assert_eq!(knobs::label(&defaults[0].settings[0]), "EPS=0.001");
         assert_eq!(knobs::label(&defaults[1].settings[0]), "GPU_CONVERGENCE=0.8");
     }
 

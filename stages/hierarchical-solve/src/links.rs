@@ -85,7 +85,8 @@ pub enum Criterion {
     /// brightest channel, in the current iterate, floored at
     /// `relative_floor` times the scene's area-mean reflected radiosity):
     /// the errors of all the links into an element then add up to about
-    /// `eps_relative` of its radiosity ([`Allowance::for_link`]).
+    /// `eps_relative` of its radiosity ([`Allowance::for_link`]); and never
+    /// more than the absolute threshold ([`crate::RELATIVE_AT`]).
     Relative,
 }
 
@@ -95,7 +96,8 @@ pub enum Allowance {
     /// The same threshold (W/m²) for every receiver.
     Absolute(f64),
     /// `eps` times the receiver's brightest radiosity channel, at least
-    /// `floor` (W/m²), shared among its links ([`Allowance::for_link`]).
+    /// `floor` (W/m²), shared among its links ([`Allowance::for_link`]),
+    /// at most `most`.
     Relative {
         /// Fraction of the receiver's radiosity.
         eps: f64,
@@ -104,6 +106,10 @@ pub enum Allowance {
         /// Least share of the receiver's radiosity a link's allowance is
         /// computed from.
         share: f64,
+        /// The absolute threshold (W/m²): no link may err by more, however
+        /// bright its receiver ([`crate::RELATIVE_AT`]: an element's error as
+        /// a sender reaches what it lights in absolute terms).
+        most: f64,
     },
 }
 
@@ -113,7 +119,7 @@ impl Allowance {
     pub fn at(&self, b: [f64; 3]) -> f64 {
         match *self {
             Allowance::Absolute(threshold) => threshold,
-            Allowance::Relative { eps, floor, .. } => eps * b.into_iter().fold(floor, f64::max),
+            Allowance::Relative { eps, floor, most, .. } => (eps * b.into_iter().fold(floor, f64::max)).min(most),
         }
     }
 
@@ -122,7 +128,7 @@ impl Allowance {
     /// F_rs B_s`, brightest channel). Relative:
     ///
     /// ```text
-    /// eps (T_l + s max(B_r, floor))
+    /// min(eps (T_l + s max(B_r, floor)), most)
     /// ```
     ///
     /// so the `n` links into an element err by at most `eps (sum_l T_l + n
@@ -141,7 +147,7 @@ impl Allowance {
     pub fn for_link(&self, b: [f64; 3], transport: f64) -> f64 {
         match *self {
             Allowance::Absolute(threshold) => threshold,
-            Allowance::Relative { eps, floor, share } => eps * (transport + share * b.into_iter().fold(floor, f64::max)),
+            Allowance::Relative { eps, floor, share, most } => (eps * (transport + share * b.into_iter().fold(floor, f64::max))).min(most),
         }
     }
 }
