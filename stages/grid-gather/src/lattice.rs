@@ -54,6 +54,11 @@ use std::sync::OnceLock;
 /// between parallel faces of one object does not.
 pub const PLANE_SLOPE: f64 = 0.087;
 
+/// The finest lattice spacing, pixels (16 points per pixel): the bound of
+/// `--lattice-spacing` and of [`IrradianceLattice::default_spacing`]. A
+/// spacing of 1e-9 would have asked for 1e18 points per pixel.
+pub const FINEST_SPACING: f64 = 1.0 / 16.0;
+
 /// What gathers one lattice point: `(image position, visibility block,
 /// work) -> what it saw`, `None` where there is nothing to gather.
 pub type GatherPoint<'a> = dyn Fn([f64; 2], u32, &mut Work) -> Option<LatticePoint> + Sync + 'a;
@@ -136,9 +141,9 @@ pub struct IrradianceLattice {
 
 impl IrradianceLattice {
     /// The default spacing for `spp` camera samples per pixel, pixels
-    /// (module docs), no finer than the parameter allows (1/16 pixel).
+    /// (module docs), no finer than [`FINEST_SPACING`].
     pub fn default_spacing(spp: u32) -> f64 {
-        (2.0 / f64::from(spp.max(1)).sqrt()).clamp(1.0 / 16.0, 1.0)
+        (2.0 / f64::from(spp.max(1)).sqrt()).clamp(FINEST_SPACING, 1.0)
     }
 
     /// The lattice of a `width` x `height` image, its points `spacing`

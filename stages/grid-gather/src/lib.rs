@@ -193,7 +193,7 @@ stage_kit::knobs! {
         /// Full: gather once per point of a lattice over the image, with visibility blocks interleaved 2 x 2, and interpolate to every camera sample on the same surface and plane; off: gather at every camera sample.
         lattice: bool = true, "", switch;
         /// Full: pixels between lattice points (16 points per pixel at most); none: min(1, 2 / sqrt(spp)), about 4 camera samples per lattice cell.
-        lattice_spacing: Option<f64> = None, "pixels", optional(0.0625..=64.0);
+        lattice_spacing: Option<f64> = None, "pixels", optional(lattice::FINEST_SPACING..=64.0);
         /// Brute: visibility rays per link per camera sample.
         brute_samples: u32 = 64, "", value(at_least(1));
         /// Most mirror reflections and glass passages along a camera ray.
