@@ -166,6 +166,8 @@ stage_kit::knobs! {
         weld_tolerance: f64 = 1e-7, "", value(left_open(0.0, 1e-3));
         /// Leaves of different materials do not blend at a shared corner (B jumps where emission or reflectance does, even on a flat surface).
         material_seams: bool = true, "", switch;
+        /// Passes correcting the vertex radiosity towards values whose interpolant has each leaf's radiosity as its mean over the leaf; 0: plain area-weighted means.
+        mean_passes: u32 = 8, "", value(0..=64);
         /// Full: the grid, uniform in post-perspective space or cubes (000 Sec. 4.2).
         grid: GridKind = GridKind::Perspective, "", value;
         /// Full: grid spacing on screen.
@@ -332,7 +334,7 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     })?;
     let triangles = mesh_triangles(scene.mesh);
     let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams };
+    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams, mean_passes: params.mean_passes };
     // Checks in every mode that the solution belongs to the mesh; the
     // preview's shading.
     let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
