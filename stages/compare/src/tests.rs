@@ -319,6 +319,20 @@ fn different_meshes_and_bad_hierarchies_are_errors() {
     other.elements[1].area = 2.5;
     let err = compare_solutions(&other, &flat([1.0; 3], [1.0; 3]), &Params::default()).unwrap_err();
     assert!(err.to_string().contains("input triangle 1 has area 2.5"), "{err}");
+    // The same areas from solutions that record one mesh-prep run: a
+    // triangle partly buried under a solid, whose open part the solver
+    // estimated differently at another EPS.
+    let recorded = |mut s: Solution, scene: &str| {
+        let prep = Provenance { stage: "mesh-prep".into(), inputs: vec![schemas::header::Input { path: "scene.ron".into(), sha256: scene.into(), made_by: None }], ..provenance() };
+        s.header.provenance.inputs = vec![schemas::header::Input { path: "mesh.exr".into(), sha256: "m".into(), made_by: Some(Box::new(prep)) }];
+        s
+    };
+    let (a, b) = (recorded(other.clone(), "0a"), recorded(flat([1.0; 3], [1.0; 3]), "0a"));
+    assert!(solutions::mesh_record(&a).is_some() && solutions::mesh_record(&a) == solutions::mesh_record(&b));
+    assert_eq!(compare_solutions(&a, &b, &Params::default()).unwrap().metrics.rmse, 0.0);
+    let elsewhere = recorded(flat([1.0; 3], [1.0; 3]), "0b");
+    let err = compare_solutions(&a, &elsewhere, &Params::default()).unwrap_err();
+    assert!(err.to_string().contains("does not record one mesh-prep run"), "{err}");
     let mut cyclic = hierarchical();
     cyclic.elements[6].first_child = 2; // 6 -> 2..5 -> 6 ...
     let err = solutions::triangle_means(&cyclic.elements, Which::B).unwrap_err();
