@@ -36,6 +36,11 @@ impl Pinhole {
         Some(Pinhole { eye, forward, right, up, half_height, half_width, width: width.into(), height: height.into() })
     }
 
+    /// The view axis: unit direction through the image's centre.
+    pub fn forward(&self) -> DVec3 {
+        self.forward
+    }
+
     /// Unit direction through the image point `(x, y)` in pixels.
     pub fn direction(&self, x: f64, y: f64) -> DVec3 {
         let sx = (2.0 * x / self.width - 1.0) * self.half_width;
@@ -52,6 +57,7 @@ mod tests {
     fn centre_pixel_looks_at_the_target_and_edges_span_the_fov() {
         let pinhole = Pinhole::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -5.0), DVec3::Y, 90.0, 200, 100).unwrap();
         assert!((pinhole.direction(100.0, 50.0) - DVec3::NEG_Z).length() < 1e-12);
+        assert_eq!(pinhole.forward(), DVec3::NEG_Z);
         let top = pinhole.direction(100.0, 0.0);
         assert!((top.y.atan2(-top.z).to_degrees() - 45.0).abs() < 1e-9);
         let right = pinhole.direction(200.0, 50.0);

@@ -161,8 +161,6 @@ struct Shading<'a> {
     /// The links' irradiance on the image lattice, where the full gather
     /// interpolates it ([`crate::lattice`]).
     lattice: Option<&'a IrradianceLattice>,
-    /// The camera's view axis (unit), for the lattice points' depths.
-    forward: DVec3,
 }
 
 /// A pixel's state in the full and brute gathers.
@@ -230,7 +228,7 @@ impl Shading<'_> {
         let mut links = Vec::new();
         let leaf = self.senders.chain(triangle, uv, &mut links);
         let irradiance = self.gather.irradiance(point, normal, triangle, leaf, &links, block, work);
-        let depth = (point - scene.camera.eye).dot(self.forward);
+        let depth = (point - scene.camera.eye).dot(scene.camera.forward());
         Some(LatticePoint { point, normal, surface: scene.ids[triangle as usize], depth, irradiance })
     }
 
@@ -333,7 +331,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let vertex_contrast = vertex_contrast(params.contrast, &grid, &centres, w, h, scene.threshold);
     let gather = FullGather::new(&senders, &grid, &rays, scene.surfaces, params, vertex_contrast, width);
     let luminaires = DirectLight { lights: scene.lights, rays: &rays };
-    let mut shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires, lattice: None, forward: camera.direction(0.5 * f64::from(width), 0.5 * f64::from(height)) };
+    let mut shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires, lattice: None };
     let lattice = (params.mode == Mode::Full && params.lattice).then(|| {
         let spacing = params.lattice_spacing.unwrap_or_else(|| IrradianceLattice::default_spacing(params.spp));
         IrradianceLattice::gather(width, height, spacing, params.crease_angle_deg, &|at, block, work| shading.lattice_point(at, block, work))

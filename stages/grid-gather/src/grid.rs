@@ -91,8 +91,7 @@ impl Grid {
     /// regular grid's cubes cover the scene's box, as many along its
     /// longest side as the screen has cells along its longer one.
     pub fn fit(params: &Params, camera: &Pinhole, (width, height): (u32, u32), centres: &[Option<DVec3>], triangles: &[TriangleGeometry]) -> Grid {
-        let forward = camera.direction(0.5 * f64::from(width), 0.5 * f64::from(height));
-        let depths = centres.iter().flatten().map(|p| (*p - camera.eye).dot(forward));
+        let depths = centres.iter().flatten().map(|p| (*p - camera.eye).dot(camera.forward()));
         let (near, far) = depths.fold((f64::INFINITY, 0.0f64), |(a, b), d| (a.min(d), b.max(d)));
         let nx = (width as usize).div_ceil(params.grid_pixels as usize).max(1);
         let ny = (height as usize).div_ceil(params.grid_pixels as usize).max(1);
@@ -116,7 +115,7 @@ impl Grid {
     /// `0 < near < far`), with `nx x ny x nz` cells.
     pub fn perspective(camera: &Pinhole, width: u32, height: u32, near: f64, far: f64, n: [usize; 3]) -> Grid {
         let (w, h) = (f64::from(width), f64::from(height));
-        let forward = camera.direction(0.5 * w, 0.5 * h);
+        let forward = camera.forward();
         let on_plane = |d: DVec3| d / d.dot(forward) - forward;
         // right = right_unit * tan(fov_x / 2), up = up_unit * tan(fov_y / 2).
         let right = on_plane(camera.direction(w, 0.5 * h));
