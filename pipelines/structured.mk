@@ -62,7 +62,9 @@ $(STRUCTURED_OUT)/compare.ron: $(BIN)/compare $(STRUCTURED_OUT)/image.exr $(OUT)
 # Mitsuba reference, 8 without (the converged reference). A benchmark
 # only: never in `make test`.
 BENCH_STRUCTURED_OUT ?= out/bench-structured
-BENCH_STRUCTURED_EPS ?= 0.0125,0.004,0.003,0.002,0.00125,0.0008,0.0004,0.000125,0.00004
+# BENCH_STRUCTURED_EPS: the simple environment's EPS grid (default:
+# bench-structured's own, which brackets structured sampling's figures).
+BENCH_STRUCTURED_EPS ?=
 BENCH_STRUCTURED_CORNELL_EPS ?= 0.0004,0.000125,0.00004,0.0000125
 BENCH_STRUCTURED_REFERENCE ?= $(wildcard out/cornell/peer/reference.exr)
 BENCH_STRUCTURED_CORNELL_SURFACES := --surface floor=floor --surface walls=back_wall,green_wall,red_wall \
@@ -70,7 +72,7 @@ BENCH_STRUCTURED_CORNELL_SURFACES := --surface floor=floor --surface walls=back_
 
 .PHONY: bench-structured
 bench-structured: $(BINS) $(BENCH_BINS) $(BIN)/structured-sample $(BIN)/exact
-	$(BIN)/bench-structured --scene simple-environment --eps $(BENCH_STRUCTURED_EPS) --quality-tau 0.05,0.1 \
+	$(BIN)/bench-structured --scene simple-environment $(if $(BENCH_STRUCTURED_EPS),--eps $(BENCH_STRUCTURED_EPS)) --quality-tau 0.05,0.1 \
 	  -o $(BENCH_STRUCTURED_OUT)/simple-environment
 	$(BIN)/bench-structured --scene cornell --eps $(BENCH_STRUCTURED_CORNELL_EPS) --quality-tau 0.15 $(BENCH_STRUCTURED_CORNELL_SURFACES) \
 	  $(if $(BENCH_STRUCTURED_REFERENCE),--reference $(BENCH_STRUCTURED_REFERENCE)) -o $(BENCH_STRUCTURED_OUT)/cornell

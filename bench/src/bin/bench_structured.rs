@@ -32,8 +32,8 @@ struct Args {
     /// A surface of the table, NAME=object,object,...; repeat for more [default: every non-emitting object].
     #[arg(long, value_name = "NAME=OBJECTS")]
     surface: Vec<String>,
-    /// hierarchical-solve's EPS values, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "0.3,0.1,0.03,0.01,0.003,0.001")]
+    /// hierarchical-solve's EPS values, comma-separated (the default brackets structured sampling's figures on the simple environment).
+    #[arg(long, value_delimiter = ',', default_value = "0.0125,0.008,0.006,0.004,0.002,0.0008,0.0004,0.000125,0.00004")]
     eps: Vec<f64>,
     /// structured-sample's isolux levels.
     #[arg(long, default_value_t = 8)]

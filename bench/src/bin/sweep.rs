@@ -1,14 +1,14 @@
 //! `sweep`: error against time over a grid of knob values, for one scene
 //! and one or more solvers (see [`bench::sweep`] for what is computed).
 //!
-//! Reproduce: `make sweep` (Cornell box, hierarchical, EPS from 1e-2 to
-//! 1e-4, preview and full gathers, 3 runs a point), or e.g.
+//! Reproduce: `make sweep` (Cornell box, hierarchical, EPS from 1e-3 to
+//! 1e-5, preview and full gathers, 3 runs a point), or e.g.
 //! `target/release/sweep --scene sphere-300 --knob EPS=0.1,0.01 --reps 1
 //! -o out/sphere-300/sweep`. Writes `sweep.ron`, `sweep.csv`, `sweep.svg`
 //! and `sweep.png` in the output directory, each point's runs under
 //! `runs/`, the reference under `reference/`.
 
-use bench::sweep::knobs::{knob, Gather, Knob, Solver, KNOBS};
+use bench::sweep::knobs::{format_value, knob, Gather, Knob, Solver, KNOBS};
 use bench::sweep::stages::Stages;
 use bench::sweep::{plot, Config};
 use bench::PipelineArgs;
@@ -35,14 +35,23 @@ struct Args {
     /// Gather modes, comma-separated: preview, full [default: every mode the solver's solution allows].
     #[arg(long, value_delimiter = ',')]
     gather: Option<Vec<String>>,
-    /// A knob and its values, NAME=v1,v2,...; repeat for a grid (the cartesian product) [default per solver: EPS=0.01,0.003,0.001,0.0003,0.0001; GPU_CONVERGENCE=0.8,0.9,0.99,0.999].
-    #[arg(long, value_name = "NAME=V1,V2,...")]
+    #[arg(long, value_name = "NAME=V1,V2,...", help = knob_help())]
     knob: Vec<String>,
     /// Runs per point; each figure is their median.
     #[arg(long, default_value_t = 3)]
     reps: usize,
     #[command(flatten)]
     pipeline: PipelineArgs,
+}
+
+/// `--knob`'s help, with each solver's default grid ([`Solver::default_knobs`]).
+fn knob_help() -> String {
+    let defaults: Vec<String> = Solver::ALL
+        .into_iter()
+        .flat_map(Solver::default_knobs)
+        .map(|(knob, values)| format!("{}={}", knob.name, values.iter().map(|&v| format_value(v, knob.integer)).collect::<Vec<_>>().join(",")))
+        .collect();
+    format!("A knob and its values, NAME=v1,v2,...; repeat for a grid (the cartesian product) [default per solver: {}]", defaults.join("; "))
 }
 
 /// `NAME=v1,v2,...` as a knob and its values.
