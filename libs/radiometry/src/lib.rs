@@ -5,6 +5,7 @@
 //! - [`sampling`]: deterministic per-work-item random streams, stratified
 //!   points on triangles, the radical inverse and the Sobol (0,2)-sequence.
 //! - [`bounds`]: axis-aligned boxes.
+//! - [`burial`]: whether a surface point lies inside a closed solid.
 //! - [`subdivision`]: the 1:4 element subdivision rule and point location.
 //! - [`geometry`]: triangle corners, normals and areas in f64.
 //! - [`rays`]: ray casting over obvhs's CWBVH.
@@ -22,6 +23,7 @@
 //! data.
 
 pub mod bounds;
+pub mod burial;
 pub mod camera;
 pub mod color;
 pub mod form_factor;

@@ -34,25 +34,18 @@
 //! from the ratios of successive changes ([`crate::gather::solve`]), as for
 //! a closed scene.
 //!
-//! A point is buried when every one of [`EXPOSURE_RAYS`] rays from it into
-//! its front hemisphere (along its normal, and [`GRAZING_RAYS`] nearly
-//! along its surface) meets the back face of a surface first: inside a
-//! closed solid every ray does, and a ray that leaves the scene or meets a
-//! front face shows the point open to the room. A two-sided surface has no back face for rays (they
-//! see its twin's front, [`radiometry::rays`]), so nothing is buried under
-//! a sheet, only inside solids. `x` is the fraction of stratified points of
-//! the element (those that exist under an alpha mask) that are not buried
+//! A point is buried as [`radiometry::burial`] tests it: all its rays
+//! meet back faces first. `x` is the fraction of stratified points of the
+//! element (those that exist under an alpha mask) that are not buried
 //! (`of_element`); a fully buried element (`x = 0`) keeps the plain rule
 //! (its links bring it nothing anyway).
 
 use crate::elements::Hierarchy;
 use crate::nodes::key;
-use glam::DVec3;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
 use rayon::prelude::*;
 use schemas::solution::Node;
-use std::f64::consts::PI;
 
 /// Points per element whose burial is tested first.
 pub const EXPOSURE_POINTS: usize = 16;
@@ -63,50 +56,6 @@ pub const EXPOSURE_POINTS: usize = 16;
 /// about 1/16, a straddling leaf's radiosity 12% off at `x` = 1/2). Only
 /// such elements pay for it.
 pub const STRADDLING_POINTS: usize = 256;
-
-/// Rays per point: one along the normal, then [`GRAZING_RAYS`]; a point is
-/// buried when all of them meet a back face.
-pub const EXPOSURE_RAYS: usize = 1 + GRAZING_RAYS;
-
-/// Rays per point that leave it nearly along its surface (at
-/// [`GRAZING_COS`] to its normal, evenly spread in azimuth under one
-/// random turn): only a solid that closes down onto the surface around
-/// the point, as a block on a floor does, stops them all with its back
-/// faces. With 6 rays drawn by the cosine (mostly steep), 703 of the 9,000
-/// one-sided leaves of `plants-10k` were found partly buried under the
-/// backs of the leaves above them (false: light reaches them from the
-/// sides); with 8 grazing rays 51, with 16 six (exposure 0.94 to 0.99),
-/// for half the rays (the ray along the normal settles most open points
-/// at once).
-pub const GRAZING_RAYS: usize = 16;
-
-/// Cosine to the normal of the grazing rays (about 6 degrees above the
-/// surface).
-pub const GRAZING_COS: f64 = 0.1;
-
-/// Whether `point` on `triangle` (unit front normal `normal`) is buried
-/// (module docs), and the rays cast.
-fn buried(h: &Hierarchy, scene: &SceneRays, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, stream: &mut Stream) -> (bool, u64) {
-    let helper = if normal.x.abs() > 0.5 { DVec3::Y } else { DVec3::X };
-    let u = normal.cross(helper).normalize();
-    let v = normal.cross(u);
-    let turn = 2.0 * PI * stream.next_f64();
-    let sin_grazing = (1.0 - GRAZING_COS * GRAZING_COS).sqrt();
-    for k in 0..EXPOSURE_RAYS {
-        let direction = if k == 0 {
-            normal
-        } else {
-            let phi = turn + 2.0 * PI * k as f64 / GRAZING_RAYS as f64;
-            normal * GRAZING_COS + u * (sin_grazing * phi.cos()) + v * (sin_grazing * phi.sin())
-        };
-        let hit = scene.closest_hit(point, direction, t_min, f32::INFINITY, [triangle, schemas::solution::NONE]);
-        let back_face = hit.is_some_and(|hit| h.triangles[hit.triangle as usize].normal.dot(direction) > 0.0);
-        if !back_face {
-            return (false, k as u64 + 1);
-        }
-    }
-    (true, EXPOSURE_RAYS as u64)
-}
 
 /// Where the rays from a point of `element` start: past the rounding of
 /// the f32 ray origin (a point near a coplanar neighbour's edge must not
@@ -142,7 +91,7 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, stream: &mut Stre
             continue;
         }
         existing += 1;
-        let (is_buried, cast) = buried(h, scene, point, normal, element.triangle, t_min, stream);
+        let (is_buried, cast) = radiometry::burial::buried(scene, &|t| h.triangles[t as usize].normal, point, normal, element.triangle, t_min, stream);
         rays += cast;
         exposed += usize::from(!is_buried);
     }
