@@ -38,6 +38,7 @@
 pub mod atlas;
 pub mod convergence;
 pub mod detail;
+pub mod exposure;
 pub mod gpu;
 pub mod mirrors;
 pub mod output;
@@ -217,6 +218,11 @@ pub struct Work {
     /// Texels of the texture atlas uploaded for the visibility maps'
     /// alpha test (0: no alpha mask, nothing allocated).
     pub mask_texels: u64,
+    /// Texels buried inside a solid, which do not take part in the
+    /// shooting ([`exposure`]), in the last atlas.
+    pub buried_texels: u64,
+    /// Rays cast to find them, every atlas built.
+    pub burial_rays: u64,
     /// Covered texels the adaptive subdivision added.
     pub elements_added: u64,
     /// Tiles it added (3 per split).
@@ -310,6 +316,8 @@ struct Built {
     /// Per tile: whether a normal map perturbs its texels' normals.
     normal_mapped: Vec<bool>,
     mask_texels: u64,
+    /// Texels buried inside a solid, and the rays that found them.
+    buried: (u64, u64),
     /// Translucent input triangles that transmit nothing (not two-sided).
     one_sided: u64,
     /// The first virtual sample of the reflection tree (after the
@@ -356,9 +364,15 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
         None => Vec::new(),
     };
     let detail_of = |k: usize| details.get(k).copied().flatten();
-    if let Some(d) = detail.as_ref().filter(|d| d.masked(mesh)) {
-        let coverage: Vec<f64> = (0..atlas.texels.len()).map(|k| detail_of(k).map_or(1.0, |x| x.coverage)).collect();
-        atlas.cover(&coverage, &|t| d.mask(mesh, t).is_some());
+    let masks = detail.as_ref().filter(|d| d.masked(mesh));
+    let (buried, burial_rays) = exposure::buried_texels(mesh, &atlas);
+    if masks.is_some() || buried.contains(&true) {
+        let mut has_buried = vec![false; mesh.triangles.len()];
+        for (texel, _) in atlas.texels.iter().zip(&buried).filter(|(_, b)| **b) {
+            has_buried[texel.triangle as usize] = true;
+        }
+        let coverage: Vec<f64> = (0..atlas.texels.len()).map(|k| if buried[k] { 0.0 } else { detail_of(k).map_or(1.0, |x| x.coverage) }).collect();
+        atlas.cover(&coverage, &|t| has_buried[t] || masks.is_some_and(|d| d.mask(mesh, t).is_some()));
     }
     let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
     let texels: Vec<GpuTexel> = atlas
@@ -462,7 +476,8 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
     let normal_mapped = (0..tiles.len()).map(|t| detail.as_ref().is_some_and(|d| d.normal_mapped(mesh, t))).collect();
     let mask_texels = masks.as_ref().map_or(0, |(_, m)| m.len() as u64);
     let one_sided = transmission.map_or(0, |(_, n)| n as u64);
-    Built { atlas, texels, tris, gpu, normal_mapped, mask_texels, one_sided, virtual_base }
+    let buried = (buried.iter().filter(|b| **b).count() as u64, burial_rays);
+    Built { atlas, texels, tris, gpu, normal_mapped, mask_texels, buried, one_sided, virtual_base }
 }
 
 /// The samples of tile `shooter` (positions, frames, polygons; the GPU
@@ -605,7 +620,7 @@ pub fn solve(
         interreflection,
         ..Default::default()
     };
-    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), mask_texels: built.mask_texels, one_sided_translucent: built.one_sided, ..Default::default() };
+    let mut work = Work { setup_seconds: started.elapsed().as_secs_f64(), mask_texels: built.mask_texels, buried_texels: built.buried.0, burial_rays: built.buried.1, one_sided_translucent: built.one_sided, ..Default::default() };
     let shooting = Instant::now();
     let mut shots = Vec::new();
     let mut unshot_lights: f64 = light_flux.iter().map(|f| 3.0 * f).sum();
@@ -700,6 +715,8 @@ pub fn solve(
                 let texels_before = built.texels.len();
                 built = build(&context, &next, Some(&copied));
                 work.elements_added += built.texels.len().saturating_sub(texels_before) as u64;
+                work.buried_texels = built.buried.0;
+                work.burial_rays += built.buried.1;
                 work.tiles_added += (next.len() - tiles.len()) as u64;
                 // A split tile is new: its children have not shot.
                 tested = origin.iter().zip(&next).map(|(&o, tile)| tested[o] && tiles[o] == *tile).collect();

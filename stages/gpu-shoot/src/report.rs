@@ -31,6 +31,8 @@ impl Solved {
             ("receiver_evaluations", w.receiver_evaluations as f64),
             ("texels", self.atlas.texels.len() as f64),
             ("mask_texels", w.mask_texels as f64),
+            ("buried_texels", w.buried_texels as f64),
+            ("burial_rays", w.burial_rays as f64),
             ("subdivision_texels_added", w.elements_added as f64),
             ("subdivision_tiles_added", w.tiles_added as f64),
             ("subdivision_seconds", w.subdivision_seconds),

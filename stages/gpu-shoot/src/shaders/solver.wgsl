@@ -231,7 +231,8 @@ fn finish_shooter(@builtin(global_invocation_id) id: vec3<u32>) {
 // texels of a neighbouring wall from a shooter next to it (the closed box
 // lost 1-2% of each wall shot that way). Visible when the centre pixel
 // holds nothing nearer than the receiver's plane (within the tolerance),
-// or one of its 8 neighbours holds the receiver's plane.
+// or one of its 8 neighbours holds the receiver's plane, unless the centre
+// pixel holds an occluder well in front of that plane (far_occluder).
 fn visible_face(layer: u32, q: vec3<f32>, m: vec3<f32>) -> bool {
     let res = f32(params.res);
     let px = (q.x / q.z * 0.5 + 0.5) * res;
@@ -239,6 +240,7 @@ fn visible_face(layer: u32, q: vec3<f32>, m: vec3<f32>) -> bool {
     let x = i32(floor(px));
     let y = i32(floor(py));
     let mq = dot(m, q);
+    if (far_occluder(layer, x, y, mq, m)) { return false; }
     for (var dy = -1; dy <= 1; dy += 1) {
         for (var dx = -1; dx <= 1; dx += 1) {
             let cx = clamp(x + dx, 0, i32(params.res) - 1);
@@ -256,6 +258,40 @@ fn visible_face(layer: u32, q: vec3<f32>, m: vec3<f32>) -> bool {
     }
     return false;
 }
+
+// Whether the centre pixel (x, y) holds a surface nearer than the
+// receiver's plane (normal m, m . q = mq) by more than FAR_PIXELS pixel
+// footprints along its ray, measured where the ray meets the plane (the
+// footprint grows as 1 / cos at a grazing plane): a real occluder, such as
+// a block over its shadow, whose 8 neighbours must not make the receiver
+// visible. The neighbour test exists for the surfaces that meet the
+// receiver's plane (a wall at the floor), whose rasterized edge covers
+// the centre pixels of the receiver's texels beside the crease; counted
+// for every occluder, it lit a pixel-wide band inside every shadow
+// (Cornell box at 128 pixels: floor +6.4%, short block +9.4% against
+// Mitsuba, +0.7% and +3.4% at 512).
+fn far_occluder(layer: u32, x: i32, y: i32, mq: f32, m: vec3<f32>) -> bool {
+    let res = f32(params.res);
+    let cx = clamp(x, 0, i32(params.res) - 1);
+    let cy = clamp(y, 0, i32(params.res) - 1);
+    let dir = vec3<f32>((f32(cx) + 0.5) / res * 2.0 - 1.0, 1.0 - (f32(cy) + 0.5) / res * 2.0, 1.0);
+    let md = dot(m, dir);
+    if (md >= 0.0 || mq >= 0.0) { return false; }
+    let len = length(dir);
+    let plane = mq / md * len;
+    let stored = textureLoad(visibility, vec2<i32>(cx, cy), i32(layer), 0).x;
+    // One pixel's footprint along the ray at the plane: its width there
+    // (2 / res of the face's unit distance, times the distance over |dir|)
+    // over the cosine of the ray to the plane's normal.
+    let cos_r = -md / len;
+    let footprint = plane / len * (2.0 / res) / max(cos_r, 1e-3);
+    return stored < plane - FAR_PIXELS * footprint - params.tolerance * plane;
+}
+
+// Pixel footprints (far_occluder) beyond which a surface in front of the
+// receiver's plane is an occluder, not a rasterized edge of a surface
+// meeting the plane.
+const FAR_PIXELS: f32 = 2.0;
 
 fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
     return a.x * b.y - a.y * b.x;
