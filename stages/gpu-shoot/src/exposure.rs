@@ -14,35 +14,52 @@
 //! -2.2%, ceiling -1.2% -> -0.8%, back wall -0.6% -> -0.4%.
 
 use crate::atlas::Atlas;
+use crate::tiling::Tile;
 use glam::DVec3;
 use radiometry::burial::buried;
+use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use schemas::mesh::Mesh;
+use stage_kit::scene::mesh_triangles;
 
-/// Per texel of `atlas` over `mesh`, whether its point is buried
-/// ([`radiometry::burial`]), and the rays cast.
-pub fn buried_texels(mesh: &Mesh, atlas: &Atlas) -> (Vec<bool>, u64) {
-    let point = |v: u32| DVec3::from(mesh.positions[v as usize].map(f64::from));
-    let corners: Vec<[DVec3; 3]> = mesh.triangles.iter().map(|t| t.vertices.map(point)).collect();
-    let normals: Vec<DVec3> = mesh.triangles.iter().map(|t| DVec3::from(t.normal.map(f64::from)).normalize_or_zero()).collect();
-    let scene = SceneRays::new(&corners);
-    let mut rays = 0;
-    let flags = atlas
-        .texels
-        .iter()
-        .enumerate()
-        .map(|(k, texel)| {
-            let p = DVec3::from(texel.position.map(f64::from));
-            // Past the rounding of the f32 ray origin.
-            let t_min = (1e-6 * p.abs().max_element().max(1.0)) as f32;
-            let mut stream = Stream::new(BURIAL_SEED, k as u64, 0);
-            let (is_buried, cast) = buried(&scene, &|t| normals[t as usize], p, normals[texel.triangle as usize], texel.triangle, t_min, &mut stream);
-            rays += cast;
-            is_buried
-        })
-        .collect();
-    (flags, rays)
+/// The input mesh's rays and geometry, built once per solve: the
+/// adaptive subdivision rebuilds the atlas over new tiles of the same
+/// triangles.
+pub struct Burial {
+    scene: SceneRays,
+    triangles: Vec<TriangleGeometry>,
+}
+
+impl Burial {
+    /// Over the input triangles of `mesh`.
+    pub fn new(mesh: &Mesh) -> Self {
+        let triangles = mesh_triangles(mesh);
+        Burial { scene: SceneRays::new(&triangles.iter().map(|t| t.corners).collect::<Vec<_>>()), triangles }
+    }
+
+    /// Per texel of `atlas` (over `tiles` of the input mesh), whether its
+    /// point is buried ([`radiometry::burial`]), and the rays cast.
+    pub fn texels(&self, atlas: &Atlas, tiles: &[Tile]) -> (Vec<bool>, u64) {
+        let mut rays = 0;
+        let flags = atlas
+            .texels
+            .iter()
+            .enumerate()
+            .map(|(k, texel)| {
+                let root = tiles[texel.triangle as usize].root;
+                let p = DVec3::from(texel.position.map(f64::from));
+                // Past the rounding of the f32 ray origin.
+                let t_min = (1e-6 * p.abs().max_element().max(1.0)) as f32;
+                let mut stream = Stream::new(BURIAL_SEED, k as u64, 0);
+                let normal_of = |t: u32| self.triangles[t as usize].normal;
+                let (is_buried, cast) = buried(&self.scene, &normal_of, p, normal_of(root), root, t_min, &mut stream);
+                rays += cast;
+                is_buried
+            })
+            .collect();
+        (flags, rays)
+    }
 }
 
 /// Seed of the grazing rays' random turn per texel (gpu-shoot has no seed

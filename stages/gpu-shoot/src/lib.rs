@@ -305,6 +305,8 @@ struct Context<'a> {
     specular: Option<&'a mirrors::Specular>,
     /// Samples per batch (the virtual samples of a level).
     batch: u32,
+    /// What finds the texels buried inside solids.
+    burial: exposure::Burial,
 }
 
 /// The solver's state for one set of tiles.
@@ -365,7 +367,7 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
     };
     let detail_of = |k: usize| details.get(k).copied().flatten();
     let masks = detail.as_ref().filter(|d| d.masked(mesh));
-    let (buried, burial_rays) = exposure::buried_texels(mesh, &atlas);
+    let (buried, burial_rays) = c.burial.texels(&atlas, tiles);
     if masks.is_some() || buried.contains(&true) {
         let mut has_buried = vec![false; mesh.triangles.len()];
         for (texel, _) in atlas.texels.iter().zip(&buried).filter(|(_, b)| **b) {
@@ -582,6 +584,7 @@ pub fn solve(
         ldt_capacity: lights.iter().map(|l| light_table(l).len()).max().unwrap_or(4),
         specular: specular.as_ref(),
         batch: batch_area,
+        burial: exposure::Burial::new(mesh),
     };
     let mut tiles = tiling::identity(mesh);
     let mut built = build(&context, &tiles, None);
