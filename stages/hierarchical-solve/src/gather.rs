@@ -63,16 +63,6 @@ pub struct Convergence {
     pub rates: [f64; 3],
 }
 
-/// The node with dense index `i`.
-fn node(h: &Hierarchy, i: usize) -> Node {
-    let clusters = h.cluster_count();
-    if i < clusters {
-        Node::Cluster(i as u32)
-    } else {
-        Node::Element((i - clusters) as u32)
-    }
-}
-
 /// The hierarchy flattened once per solve: parent, children and area per
 /// dense index, so the sweeps neither allocate nor branch on node kinds.
 struct Topology {
@@ -97,14 +87,14 @@ impl Topology {
         let mut t = Topology { parent: vec![usize::MAX; n], child_start: vec![0; n + 1], children: Vec::new(), area: vec![0.0; n], exposure: vec![1.0; n], leaf: vec![None; n], transmit: Vec::new() };
         if h.transmission.is_some() {
             t.transmit = (0..n)
-                .map(|i| match node(h, i) {
+                .map(|i| match h.node(i) {
                     Node::Element(e) if h.elements[e as usize].is_leaf() => h.transmission_of(e).map(|(tau, twin)| (tau, h.flat(Node::Element(twin)))),
                     _ => None,
                 })
                 .collect();
         }
         for i in 0..n {
-            let this = node(h, i);
+            let this = h.node(i);
             t.area[i] = h.area(this);
             if let Some(p) = h.parent(this) {
                 t.parent[i] = h.flat(p);
@@ -119,7 +109,7 @@ impl Topology {
         }
         // Children follow their parents in the dense order.
         for i in (0..n).rev() {
-            t.exposure[i] = match node(h, i) {
+            t.exposure[i] = match h.node(i) {
                 Node::Element(e) if h.elements[e as usize].is_leaf() => h.exposure(e),
                 _ => {
                     let children = &t.children[t.child_start[i]..t.child_start[i + 1]];

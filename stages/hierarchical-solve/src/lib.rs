@@ -376,16 +376,16 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let allowance = allowance(params, threshold, (pass > 1).then(|| mean_reflected(&h, &b)));
         // The relative criterion sees a sender's variation at every level
         // below it; the absolute one only at its children, as before.
-        let deviation = match allowance {
-            Allowance::Relative { .. } => links::leaf_deviation(&h, &b),
-            Allowance::Absolute(_) => Vec::new(),
+        let (deviation, dimmest) = match allowance {
+            Allowance::Relative { .. } => (links::leaf_deviation(&h, &b), links::dimmest_leaf(&h, &b)),
+            Allowance::Absolute(_) => (Vec::new(), Vec::new()),
         };
         let mut active = std::mem::take(&mut all_links);
         // How many links at the front of all_links keep the order the
         // previous pass sorted them in: those it kept first (sort_links).
         let mut in_order = None;
         while !active.is_empty() {
-            let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, &deviation, &allowance, floors)).collect();
+            let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, &deviation, &dimmest, &allowance, floors)).collect();
             for (l, d) in active.iter().zip(&decisions) {
                 let node = match d {
                     Split::Sender => l.sender,

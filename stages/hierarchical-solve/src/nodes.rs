@@ -30,6 +30,16 @@ impl Hierarchy {
         }
     }
 
+    /// The node with dense index `i` (the inverse of [`Hierarchy::flat`]).
+    pub fn node(&self, i: usize) -> Node {
+        let clusters = self.cluster_count();
+        if i < clusters {
+            Node::Cluster(i as u32)
+        } else {
+            Node::Element((i - clusters) as u32)
+        }
+    }
+
     /// Number of clusters (0 without clustering).
     pub fn cluster_count(&self) -> usize {
         self.clusters.as_ref().map_or(0, ClusterTree::len)
