@@ -484,7 +484,8 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation
 /// Cornell box at `EPS` 2e-4 a floor leaf beside the short block's
 /// shadowed face was 41% above the `EPS` 2.5e-5 solution's, most of it
 /// brought by links into the floor triangle's cluster and top element,
-/// and the face's bottom leaves, which that floor lights, 15% to 40%. The
+/// and the leaves along the bottom of the face, which that floor lights,
+/// 7% to 38% (now 22%, and 6% to 24%). The
 /// preview against Mitsuba (relative RMSE, 2 threads): `EPS` 4e-4 1.74%
 /// -> 1.47% (38k -> 41k links), 2e-4 1.14% -> 0.96% (90k -> 98k), 1e-4
 /// 0.97% -> 0.90% (196k -> 213k links; short block +0.49% -> +0.25%,
