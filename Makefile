@@ -31,8 +31,8 @@ OUT ?= out/$(SCENE_NAME)
 # --- knobs (defaults are the stages' own) -------------------------------
 # CLUSTERS=1 solves with the cluster hierarchy (the cluster stage), 0 links
 # every pair of input triangles. The large procedural scenes default to a
-# coarser refinement threshold: 1.5e-5 of the lamp's exitance is set by a
-# closed box at reflectance 0.999 (hierarchical-solve's RELATIVE_AT), far
+# coarser refinement threshold: 1.5e-5 of the lamp's exitance is chosen for
+# the Cornell box's full gather (hierarchical-solve's RELATIVE_AT), far
 # stricter than a 100k-triangle plant room needs.
 CLUSTERS ?= 1
 ifneq ($(filter plants-% box-% sphere-%,$(SCENE)),)

@@ -144,10 +144,12 @@ stage_kit::show_by_name!(Criterion);
 /// points); the absolute alone 0.96% in 1.36 s, short block +1.2%; both,
 /// at 1/8: 1.14% in 0.93 s with every surface within 0.95%, 0.87% in
 /// 1.47 s within 0.46% (1/16 about the same, 1/4 slower). The default
-/// `eps` is set by the closed box at rho 0.999, which multiplies every
-/// link's error about a thousandfold (its mean is 0.07% low at 1.5e-5,
-/// 0.32% at 1e-4); on the Cornell box it gives the former default's
-/// accuracy (full gather 0.49% against 0.47%) in 0.65 of its time.
+/// `eps` was set by the closed box at rho 0.999, which multiplies every
+/// link's error about a thousandfold (its mean was 0.07% low at 1.5e-5,
+/// 0.32% at 1e-4, until the uniform senders' shortcut was scaled by `1 -
+/// q`, [`gather::UNIFORM_SENDER`]: now 3e-7 and 0.003%); it stays for the
+/// Cornell box, whose full gather it brings to 0.48% against Mitsuba
+/// (0.51% at 2.5e-5, 0.59% at 1e-4).
 pub const RELATIVE_AT: f64 = 0.125;
 
 impl Params {
