@@ -468,9 +468,10 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation
     over.into_iter().map(|e| e.1).collect()
 }
 
-/// How much dimmer than node `r` the dimmest exposed leaf below it is:
-/// that leaf's brightest channel over `r`'s ([`dimmest_leaf`]), in [0, 1];
-/// 1 where `dimmest` is empty (the absolute criterion).
+/// How much dimmer than node `r` the dimmest exposed leaf below it is, in
+/// what the relative criterion bounds: [`light_scale`] of that leaf
+/// ([`dimmest_leaf`]) over `r`'s, in [0, 1]; 1 where `dimmest` is empty
+/// (the absolute criterion).
 ///
 /// The relative criterion bounds each element's error against its own
 /// radiosity. A link into an inner element or a cluster lights all the
@@ -492,17 +493,27 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation
 /// every surface within 0.26%).
 fn dimming(h: &Hierarchy, r: Node, radiosity: &[[f64; 3]], dimmest: &[f64]) -> f64 {
     let Some(&low) = dimmest.get(h.flat(r)) else { return 1.0 };
-    let top = radiosity[h.flat(r)].into_iter().fold(0.0, f64::max);
-    if top > 0.0 && low.is_finite() {
+    let top = light_scale(radiosity[h.flat(r)], h.node_reflectance(r));
+    if top > 0.0 && top.is_finite() && low.is_finite() {
         (low / top).clamp(0.0, 1.0)
     } else {
         1.0
     }
 }
 
-/// Per node (dense index), the brightest radiosity channel of the dimmest
-/// leaf element below it with any exposed area ([`crate::exposure`]; a
-/// buried leaf shows nothing), +inf where there is none. Children follow
+/// What a link's error on a node is measured against, per unit of the
+/// irradiance it brings: the node's radiosity over its reflectance,
+/// `max_c B_c / rho_c` over the channels that reflect (+inf where none
+/// does). A leaf's error is `rho ΔH` and its allowance `eps B`, so the
+/// leaf with the smallest `B / rho`, not the smallest `B`, binds: a black
+/// or dark-coloured leaf in a cluster is dim but errs as little.
+fn light_scale(b: [f64; 3], rho: [f64; 3]) -> f64 {
+    (0..3).filter(|&c| rho[c] > 0.0).map(|c| (b[c] / rho[c]).max(0.0)).reduce(f64::max).unwrap_or(f64::INFINITY)
+}
+
+/// Per node (dense index), the [`light_scale`] of the dimmest leaf element
+/// below it with any exposed area ([`crate::exposure`]; a buried leaf shows
+/// nothing) and a reflectance, +inf where there is none. Children follow
 /// their parents in the dense order, so one backward sweep gathers it.
 pub fn dimmest_leaf(h: &Hierarchy, radiosity: &[[f64; 3]]) -> Vec<f64> {
     let mut low = vec![f64::INFINITY; radiosity.len()];
@@ -510,7 +521,7 @@ pub fn dimmest_leaf(h: &Hierarchy, radiosity: &[[f64; 3]]) -> Vec<f64> {
         let node = h.node(i);
         if let Node::Element(e) = node {
             if h.elements[e as usize].is_leaf() && h.exposure(e) > 0.0 {
-                low[i] = radiosity[i].into_iter().fold(0.0, f64::max);
+                low[i] = light_scale(radiosity[i], h.reflectance_of(e));
             }
         }
         if let Some(p) = h.parent(node) {
@@ -604,15 +615,16 @@ mod tests {
     }
 
     /// Every node's dimmest exposed leaf, against the leaves' parent
-    /// chains walked one by one: element 0 holds the dim leaf 9 (0.05),
-    /// not the buried leaf 8; element 1 and the leaves are their own.
+    /// chains walked one by one: element 0 holds the dim leaf 9 (0.05 over
+    /// its reflectance 0.5), not the buried leaf 8; element 1 and the
+    /// leaves are their own; the black lamp never binds.
     #[test]
     fn the_dimmest_leaf_is_the_dimmest_exposed_leaf_below_each_node() {
         let (h, b) = floor_under_a_lamp();
         let low = dimmest_leaf(&h, &b);
         let mut want = vec![f64::INFINITY; b.len()];
         for e in (0..h.elements.len()).filter(|&e| h.elements[e].is_leaf() && h.exposure(e as u32) > 0.0) {
-            let bright = b[e].into_iter().fold(0.0, f64::max);
+            let bright = (0..3).map(|c| b[e][c] / h.reflectance_of(e as u32)[c]).fold(0.0, f64::max);
             let mut node = Some(Node::Element(e as u32));
             while let Some(n) = node {
                 want[h.flat(n)] = want[h.flat(n)].min(bright);
@@ -620,7 +632,8 @@ mod tests {
             }
         }
         assert_eq!(low, want);
-        assert_eq!(low[0], 0.05);
+        assert_eq!(low[0], 0.05 / 0.5, "B / rho of leaf 9's brightest channel");
+        assert_eq!(low[h.flat(Node::Element(2))], f64::INFINITY, "a black leaf never binds");
         let mean = b[0][0];
         assert!((dimming(&h, Node::Element(0), &b, &low) - 0.05 / mean).abs() < 1e-15);
         assert_eq!(dimming(&h, Node::Element(0), &b, &[]), 1.0, "the absolute criterion does not dim");
