@@ -34,6 +34,10 @@ pub struct Texel {
     pub position: [f32; 3],
     /// Area it stands for, m².
     pub area: f32,
+    /// Buried inside a solid ([`crate::exposure`]): absent, as a
+    /// transparent texel is, and in the lightmap a texel without a value,
+    /// filled from its exposed neighbours ([`crate::output::fill_seams`]).
+    pub buried: bool,
 }
 
 impl Texel {
@@ -238,7 +242,7 @@ pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, level: u32) -> Atlas {
                         // triangle: interior texels stand for 2 A / n^2, those
                         // A / n^2, and the areas sum to A exactly.
                         let area = if i + j + 1 == n { region.texel_area * 0.5 } else { region.texel_area };
-                        all_texels.push(Texel { x, y, triangle: t as u32, position: p.as_vec3().to_array(), area });
+                        all_texels.push(Texel { x, y, triangle: t as u32, position: p.as_vec3().to_array(), area, buried: false });
                     }
                 }
                 let count = all_texels.len() as u32 - start;

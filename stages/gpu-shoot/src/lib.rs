@@ -374,6 +374,9 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
             has_buried[texel.triangle as usize] = true;
         }
         let coverage: Vec<f64> = (0..atlas.texels.len()).map(|k| if buried[k] { 0.0 } else { detail_of(k).map_or(1.0, |x| x.coverage) }).collect();
+        for (texel, &b) in atlas.texels.iter_mut().zip(&buried) {
+            texel.buried = b;
+        }
         atlas.cover(&coverage, &|t| has_buried[t] || masks.is_some_and(|d| d.mask(mesh, t).is_some()));
     }
     let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];

@@ -161,7 +161,9 @@ pub fn lightmap_of(a: &Atlas, radiosity: &[[f32; 3]], residual: &[[f32; 3]], mes
         let i = t.y as usize * w + t.x as usize;
         lm.radiosity[i] = radiosity[k];
         lm.residual[i] = residual[k];
-        lm.coverage[i] = COVERED;
+        // A buried texel holds no value: filled from its neighbours, as
+        // beyond an edge.
+        lm.coverage[i] = if t.buried { 0.0 } else { COVERED };
         lm.texel_area[i] = t.area;
     }
     // Positions and normals of every texel of a region, gutter included
@@ -199,7 +201,16 @@ pub fn bilinear(lm: &Lightmap, t: usize, uv: [f64; 2]) -> [f64; 3] {
     bilinear_of(lm, &lm.radiosity, t, uv)
 }
 
-/// [`bilinear`] of `values` (the lightmap's radiosity or residual).
+/// [`bilinear`] of `values` (the lightmap's radiosity or residual), over
+/// the texels that hold a value (covered or filled), their weights
+/// renormalised; 0 where none of the four does.
+///
+/// A texel buried inside a solid ([`crate::atlas::Texel::buried`]) holds
+/// none: [`fill_seams`] extrapolates into it from the exposed texels
+/// beside it as it does beyond a triangle's edge. Read as a covered texel of radiosity
+/// 0, it darkened every lookup within a texel of a block's footprint, and
+/// the floor along the blocks' bases showed a dark band in gpu-shoot's
+/// preview.
 pub fn bilinear_of(lm: &Lightmap, values: &[[f32; 3]], t: usize, uv: [f64; 2]) -> [f64; 3] {
     let r = lm.regions[t];
     let n = r.size as f64;
@@ -207,12 +218,30 @@ pub fn bilinear_of(lm: &Lightmap, values: &[[f32; 3]], t: usize, uv: [f64; 2]) -
     let fy = (uv[1] * n + 0.5).clamp(0.0, n + 1.0);
     let (ix, iy) = (fx.floor().min(n), fy.floor().min(n));
     let (tx, ty) = (fx - ix, fy - iy);
-    let at = |dx: f64, dy: f64| {
+    let (mut sum, mut weight) = ([0.0; 3], 0.0);
+    for (dx, dy, w) in [(0.0, 0.0, (1.0 - tx) * (1.0 - ty)), (1.0, 0.0, tx * (1.0 - ty)), (0.0, 1.0, (1.0 - tx) * ty), (1.0, 1.0, tx * ty)] {
         let k = (r.y as usize + (iy + dy) as usize) * lm.width + r.x as usize + (ix + dx) as usize;
-        values[k].map(f64::from)
-    };
-    let (a, b, c, d) = (at(0.0, 0.0), at(1.0, 0.0), at(0.0, 1.0), at(1.0, 1.0));
-    [0, 1, 2].map(|k| (a[k] * (1.0 - tx) + b[k] * tx) * (1.0 - ty) + (c[k] * (1.0 - tx) + d[k] * tx) * ty)
+        if lm.coverage[k] != 0.0 {
+            (0..3).for_each(|c| sum[c] += w * f64::from(values[k][c]));
+            weight += w;
+        }
+    }
+    if weight > 0.0 {
+        sum.map(|v| v / weight)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Whether barycentric `uv` of region `t` lies in a buried texel (one of
+/// the triangle's texels that holds no value of its own,
+/// [`crate::atlas::Texel::buried`]).
+fn buried_at(lm: &Lightmap, t: usize, uv: [f64; 2]) -> bool {
+    let r = lm.regions[t];
+    let n = r.size as f64;
+    let (i, j) = ((uv[0] * n).floor().clamp(0.0, n - 1.0) as u32, (uv[1] * n).floor().clamp(0.0, n - 1.0) as u32);
+    let (x, y) = r.texel(i, j);
+    r.is_covered(i, j) && lm.coverage[y as usize * lm.width + x as usize] != COVERED
 }
 
 /// Radiosity and residual for every covered texel of `atlas` (tiles
@@ -290,8 +319,13 @@ pub fn copy_down(old: &Lightmap, old_tiles: &[Tile], atlas: &Atlas, tiles: &[Til
 /// about a texel, on each the mean of the lookups at its centroid and at
 /// the three points `(2/3, 1/6, 1/6)` of its corners (Dunavant's degree-2
 /// rule plus the centroid), plus
-/// `rho x ambient` when asked (004 Eq. 2.4, for display). Inner elements
-/// hold the area-weighted mean of their children. No links, no clusters.
+/// `rho x ambient` when asked (004 Eq. 2.4, for display). The lookups that
+/// fall in a buried texel are left out, and a leaf's area is its exposed
+/// part's (the fraction of its lookups kept), as hierarchical-solve's
+/// solution holds it: a leaf straddling a block's footprint shows its
+/// exposed part's radiosity, and one under the block weighs nothing where
+/// a display averages leaves. Inner elements hold their children's area
+/// and its area-weighted mean radiosity. No links, no clusters.
 pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile], ambient: Option<[f64; 3]>, texels_per_leaf: f64, header: Header) -> Solution {
     let mut elements: Vec<Element> = mesh.triangles.iter().enumerate().map(|(t, tri)| Element::root(t as u32, tri.area, [0.0; 3])).collect();
     // Per element: its corners in its input triangle, and below the tiles
@@ -375,20 +409,26 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile],
         }
         let (a, b) = (2.0 / 3.0, 1.0 / 6.0);
         let points = [[1.0 / 3.0; 3], [a, b, b], [b, a, b], [b, b, a]];
-        let weight = 1.0 / (4.0 * pieces.len() as f64);
-        let mut sum = [0.0; 3];
+        let (mut sum, mut exposed) = ([0.0; 3], 0usize);
         for c in &pieces {
             let point = |l: [f64; 3]| [l[0] * c[0][0] + l[1] * c[1][0] + l[2] * c[2][0], l[0] * c[0][1] + l[1] * c[1][1] + l[2] * c[2][1]];
             for l in points {
+                if buried_at(lm, tile, point(l)) {
+                    continue;
+                }
+                exposed += 1;
                 for (s, v) in sum.iter_mut().zip(bilinear(lm, tile, point(l))) {
-                    *s += v * weight;
+                    *s += v;
                 }
             }
         }
         let extra = rho_ambient(t);
-        elements[e].radiosity = [0, 1, 2].map(|k| (sum[k] + extra[k]) as f32);
+        let mean = sum.map(|v| if exposed > 0 { v / exposed as f64 } else { 0.0 });
+        elements[e].radiosity = [0, 1, 2].map(|k| (mean[k] + extra[k]) as f32);
+        elements[e].area = (elements[e].area as f64 * exposed as f64 / (4 * pieces.len()) as f64) as f32;
     }
-    // Inner elements: area-weighted mean of the children, deepest first.
+    // Inner elements: their children's exposed area and its area-weighted
+    // mean radiosity, deepest first.
     for e in (0..elements.len()).rev() {
         if elements[e].is_leaf() {
             continue;
@@ -402,7 +442,8 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile],
             }
             area += child.area as f64;
         }
-        elements[e].radiosity = sum.map(|s| (s / area) as f32);
+        elements[e].radiosity = sum.map(|s| if area > 0.0 { (s / area) as f32 } else { 0.0 });
+        elements[e].area = area as f32;
     }
     Solution { header, elements, clusters: Vec::new(), links: Vec::new() }
 }
