@@ -425,7 +425,7 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile],
         let extra = rho_ambient(t);
         let mean = sum.map(|v| if exposed > 0 { v / exposed as f64 } else { 0.0 });
         elements[e].radiosity = [0, 1, 2].map(|k| (mean[k] + extra[k]) as f32);
-        elements[e].area = (elements[e].area as f64 * exposed as f64 / (4 * pieces.len()) as f64) as f32;
+        elements[e].area = (elements[e].area as f64 * exposed as f64 / (points.len() * pieces.len()) as f64) as f32;
     }
     // Inner elements: their children's exposed area and its area-weighted
     // mean radiosity, deepest first.
