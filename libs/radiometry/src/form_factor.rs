@@ -210,8 +210,28 @@ struct OneSided<'a> {
     front: DVec3,
 }
 
-/// Relative accuracy the adaptive receiver quadrature aims for.
+/// Relative accuracy the adaptive receiver quadrature aims for unless told
+/// otherwise ([`Quadrature::to_depth`]).
 pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
+
+/// How far [`triangle_to_polygon`] refines its receiver quadrature near
+/// the sender: at most `depth` levels of midpoint splits, and no further
+/// where a triangle's estimate is within `tolerance` (relative) of its
+/// four children's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quadrature {
+    /// Deepest split.
+    pub depth: u32,
+    /// Relative change below which a triangle is not split further.
+    pub tolerance: f64,
+}
+
+impl Quadrature {
+    /// Down to `depth` levels, to [`QUADRATURE_TOLERANCE`].
+    pub const fn to_depth(depth: u32) -> Self {
+        Quadrature { depth, tolerance: QUADRATURE_TOLERANCE }
+    }
+}
 
 /// Area-averaged form factor from a receiver triangle to a one-sided sender
 /// polygon (front side `sender_normal`):
@@ -229,7 +249,8 @@ pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
 /// integrand varies fast, and near a shared edge it has a logarithmic
 /// singularity, so the rule is applied adaptively: a triangle whose estimate
 /// differs from the sum over its four midpoint children by more than
-/// [`QUADRATURE_TOLERANCE`] is split, down to `depth` levels. Each level
+/// `quadrature.tolerance` (relative) is split, down to `quadrature.depth`
+/// levels. Each level
 /// roughly halves the error of a receiver touching the sender (the
 /// singular strip halves in width), at twice the cost.
 /// This matters for energy balance: in a closed room with reflectance rho,
@@ -240,14 +261,14 @@ pub const QUADRATURE_TOLERANCE: f64 = 1e-5;
 /// in front only (clipped, then fanned into triangles weighted by area):
 /// the integrand is 0 behind, and a fixed rule across that kink misses the
 /// front part's light by tens of percent on a coarse leaf.
-pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3], sender_normal: DVec3, depth: u32) -> AreaFactor {
+pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &[DVec3], sender_normal: DVec3, quadrature: Quadrature) -> AreaFactor {
     let sender = OneSided { polygon: sender, front: sender_normal };
     let Some(origin) = sender.polygon.first().copied() else {
         return AreaFactor { mean: 0.0, min: 0.0, max: 0.0 };
     };
     let height = |p: DVec3| (p - origin).dot(sender_normal);
     if receiver.iter().all(|&p| height(p) > 0.0) {
-        return front_part(receiver, receiver_normal, &sender, depth);
+        return front_part(receiver, receiver_normal, &sender, quadrature);
     }
     let mut front = [DVec3::ZERO; MAX_CLIPPED];
     let count = clip_to_upper_hemisphere(origin, sender_normal, receiver, &mut front);
@@ -260,7 +281,7 @@ pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender
     let mut in_front = 0.0;
     for k in 1..count.saturating_sub(1) {
         let piece = [front[0], front[k], front[k + 1]];
-        let part = front_part(&piece, receiver_normal, &sender, depth);
+        let part = front_part(&piece, receiver_normal, &sender, quadrature);
         let piece_area = area(&piece);
         in_front += piece_area;
         result.mean += piece_area / whole * part.mean;
@@ -279,7 +300,7 @@ pub fn triangle_to_polygon(receiver: &[DVec3; 3], receiver_normal: DVec3, sender
 }
 
 /// [`triangle_to_polygon`] for a receiver wholly in front of the sender.
-fn front_part(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &OneSided, depth: u32) -> AreaFactor {
+fn front_part(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &OneSided, quadrature: Quadrature) -> AreaFactor {
     let centroid = |p: &[DVec3]| p.iter().copied().sum::<DVec3>() / p.len() as f64;
     let size = |p: &[DVec3], c: DVec3| p.iter().map(|v| v.distance(c)).fold(0.0, f64::max);
     let (cr, cs) = (centroid(receiver), centroid(sender.polygon));
@@ -288,11 +309,11 @@ fn front_part(receiver: &[DVec3; 3], receiver_normal: DVec3, sender: &OneSided, 
     if far {
         coarse
     } else {
-        adaptive(receiver, receiver_normal, sender, coarse, depth)
+        adaptive(receiver, receiver_normal, sender, coarse, quadrature.depth, quadrature.tolerance)
     }
 }
 
-fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &OneSided, coarse: AreaFactor, depth: u32) -> AreaFactor {
+fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &OneSided, coarse: AreaFactor, depth: u32, tolerance: f64) -> AreaFactor {
     if depth == 0 {
         return coarse;
     }
@@ -301,10 +322,10 @@ fn adaptive(receiver: &[DVec3; 3], normal: DVec3, sender: &OneSided, coarse: Are
     let children = [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]];
     let estimates = children.map(|child| rule(&child, normal, sender));
     let fine: f64 = estimates.iter().map(|e| e.mean).sum::<f64>() * 0.25;
-    let converged = (fine - coarse.mean).abs() <= QUADRATURE_TOLERANCE * fine.abs().max(1e-12);
+    let converged = (fine - coarse.mean).abs() <= tolerance * fine.abs().max(1e-12);
     let mut result = AreaFactor { mean: 0.0, min: coarse.min, max: coarse.max };
     for (child, estimate) in children.iter().zip(estimates) {
-        let part = if converged { estimate } else { adaptive(child, normal, sender, estimate, depth - 1) };
+        let part = if converged { estimate } else { adaptive(child, normal, sender, estimate, depth - 1, tolerance) };
         result.mean += 0.25 * part.mean;
         result.min = result.min.min(part.min);
         result.max = result.max.max(part.max);
@@ -390,7 +411,7 @@ mod tests {
         // A floor triangle straddling the plane gets only its front part,
         // integrated as such (depth 0: no adaptive help across the kink).
         let straddling = [dvec3(-0.1, 0.7, 0.0), dvec3(0.1, 0.7, 0.0), dvec3(0.0, 0.9, 0.0)];
-        let one = triangle_to_polygon(&straddling, DVec3::Z, &lamp, front, 0).mean;
+        let one = triangle_to_polygon(&straddling, DVec3::Z, &lamp, front, Quadrature::to_depth(0)).mean;
         let n = 400;
         let mut sum = 0.0;
         let mut count = 0;
@@ -431,6 +452,30 @@ mod tests {
         (w * (1.0 / w).atan() + h * (1.0 / h).atan() - s * (1.0 / s).atan() + 0.25 * log) / (PI * w)
     }
 
+    /// A looser tolerance stops the adaptive quadrature earlier, within
+    /// about that tolerance: Howell C-11, unit squares 0.05 apart (where the
+    /// fixed rule alone is several percent off), to tolerances 1e-2 down to
+    /// 1e-5.
+    #[test]
+    fn the_quadrature_tolerance_bounds_the_relative_error_of_near_pairs() {
+        let c = 0.05;
+        let floor = [dvec3(0.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(1.0, 1.0, 0.0), dvec3(0.0, 1.0, 0.0)];
+        let ceiling = floor.map(|p| p + DVec3::Z * c);
+        let halves = [[floor[0], floor[1], floor[2]], [floor[0], floor[2], floor[3]]];
+        let factor = |q: Quadrature| halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &ceiling, -DVec3::Z, q).mean).sum::<f64>();
+        let exact = test_support::closed_form::parallel_rectangles(1.0, 1.0, c);
+        let coarse = ((factor(Quadrature::to_depth(0)) - exact) / exact).abs();
+        assert!(coarse > 0.02, "the fixed rule alone is {coarse:.2e} off: the test does not exercise the tolerance");
+        let tolerances = [1e-2, 1e-3, 1e-4, 1e-5];
+        let errors = tolerances.map(|tolerance| ((factor(Quadrature { depth: 8, tolerance }) - exact) / exact).abs());
+        for (tolerance, error) in tolerances.iter().zip(errors) {
+            assert!(error <= *tolerance, "tolerance {tolerance:e}: {error:.2e} off Howell C-11");
+        }
+        assert!(errors.windows(2).all(|w| w[1] <= w[0]), "errors {errors:?} do not fall as the tolerance tightens");
+        // The loosest stopped early: 2.2e-4 against 1.1e-7 at the tightest.
+        assert!(errors[0] > 100.0 * errors[3], "errors {errors:?}: the tolerance did not stop the quadrature");
+    }
+
     #[test]
     fn adaptive_quadrature_resolves_the_shared_edge_singularity() {
         // Receiver: the floor rectangle [0, w] x [0, l] at z = 0, split into
@@ -439,7 +484,7 @@ mod tests {
         let floor = [dvec3(0.0, 0.0, 0.0), dvec3(w, 0.0, 0.0), dvec3(w, l, 0.0), dvec3(0.0, l, 0.0)];
         let wall = [dvec3(0.0, 0.0, 0.0), dvec3(0.0, l, 0.0), dvec3(0.0, l, h), dvec3(0.0, 0.0, h)];
         let halves = [[floor[0], floor[1], floor[2]], [floor[0], floor[2], floor[3]]];
-        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall, DVec3::X, 5).mean).sum();
+        let f: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall, DVec3::X, Quadrature::to_depth(5)).mean).sum();
         let exact = perpendicular_shared_edge(w, h, l);
         assert!(((f - exact) / exact).abs() < 1e-4, "{f} vs {exact}");
         let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &OneSided { polygon: &wall, front: DVec3::X }).mean).sum();

@@ -69,6 +69,7 @@ use links::{children_links, decide, link, self_link, Allowance, Floors, Link, Li
 pub use links::Criterion;
 use schemas::cluster::Clusters;
 use schemas::solution::Node;
+use radiometry::form_factor::Quadrature;
 use radiometry::photometry::DirectLight;
 use radiometry::rays::SceneRays;
 use rayon::prelude::*;
@@ -307,7 +308,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let total_area: f64 = (0..n).map(|t| h.elements[t].area).sum();
     let min_area = params.min_area * total_area;
     let floors = Floors { area: min_area, shadow: min_area * 0.25f64.powi(params.shadow_levels as i32) };
-    let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed, quadrature_depth: params.quadrature_depth };
+    let linking = Linking { cluster_samples: params.cluster_samples, seed: params.seed, quadrature: Quadrature::to_depth(params.quadrature_depth) };
     let mut scene = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
     if let Some(masks) = h.detail.as_ref().and_then(|d| d.alpha_masks(mesh)) {
         scene = scene.with_alpha_masks(masks);
@@ -382,6 +383,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
             Allowance::Relative { .. } => (links::leaf_deviation(&h, &b), links::dimmest_leaf(&h, &b)),
             Allowance::Absolute(_) => (Vec::new(), Vec::new()),
         };
+        let linking = Linking { quadrature: allowance.quadrature(rates, params.quadrature_depth), ..linking };
         let mut active = std::mem::take(&mut all_links);
         // How many links at the front of all_links keep the order the
         // previous pass sorted them in: those it kept first (sort_links).

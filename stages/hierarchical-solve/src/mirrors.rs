@@ -60,7 +60,7 @@ use crate::elements::Hierarchy;
 use crate::links::Allowance;
 use crate::rows::Rows;
 use glam::DVec3;
-use radiometry::form_factor::{point_kernel, triangle_to_polygon, AreaFactor};
+use radiometry::form_factor::{point_kernel, triangle_to_polygon, AreaFactor, Quadrature};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{stratified_point, Stream};
 use rayon::prelude::*;
@@ -461,7 +461,7 @@ impl Windows {
                 }
                 let Some(next) = image.through(w as u32, window, &re.points) else { continue };
                 let last = next.corners[next.corners.len() - 1];
-                let f = triangle_to_polygon(&re.points, nr, &last, next.normal, self.quadrature);
+                let f = triangle_to_polygon(&re.points, nr, &last, next.normal, Quadrature::to_depth(self.quadrature));
                 if past {
                     (0..3).for_each(|c| pair.truncated[c] += next.coefficient[c] * f.mean);
                     continue;
