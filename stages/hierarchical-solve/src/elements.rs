@@ -7,7 +7,8 @@ use crate::detail::Detail;
 use crate::cluster_tree::ClusterTree;
 use crate::transmission::Transmission;
 use glam::DVec3;
-use radiometry::form_factor::point_to_one_sided_polygon;
+use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon};
+use std::f64::consts::PI;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Manifest, Mesh};
@@ -24,6 +25,12 @@ pub fn exposed(exposure: f64) -> f64 {
         1.0
     }
 }
+
+/// Distance, in radii of an element, beyond which its weight among its
+/// siblings is the point kernel at its centroid
+/// ([`Hierarchy::weight_to_element`]): a disc facing a point at this
+/// distance has a factor within 1/64 (1.6%) of the point kernel's.
+pub const FAR_PART: f64 = 8.0;
 
 /// One element.
 #[derive(Clone, Debug)]
@@ -126,6 +133,30 @@ impl Hierarchy {
     /// coverage (an alpha-masked element sends through its opaque fraction).
     pub fn factor_to_element(&self, x: DVec3, n: DVec3, e: u32) -> f64 {
         point_to_one_sided_polygon(x, n, &self.elements[e as usize].points, self.normal(e)) * self.coverage(e)
+    }
+
+    /// [`Hierarchy::factor_to_element`] where it weighs an element against
+    /// its siblings (the parts of a sender or of a receiver, whose weights
+    /// are normalised to sum to 1): beyond [`FAR_PART`] times the element's
+    /// radius `r` from `x`, the point kernel at its centroid `c`,
+    ///
+    /// ```text
+    /// A_e G(x, c) / pi  x  coverage
+    /// ```
+    ///
+    /// which differs from Lambert's factor by a relative `O((r / d)²)`,
+    /// about alike for siblings at about the same distance. Lambert's
+    /// formula (an `atan2` per edge) was a third of the time the last solve
+    /// spent weighing senders' parts on the Cornell box.
+    pub fn weight_to_element(&self, x: DVec3, n: DVec3, e: u32) -> f64 {
+        let el = &self.elements[e as usize];
+        let c = (el.points[0] + el.points[1] + el.points[2]) / 3.0;
+        let radius2 = el.points.iter().map(|p| p.distance_squared(c)).fold(0.0, f64::max);
+        if c.distance_squared(x) > FAR_PART * FAR_PART * radius2 {
+            el.area * point_kernel(x, n, c, self.normal(e)) / PI * self.coverage(e)
+        } else {
+            self.factor_to_element(x, n, e)
+        }
     }
 
     /// Unit front normal of element `e` (its triangle's).

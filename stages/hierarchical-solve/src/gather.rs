@@ -532,7 +532,7 @@ impl SenderTerms {
         let (mut terms, mut rays) = (Vec::with_capacity(parts.len()), 0);
         for part in parts {
             let Node::Element(e) = part else { return whole };
-            let mut weight = h.factor_to_element(x, n, e);
+            let mut weight = h.weight_to_element(x, n, e);
             if partly_occluded {
                 let cast;
                 (weight, cast) = visibility::visible_factor(h, scene, r, e, weight, seed);

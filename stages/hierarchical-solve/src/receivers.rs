@@ -338,7 +338,7 @@ impl Part {
     /// Factor from point `x` (normal `n`) to the part.
     fn factor(&self, h: &Hierarchy, x: glam::DVec3, n: glam::DVec3) -> f64 {
         match self {
-            Part::Element(e) => h.factor_to_element(x, n, *e),
+            Part::Element(e) => h.weight_to_element(x, n, *e),
             Part::Points(area, points) => area * points.iter().map(|&(y, ny)| point_kernel(x, n, y, ny)).sum::<f64>() / (PI * points.len() as f64),
         }
     }
