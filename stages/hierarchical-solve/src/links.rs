@@ -174,7 +174,11 @@ impl Allowance {
     /// radiosity, and interreflection multiplies it by up to `1 / (1 - q)`:
     /// the receiver then errs by at most `QUADRATURE_SHARE eps` through its
     /// form factors, a sixteenth of the `eps` the criterion allows it.
-    /// The fixed tolerance alone (the floor) took the quadrature of nearly
+    /// (Where the absolute cap `most` binds, on receivers bright enough that
+    /// `eps` of what they get exceeds it, the criterion allows less; the
+    /// quadrature is not tightened for them: at coarse `EPS`, where `eps`
+    /// is near 1, their links' factors may err by a few percent, the same
+    /// order as the 7-point rule's own error on touching elements.) The fixed tolerance alone (the floor) took the quadrature of nearly
     /// every pair of near elements down to its deepest level: 37% of a
     /// solve's time on the Cornell box at `EPS` 2e-4 (one thread, perf).
     /// With this one (about 7e-3 there) the solve takes 0.79 of the time
