@@ -245,7 +245,7 @@ impl Quadrature {
 /// [`DUNAVANT_5`], with the spread of the point values (the refinement
 /// oracle's measure of how much the transport varies over the receiver).
 ///
-/// Where the two are close (nearer than [`near_distance`] times the sum of
+/// Where the two are close (nearer than `near_distance` times the sum of
 /// their radii: 3 at the default tolerance) the integrand varies fast, and near a shared edge it has a logarithmic
 /// singularity, so the rule is applied adaptively: a triangle whose estimate
 /// differs from the sum over its four midpoint children by more than
