@@ -70,7 +70,7 @@ pub struct Linking {
     /// Seed of their random streams.
     pub seed: u64,
     /// The adaptive receiver quadrature of the form factors between
-    /// elements ([`quadrature_tolerance`]).
+    /// elements ([`Allowance::quadrature`]).
     pub quadrature: Quadrature,
 }
 
