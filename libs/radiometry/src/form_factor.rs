@@ -246,11 +246,11 @@ impl Quadrature {
 /// oracle's measure of how much the transport varies over the receiver).
 ///
 /// Where the two are close (nearer than `near_distance` times the sum of
-/// their radii: 3 at the default tolerance) the integrand varies fast, and near a shared edge it has a logarithmic
-/// singularity, so the rule is applied adaptively: a triangle whose estimate
-/// differs from the sum over its four midpoint children by more than
-/// `quadrature.tolerance` (relative) is split, down to `quadrature.depth`
-/// levels. Each level
+/// their radii: 3 at the default tolerance) the integrand varies fast, and
+/// near a shared edge it has a logarithmic singularity, so the rule is
+/// applied adaptively: a triangle whose estimate differs from the sum over
+/// its four midpoint children by more than `quadrature.tolerance`
+/// (relative) is split, down to `quadrature.depth` levels. Each level
 /// roughly halves the error of a receiver touching the sender (the
 /// singular strip halves in width), at twice the cost.
 /// This matters for energy balance: in a closed room with reflectance rho,

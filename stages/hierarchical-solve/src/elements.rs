@@ -8,12 +8,12 @@ use crate::cluster_tree::ClusterTree;
 use crate::transmission::Transmission;
 use glam::DVec3;
 use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon};
-use std::f64::consts::PI;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::NONE;
 use schemas::surface::Surface;
+use std::f64::consts::PI;
 
 /// What the irradiance averaged over a node is divided by to give its
 /// exposed part's ([`crate::exposure`]): its exposure, or 1 where it is
