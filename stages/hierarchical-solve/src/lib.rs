@@ -99,7 +99,7 @@ stage_kit::knobs! {
         visibility_rays: usize = 16, "rays", value(1..=4096);
         /// Point pairs (and rays) per link with a cluster at an end.
         cluster_samples: usize = 16, "pairs", value(1..=4096);
-        /// Deepest split of the adaptive receiver quadrature near touching elements, and of the near-field quadrature of a luminaire's direct light over an element.
+        /// Deepest split of the adaptive receiver quadrature near touching elements (to a tolerance that follows the relative criterion's eps: a sixteenth of it, times 1 - q), and of the near-field quadrature of a luminaire's direct light over an element.
         quadrature_depth: u32 = 3, "levels", value(0..=8);
         /// Convergence: gathering stops when a bound of every leaf's remaining error is under this fraction of the largest radiosity.
         tolerance: f64 = 1e-5, "", value(positive());
