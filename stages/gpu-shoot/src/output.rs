@@ -413,11 +413,12 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile],
         for c in &pieces {
             let point = |l: [f64; 3]| [l[0] * c[0][0] + l[1] * c[1][0] + l[2] * c[2][0], l[0] * c[0][1] + l[1] * c[1][1] + l[2] * c[2][1]];
             for l in points {
-                if buried_at(lm, tile, point(l)) {
+                let uv = point(l);
+                if buried_at(lm, tile, uv) {
                     continue;
                 }
                 exposed += 1;
-                for (s, v) in sum.iter_mut().zip(bilinear(lm, tile, point(l))) {
+                for (s, v) in sum.iter_mut().zip(bilinear(lm, tile, uv)) {
                     *s += v;
                 }
             }

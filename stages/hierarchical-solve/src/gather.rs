@@ -372,6 +372,15 @@ pub const MAX_SENDER_PARTS: usize = 16;
 /// by at most this fraction.
 pub const UNIFORM_SENDER: f64 = 1e-3;
 
+/// `1 - q` in [0, 1], `q` a solve's rate of convergence: how much a
+/// one-signed error per link must shrink for the solution's to stay within
+/// it, as interreflection multiplies it by up to `1 / (1 - q)` (0 where
+/// `q` is 1 or more). Scales [`UNIFORM_SENDER`] and the form factors'
+/// quadrature tolerance ([`crate::links::Allowance::quadrature`]).
+pub fn damping(q: f64) -> f64 {
+    (1.0 - q).clamp(0.0, 1.0)
+}
+
 /// What radiosity a link's sender sends in a solve.
 #[derive(Clone, Copy)]
 pub enum Senders<'a> {
@@ -489,7 +498,7 @@ impl SenderTerms {
         let (parts, rays) = match senders {
             Senders::Means => (Rows::default(), 0),
             Senders::Resolved { radiosity, deviation, scene, seed, rates } => {
-                let uniform = rates.map(|q| UNIFORM_SENDER * (1.0 - q).clamp(0.0, 1.0));
+                let uniform = rates.map(|q| UNIFORM_SENDER * damping(q));
                 let (lists, rays): (Vec<_>, Vec<usize>) = links
                     .par_iter()
                     .map(|l| if Self::uniform(h, l, radiosity, deviation, uniform) { (Vec::new(), 0) } else { Self::of_link(h, l, scene, seed) })

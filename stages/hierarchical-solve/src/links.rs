@@ -186,14 +186,14 @@ impl Allowance {
     /// With this one (about 7e-3 there) the solve takes 0.79 of the time,
     /// and no triangle's mean radiosity moves by more than 0.13%; 0.53 of
     /// it with the pairs refined only as near as the tolerance needs
-    /// (radiometry's `triangle_to_polygon`). A closed
-    /// box at rho 0.999 keeps the floor: its relative `eps` is a few 1e-6
-    /// (its mean radiosity is a hundred times its lamp's emission).
+    /// (radiometry's `triangle_to_polygon`). A closed box at rho 0.999
+    /// keeps the floor: its relative `eps` is a few 1e-6 (its mean
+    /// radiosity is a hundred times its lamp's emission).
     pub fn quadrature(&self, q: [f64; 3], depth: u32) -> Quadrature {
         let q = q.into_iter().fold(0.0, f64::max);
         let tolerance = match *self {
-            Allowance::Relative { eps, .. } if (0.0..1.0).contains(&q) => (QUADRATURE_SHARE * eps * (1.0 - q)).max(QUADRATURE_TOLERANCE),
-            _ => QUADRATURE_TOLERANCE,
+            Allowance::Relative { eps, .. } => (QUADRATURE_SHARE * eps * crate::gather::damping(q)).max(QUADRATURE_TOLERANCE),
+            Allowance::Absolute(_) => QUADRATURE_TOLERANCE,
         };
         Quadrature { depth, tolerance }
     }
