@@ -92,8 +92,12 @@ fn a_coarse_clustered_solve_lights_every_face_by_its_own_orientation() {
     // Those EPS were 24 times the ones below, which have the same relative
     // threshold since hierarchical-solve's RELATIVE_AT went from 3 to 1/8
     // with the absolute threshold as a cap: 5.4% and 0.24% (surfaces 1.3%
-    // and 0.05%).
-    for (eps, face_tolerance, surface_tolerance) in [("4e-4", 0.07, 0.03), ("4e-5", 0.03, 0.016)] {
+    // and 0.05%); 5.2% at 4e-4 (the short block's face turned from the lamp,
+    // lit by the floor in its umbra, which links from the ceiling into the
+    // clusters holding floor and block lit as if the block hid none of it)
+    // until partly occluded cluster links were split by their shadow term:
+    // 1.74% (surfaces 0.65%).
+    for (eps, face_tolerance, surface_tolerance) in [("4e-4", 0.03, 0.03), ("4e-5", 0.03, 0.016)] {
         let clustered = solve_prepared(&dir, &["--eps", eps], Some(8));
         let (face, surface) = worst(&format!("EPS {eps}"), &face_means(&dir, &clustered), &expected);
         assert!(face < face_tolerance, "EPS {eps}: a face's mean radiosity {:.1}% off the unclustered solve", 100.0 * face);
