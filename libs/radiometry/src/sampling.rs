@@ -43,18 +43,34 @@ pub fn square_to_triangle(u: f64, v: f64) -> [f64; 3] {
     [b0, b1, 1.0 - b0 - b1]
 }
 
-/// The `k`-th of `n` jittered stratified samples on a triangle (strata are
-/// an `m x m` grid of the unit square, `m = ceil(sqrt(n))`, visited in a
-/// fixed order), as a world-space point.
+/// The `k`-th of `n` jittered stratified samples on a triangle, as a
+/// world-space point: the strata are a `columns x rows` grid of the unit
+/// square ([`strata`]), `n` cells of equal area each visited once by `k` in
+/// `0..n`, mapped to the triangle by [`square_to_triangle`].
 pub fn stratified_point(corners: &[DVec3; 3], k: usize, n: usize, stream: &mut Stream) -> DVec3 {
-    let m = (n as f64).sqrt().ceil().max(1.0) as usize;
-    let (i, j) = (k % m, (k / m) % m);
+    let (columns, rows) = strata(n);
+    let (i, j) = (k % columns, (k / columns) % rows);
     // Keep the jitter off the stratum border so points stay strictly inside.
     let jitter = |s: &mut Stream| 0.001 + 0.998 * s.next_f64();
-    let u = (i as f64 + jitter(stream)) / m as f64;
-    let v = (j as f64 + jitter(stream)) / m as f64;
+    let u = (i as f64 + jitter(stream)) / columns as f64;
+    let v = (j as f64 + jitter(stream)) / rows as f64;
     let b = square_to_triangle(u, v);
     corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2]
+}
+
+/// The `(columns, rows)` of `n` strata over the unit square: `rows` the
+/// largest divisor of `n` not over `sqrt(n)`, so that `columns x rows = n`
+/// exactly (`m x m` where `n = m^2`). An `m x m` grid with `m =
+/// ceil(sqrt(n))` and `n` not a square leaves cells unvisited: 8 samples
+/// covered 8 of 9 cells, one corner of the square never, and a visible
+/// fraction estimated from them over-weighted the rest of the element:
+/// with a ray count per link that was not always a square, the leaves
+/// straddling a solid's footprint read 10.9% dark on average (1.9% with
+/// these strata, as with 16 rays on every link).
+pub fn strata(n: usize) -> (usize, usize) {
+    let n = n.max(1);
+    let rows = (1..=n).take_while(|r| r * r <= n).filter(|r| n % r == 0).last().unwrap_or(1);
+    (n / rows, rows)
 }
 
 /// Radical inverse of `k` in base `b` (van der Corput): the digits of `k`
@@ -91,6 +107,35 @@ pub fn sobol_02(k: u32, shift: [u32; 2]) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every count of strata tiles the unit square with `n` cells, each
+    /// visited once by `k` in `0..n`; squares keep their `m x m` grid.
+    /// Over many streams, 8 points on a triangle average to its centroid
+    /// (a 3 x 3 grid with one cell never visited put the mean 0.058 off it,
+    /// on a triangle of unit legs).
+    #[test]
+    fn strata_tile_the_square_and_sample_the_triangle_evenly() {
+        for n in 1..=300 {
+            let (columns, rows) = strata(n);
+            assert_eq!(columns * rows, n, "n = {n}");
+            assert!(rows <= columns, "n = {n}");
+            let cells: std::collections::HashSet<(usize, usize)> = (0..n).map(|k| (k % columns, (k / columns) % rows)).collect();
+            assert_eq!(cells.len(), n, "n = {n}: every cell once");
+        }
+        assert_eq!(strata(16), (4, 4));
+        assert_eq!(strata(256), (16, 16));
+        assert_eq!(strata(8), (4, 2));
+        let corners = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let (mut sum, runs) = (DVec3::ZERO, 4000);
+        for run in 0..runs {
+            let mut stream = Stream::new(7, run, 0);
+            for k in 0..8 {
+                sum += stratified_point(&corners, k, 8, &mut stream);
+            }
+        }
+        let mean = sum / (8 * runs) as f64;
+        assert!((mean - DVec3::new(1.0 / 3.0, 1.0 / 3.0, 0.0)).length() < 3e-3, "mean {mean}");
+    }
 
     #[test]
     fn stream_is_uniform_and_reproducible() {
