@@ -69,7 +69,7 @@ pub fn stratified_point(corners: &[DVec3; 3], k: usize, n: usize, stream: &mut S
 /// these strata, as with 16 rays on every link).
 pub fn strata(n: usize) -> (usize, usize) {
     let n = n.max(1);
-    let rows = (1..=n).take_while(|r| r * r <= n).filter(|&r| n.is_multiple_of(r)).last().unwrap_or(1);
+    let rows = (1..=n.isqrt()).rev().find(|&r| n.is_multiple_of(r)).unwrap_or(1);
     (n / rows, rows)
 }
 

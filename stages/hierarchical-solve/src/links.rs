@@ -43,6 +43,26 @@ impl Link {
     pub fn partly_occluded(&self) -> bool {
         self.visibility.is_some_and(|v| v > 0.0 && v < 1.0)
     }
+
+    /// Its visible fraction, 1 until rays were cast.
+    fn visible(&self) -> f64 {
+        f64::from(self.visibility.unwrap_or(1.0))
+    }
+
+    /// The oracle's shadow term, `2 min(V, 1 - V) rho_r B_s F_rs`, with
+    /// `reflected` = `rho_r B_s`: what a shadow edge across the link may
+    /// misplace on its receiver ([`decide`]).
+    fn shadow_error(&self, reflected: f64) -> f64 {
+        let v = self.visible();
+        2.0 * v.min(1.0 - v) * reflected * self.form_factor
+    }
+
+    /// Its share of `allowance` ([`Allowance::for_link`]) with its receiver's
+    /// radiosity and what it brings, `rho_r V F_rs B_s` (`reflected` =
+    /// `rho_r B_s`), both scaled by `dim` ([`dimming`]).
+    fn share(&self, allowance: &Allowance, receiver: [f64; 3], reflected: f64, dim: f64) -> f64 {
+        allowance.for_link(receiver.map(|x| dim * x), dim * reflected * self.visible() * self.form_factor)
+    }
 }
 
 /// What to do with a link.
@@ -462,12 +482,10 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[
                 .flat_map(|&child| (0..3).map(move |c| (child, c)))
                 .map(|(child, c)| rho[c] * (radiosity[h.flat(child)][c] - b[c]).abs())
                 .fold(0.0, f64::max);
-            let v = f64::from(link.visibility.unwrap_or(1.0));
-            let shadow = 2.0 * v.min(1.0 - v) * reflected * link.form_factor;
-            let shared = allowance.for_link(radiosity[h.flat(r)].map(|x| dim * x), dim * reflected * v * link.form_factor);
+            let shadow_over_share = link.shadow_error(reflected) > link.share(allowance, radiosity[h.flat(r)], reflected, dim);
             let wanted = if sender_variation * link.form_factor > threshold && sender_variation * link.form_factor >= reflected * bound {
                 Split::Sender
-            } else if reflected * bound > threshold || shadow > shared {
+            } else if reflected * bound > threshold || shadow_over_share {
                 Split::Larger
             } else {
                 Split::Keep
@@ -529,13 +547,11 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation
             .map(|(child, c)| rho[c] * (radiosity[h.flat(Node::Element(child))][c] - b[c]).abs())
             .fold(0.0, f64::max)
     };
-    let v = f64::from(link.visibility.unwrap_or(1.0));
-    let b_r = radiosity[h.flat(link.receiver)];
-    let threshold = allowance.for_link(b_r.map(|x| dim * x), dim * reflected * v * link.form_factor);
+    let threshold = link.share(allowance, radiosity[h.flat(link.receiver)], reflected, dim);
     let errors = [
         (reflected * link.spread, Split::Receiver),
         (sender_variation * link.form_factor, Split::Sender),
-        (2.0 * v.min(1.0 - v) * reflected * link.form_factor, Split::Larger),
+        (link.shadow_error(reflected), Split::Larger),
     ];
     let mut over: Vec<(f64, Split)> = errors.into_iter().filter(|e| e.0 > threshold).collect();
     over.sort_by(|a, b| b.0.total_cmp(&a.0));
