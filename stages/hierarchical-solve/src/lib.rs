@@ -95,7 +95,7 @@ stage_kit::knobs! {
         min_area: f64 = 1e-4, "", value(left_open(0.0, 1.0));
         /// How many 1:4 levels below `min_area` a shadow edge across a link between elements may split.
         shadow_levels: u32 = 2, "levels", value(0..=8);
-        /// Visibility rays per link between two elements.
+        /// Least visibility rays per link between two elements; up to 16 times as many where the noise of its visible fraction would exceed half its share of the allowance.
         visibility_rays: usize = 16, "rays", value(1..=4096);
         /// Point pairs (and rays) per link with a cluster at an end.
         cluster_samples: usize = 16, "pairs", value(1..=4096);
@@ -444,7 +444,10 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let rays: usize = all_links
             .par_iter_mut()
             .filter(|l| l.visibility.is_none())
-            .map(|l| visibility::settle(&h, &scene, &occluders, l, params.visibility_rays, linking))
+            .map(|l| {
+                let rays = links::visibility_rays(&h, l, &b, &dimmest, &allowance, params.visibility_rays);
+                visibility::settle(&h, &scene, &occluders, l, rays, linking)
+            })
             .sum();
         work.rays += rays as u64;
         work.visibility_seconds += started.elapsed().as_secs_f64();
