@@ -31,6 +31,19 @@ impl Stream {
         self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
         (mix64(self.state) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
+
+    /// A uniformly random permutation of `0..n` (Fisher-Yates), `n - 1`
+    /// numbers of the stream: pairs the `k`-th stratum of one end of a link
+    /// with a shuffled stratum of the other (Latin hypercube), so that the
+    /// pairs sample the product of the two ends and not its diagonal.
+    pub fn permutation(&mut self, n: usize) -> Vec<usize> {
+        let mut order: Vec<usize> = (0..n).collect();
+        for i in (1..n).rev() {
+            let j = (self.next_f64() * (i + 1) as f64) as usize;
+            order.swap(i, j.min(i));
+        }
+        order
+    }
 }
 
 /// Maps the unit square to barycentric coordinates on a triangle, uniformly

@@ -490,11 +490,7 @@ impl Windows {
         let path_key = image.path.iter().fold(u64::from(s), |key, &w| key.wrapping_mul(1_000_003).wrapping_add(u64::from(w) + 1));
         let mut stream = Stream::new(self.seed ^ 0x4d49_5252_4f52, r.into(), path_key);
         // Receiver stratum k with a shuffled sender stratum, as the links' rays.
-        let mut order: Vec<usize> = (0..self.rays).collect();
-        for i in (1..self.rays).rev() {
-            let j = (stream.next_f64() * (i + 1) as f64) as usize;
-            order.swap(i, j.min(i));
-        }
+        let order = stream.permutation(self.rays);
         let last = image.corners[image.corners.len() - 1];
         let (mut clear, mut total, mut cast) = (0.0, 0.0, 0u64);
         'pairs: for (k, &k_sender) in order.iter().enumerate() {

@@ -133,11 +133,7 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
     let mut stream = Stream::new(seed, receiver.into(), sender.into());
     // Pair receiver stratum k with a shuffled sender stratum, so that ray
     // directions are not correlated with position on the receiver.
-    let mut order: Vec<usize> = (0..rays).collect();
-    for i in (1..rays).rev() {
-        let j = (stream.next_f64() * (i + 1) as f64) as usize;
-        order.swap(i, j.min(i));
-    }
+    let order = stream.permutation(rays);
     let mut visible = WeightedVisibility::default();
     let mut nearest = f64::INFINITY;
     let mut cast = 0;
