@@ -3,7 +3,6 @@
 //! elements' [`crate::elements::Hierarchy`] holds one, and the link
 //! hierarchy's nodes ([`crate::nodes`]) read it.
 
-use radiometry::sampling::Stream;
 use schemas::cluster::Clusters;
 
 /// The cluster hierarchy as the solver uses it: the artifact's nodes with
@@ -69,15 +68,19 @@ impl ClusterTree {
         self.clusters.nodes.is_empty()
     }
 
-    /// An input triangle below cluster `c`, drawn with probability
-    /// proportional to its area.
-    pub fn sample_triangle(&self, c: u32, stream: &mut Stream) -> u32 {
+    /// The input triangle below cluster `c` at `u` in [0, 1) of the
+    /// cluster's area, its triangles laid end to end in the tree's order
+    /// (so a uniform `u` draws each with probability proportional to its
+    /// area), and where `u` falls along it, in [0, 1).
+    pub fn triangle_at(&self, c: u32, u: f64) -> (u32, f64) {
         let node = &self.clusters.nodes[c as usize];
         let range = node.triangle_range();
         let (first, last) = (range.start, range.end);
         let (lo, hi) = (self.cumulative[first], self.cumulative[last]);
-        let target = lo + stream.next_f64() * (hi - lo);
+        let target = lo + u * (hi - lo);
         let k = self.cumulative[first + 1..last].partition_point(|&x| x <= target);
-        self.clusters.order[first + k]
+        let (start, end) = (self.cumulative[first + k], self.cumulative[first + k + 1]);
+        let along = if end > start { ((target - start) / (end - start)).clamp(0.0, 1.0 - f64::EPSILON) } else { 0.0 };
+        (self.clusters.order[first + k], along)
     }
 }

@@ -168,8 +168,18 @@ impl Hierarchy {
         }
     }
 
-    /// The `k`-th of `n` random points on a node: stratified on an element,
-    /// area-weighted over the triangles of a cluster.
+    /// The `k`-th of `n` random points on a node, uniform by area: on an
+    /// element stratified over its triangle ([`stratified_point`]); on a
+    /// cluster in the `k`-th of `n` equal shares of its area, its triangles
+    /// laid end to end in the tree's order ([`ClusterTree::triangle_at`]),
+    /// which keeps nearby triangles together, and jittered across.
+    ///
+    /// Stratified, the `n` points of a cluster visit each part of it in
+    /// proportion to its area. Drawn independently, 16 points over the
+    /// cluster that holds the Cornell box's floor and short block left the
+    /// form factors of the links into it between 0.25 and 1.95 times their
+    /// converged values over seeds 1-8 (the kernel is heavy-tailed over a
+    /// cluster: a block face near the sender, the floor far).
     pub fn sample(&self, node: Node, k: usize, n: usize, stream: &mut Stream) -> SurfacePoint {
         match node {
             Node::Element(e) => {
@@ -181,9 +191,9 @@ impl Hierarchy {
                 }
             }
             Node::Cluster(c) => {
-                let t = self.tree().sample_triangle(c, stream);
+                let (t, along) = self.tree().triangle_at(c, (k as f64 + stream.next_f64()) / n as f64);
                 let g = &self.triangles[t as usize];
-                let b = square_to_triangle(stream.next_f64(), stream.next_f64());
+                let b = square_to_triangle(along, stream.next_f64());
                 SurfacePoint { point: g.corners[0] * b[0] + g.corners[1] * b[1] + g.corners[2] * b[2], normal: g.normal, triangle: t }
             }
         }
@@ -195,5 +205,43 @@ pub fn key(node: Node) -> u64 {
     match node {
         Node::Element(e) => u64::from(e) << 1,
         Node::Cluster(c) => (u64::from(c) << 1) | 1,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::dvec3;
+    use test_support::meshes::{manifest, material, quads};
+
+    /// A 1 x 1 quad (triangles 0, 1 of 0.5 m²) and a 2 x 1 quad beside it
+    /// (triangles 2, 3 of 1 m²) in one cluster: `n` stratified points give
+    /// each triangle exactly `n` times its share of the area, and lie on
+    /// the triangle they name.
+    #[test]
+    fn a_clusters_points_visit_its_triangles_in_proportion_to_their_area() {
+        let mesh = quads(&[
+            (dvec3(0.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0), 0, 0),
+            (dvec3(1.0, 0.0, 0.0), dvec3(2.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0), 0, 0),
+        ]);
+        let h = Hierarchy::new(&mesh, &manifest(1, vec![material([0.5; 3], [0.0; 3])]), Some(test_support::artifacts::clusters_over(&mesh)), None);
+        for (n, want) in [(6, [1, 1, 2, 2]), (12, [2, 2, 4, 4])] {
+            for seed in 0..20 {
+                let mut stream = Stream::new(seed, 0, 0);
+                let mut count = [0; 4];
+                for k in 0..n {
+                    let p = h.sample(Node::Cluster(0), k, n, &mut stream);
+                    count[p.triangle as usize] += 1;
+                    let x0 = if p.triangle < 2 { 0.0 } else { 1.0 };
+                    let width = if p.triangle < 2 { 1.0 } else { 2.0 };
+                    let (u, v) = ((p.point.x - x0) / width, p.point.y);
+                    // Triangle 2t is below the quad's diagonal, 2t + 1 above.
+                    let below = u >= v;
+                    assert!(p.point.z == 0.0 && (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v), "{p:?}");
+                    assert_eq!(below, p.triangle % 2 == 0, "{p:?} is on triangle {}", p.triangle);
+                }
+                assert_eq!(count, want, "n = {n}, seed {seed}");
+            }
+        }
     }
 }
