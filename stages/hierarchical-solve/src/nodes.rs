@@ -238,7 +238,7 @@ mod tests {
                     // Triangle 2t is below the quad's diagonal, 2t + 1 above.
                     let below = u >= v;
                     assert!(p.point.z == 0.0 && (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v), "{p:?}");
-                    assert_eq!(below, p.triangle % 2 == 0, "{p:?} is on triangle {}", p.triangle);
+                    assert_eq!(below, p.triangle.is_multiple_of(2), "{p:?} is on triangle {}", p.triangle);
                 }
                 assert_eq!(count, want, "n = {n}, seed {seed}");
             }
