@@ -473,7 +473,7 @@ pub fn decide(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation: &[[
             let threshold = allowance.at(radiosity[h.flat(r)].map(|x| dim * x));
             let rho = h.node_reflectance(r);
             let b = radiosity[h.flat(s)];
-            let reflected = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);
+            let reflected = brightest_reflected(rho, b);
             let distance = box_distance(h.bounds(r), h.bounds(s));
             let bound = if distance > 0.0 { h.area(s) / (PI * distance * distance) } else { f64::INFINITY };
             let sender_variation = h
@@ -535,7 +535,7 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], deviation
     };
     let rho = h.reflectance_of(receiver);
     let b = radiosity[h.flat(link.sender)];
-    let reflected = (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);
+    let reflected = brightest_reflected(rho, b);
     let sender_element = &h.elements[sender as usize];
     let sender_variation = if sender_element.is_leaf() {
         0.0
@@ -575,7 +575,8 @@ pub const MOST_RAYS_FACTOR: usize = 16;
 /// n = (T / a)^2        gives        T / (2 sqrt n) <= a / 2,
 /// ```
 ///
-/// `a` the share with `V = 1`. A fixed count gave every link the same
+/// `a` its share with `V = 1` (`Link::share`: its rays are not cast
+/// yet). A fixed count gave every link the same
 /// noise whatever it carried: on the built-in Cornell box the preview's
 /// error below 1% relative RMSE was mostly the visibility noise of a few
 /// large, partly occluded links (a surface lit through about 200 links
@@ -590,13 +591,20 @@ pub fn visibility_rays(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], dimme
     let dim = dimming(h, r, radiosity, dimmest);
     let rho = h.node_reflectance(r);
     let b = radiosity[h.flat(link.sender)];
-    let transport = dim * link.form_factor * (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max);
-    let allowed = allowance.for_link(radiosity[h.flat(r)].map(|x| dim * x), transport);
+    let reflected = brightest_reflected(rho, b);
+    let transport = dim * reflected * link.form_factor;
+    let allowed = link.share(allowance, radiosity[h.flat(r)], reflected, dim);
     if allowed.is_nan() || allowed <= 0.0 {
         return least;
     }
     let wanted = (transport / allowed).powi(2).ceil();
     (wanted.min((MOST_RAYS_FACTOR * least) as f64) as usize).max(least)
+}
+
+/// `rho_r B_s` in its brightest channel: what a link's error terms and
+/// its share of the allowance are made of ([`decide`], [`visibility_rays`]).
+fn brightest_reflected(rho: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|c| rho[c] * b[c]).fold(0.0, f64::max)
 }
 
 /// How much dimmer than node `r` the dimmest exposed leaf below it is, in
