@@ -60,6 +60,8 @@ pub mod receivers;
 pub mod report;
 pub mod rows;
 pub mod shaft;
+#[cfg(test)]
+mod test_scenes;
 pub mod transfer;
 pub mod transmission;
 pub mod visibility;
@@ -471,13 +473,13 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // and partly occluded links into clusters weighing each face by
         // its visibility (receivers).
         senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
-        let mut receivers = receivers::ReceiverTerms::new(&h, &all_links, None, &mut receiver_weights);
+        let mut receivers = receivers::ReceiverTerms::new(&h, &mut all_links, None, &mut receiver_weights);
         let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders, &receivers);
         let left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
             senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &scene, seed: params.seed, rates: convergence.rates });
-            receivers = receivers::ReceiverTerms::new(&h, &all_links, Some((&scene, params.seed)), &mut receiver_weights);
+            receivers = receivers::ReceiverTerms::new(&h, &mut all_links, Some((&scene, params.seed)), &mut receiver_weights);
             work.part_rays = (senders.rays() + receivers.rays) as u64;
             work.resolved_links = senders.resolved();
             let means = convergence;

@@ -23,7 +23,8 @@ pub struct Link {
     /// Unoccluded form factor F_rs: between elements, the receiver-area
     /// mean of Lambert's point-to-polygon factor to the sender (002 Eq. 3);
     /// with a cluster at either end, the Monte Carlo estimate of
-    /// [`transfer`].
+    /// [`transfer`], which a link into a cluster of few triangles then
+    /// replaces by their own measure in every solve ([`crate::receivers`]).
     pub form_factor: f64,
     /// Largest minus smallest point factor over the receiver's quadrature
     /// points: how much the transport varies over the receiver.

@@ -101,10 +101,7 @@ pub fn estimate(h: &Hierarchy, scene: Option<&SceneRays>, receiver: Node, sender
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{dvec3, DVec3};
-    use radiometry::form_factor::point_to_one_sided_polygon;
-    use schemas::solution::NONE;
-    use test_support::meshes::{manifest, material, quads};
+    use crate::test_scenes::FloorAndWall;
 
     /// A cluster of a unit floor and a unit wall standing on its edge
     /// (triangles 0-3) under a lamp triangle (4) whose edge the wall's top
@@ -116,34 +113,11 @@ mod tests {
     /// factor (independent points, as before: 10.1%).
     #[test]
     fn a_clusters_form_factor_is_unbiased_and_its_strata_cut_the_noise() {
-        let mesh = quads(&[
-            (dvec3(0.0, 0.0, 0.0), DVec3::X, DVec3::Y, 0, 0),
-            (dvec3(1.0, 0.0, 0.0), DVec3::Z, DVec3::Y, 0, 0),
-            (dvec3(0.0, 0.0, 1.0), DVec3::Y, DVec3::X, 1, 1),
-        ]);
-        let mut clusters = test_support::artifacts::clusters_over(&mesh);
-        clusters.nodes.truncate(3);
-        for (c, first, count) in [(1, 0, 4), (2, 4, 2)] {
-            let node = &mut clusters.nodes[c];
-            (node.first_triangle, node.triangle_count, node.first_child, node.child_count) = (first, count, NONE, 0);
-        }
-        let manifest = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [1.0; 3])]);
-        let h = Hierarchy::new(&mesh, &manifest, Some(clusters), None);
-        let lamp = [dvec3(0.0, 0.0, 1.0), dvec3(0.0, 1.0, 1.0), dvec3(1.0, 1.0, 1.0)];
-        let m = 400;
-        let grid = |origin: DVec3, u: DVec3, v: DVec3, normal: DVec3| {
-            let mut sum = 0.0;
-            for i in 0..m {
-                for j in 0..m {
-                    let p = origin + u * ((i as f64 + 0.5) / m as f64) + v * ((j as f64 + 0.5) / m as f64);
-                    sum += point_to_one_sided_polygon(p, normal, &lamp, -DVec3::Z);
-                }
-            }
-            sum / (m * m) as f64
-        };
-        let reference = (grid(DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z) + grid(DVec3::X, DVec3::Z, DVec3::Y, -DVec3::X)) / 2.0;
+        let scene = FloorAndWall::new(1.0);
+        let quads = scene.quad_factors(400);
+        let (h, reference) = (&scene.h, (quads[0] + quads[1]) / 2.0);
         let seeds = 400;
-        let f: Vec<f64> = (0..seeds).map(|seed| estimate(&h, None, Node::Cluster(1), Node::Element(4), 16, seed).form_factor).collect();
+        let f: Vec<f64> = (0..seeds).map(|seed| estimate(h, None, Node::Cluster(1), Node::Element(4), 16, seed).form_factor).collect();
         let mean = f.iter().sum::<f64>() / seeds as f64;
         let std = (f.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (seeds - 1) as f64).sqrt();
         assert!((mean / reference - 1.0).abs() < 0.01, "mean {mean} against {reference}");
