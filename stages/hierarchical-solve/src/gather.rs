@@ -31,7 +31,7 @@
 use crate::elements::{exposed, Hierarchy};
 use crate::links::Link;
 use crate::mirrors::Couplings;
-use crate::receivers::ReceiverTerms;
+use crate::receivers::{PartSource, ReceiverTerms};
 use crate::rows::Rows;
 use crate::visibility;
 use radiometry::rays::SceneRays;
@@ -274,8 +274,16 @@ pub fn solve(
         Convergence { iterations: 0, relative_change: f64::INFINITY, error_bound: f64::INFINITY, contraction: f64::NAN, converged: false, extrapolations: 0, rates: [0.0; 3] };
     let mut rate = Rate::new(prior_rate);
     while convergence.iterations < max_iterations {
-        // What each link into an inner element sends, once for its parts.
-        let sent_to_parts: Vec<[f64; 3]> = receivers.part_links.par_iter().map(|&l| senders.radiosity(l, b)).collect();
+        // What lights the parts of inner elements, once for all of them
+        // (crate::receivers::PartSource).
+        let sent_to_parts: Vec<[f64; 3]> = receivers
+            .part_sources
+            .par_iter()
+            .map(|source| match source {
+                PartSource::Link(l) => senders.radiosity(*l, b),
+                PartSource::Triangle { terms, .. } => PartSource::on_triangle(terms, b),
+            })
+            .collect();
         let gathered: Vec<[f64; 3]> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -297,7 +305,7 @@ pub fn solve(
                     }
                 }
                 for (k, &w) in i.checked_sub(clusters).into_iter().flat_map(|e| receivers.of_element(e)) {
-                    let l = receivers.part_links[k];
+                    let l = receivers.part_sources[k].link();
                     for c in 0..3 {
                         g[c] += w * coupling[l] * sent_to_parts[k][c];
                     }
@@ -697,7 +705,7 @@ fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: 
     let mut norm = [0.0f64; 3];
     for i in 0..n {
         let links: f64 = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| coupling[l]).sum();
-        let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum::<f64>() + receivers.of_element(t).map(|(k, &w)| w * coupling[receivers.part_links[k]]).sum::<f64>());
+        let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum::<f64>() + receivers.of_element(t).map(|(k, &w)| w * coupling[receivers.part_sources[k].link()] * receivers.part_sources[k].weight()).sum::<f64>());
         let own = (links + distributed + specular.map_or(0.0, |s| s.row_sum(i))) / exposed(topology.exposure[i]);
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {

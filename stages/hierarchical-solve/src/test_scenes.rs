@@ -52,4 +52,22 @@ impl FloorAndWall {
         };
         [grid(DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z), grid(DVec3::X, DVec3::Z, DVec3::Y, -DVec3::X)]
     }
+
+    /// The mean over triangle `corners` (normal `normal`) of Lambert's
+    /// factor to the lamp triangle: the centroids of the `m^2` triangles of
+    /// its regular subdivision.
+    pub fn triangle_factor(&self, corners: &[DVec3; 3], normal: DVec3, m: usize) -> f64 {
+        let point = |u: f64, v: f64| corners[0] + (corners[1] - corners[0]) * (u / m as f64) + (corners[2] - corners[0]) * (v / m as f64);
+        let factor = |p: DVec3| point_to_one_sided_polygon(p, normal, &self.lamp, -DVec3::Z);
+        let mut sum = 0.0;
+        for i in 0..m {
+            for j in 0..m - i {
+                sum += factor(point(i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0));
+                if i + j + 1 < m {
+                    sum += factor(point(i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0));
+                }
+            }
+        }
+        sum / (m * m) as f64
+    }
 }
