@@ -281,7 +281,7 @@ pub fn solve(
             .par_iter()
             .map(|source| match source {
                 PartSource::Link(l) => senders.radiosity(*l, b),
-                PartSource::Triangle { terms, .. } => PartSource::on_triangle(terms, b),
+                PartSource::Triangle { terms, .. } => weighted(terms.iter().copied(), b),
             })
             .collect();
         let gathered: Vec<[f64; 3]> = (0..n)
@@ -578,14 +578,21 @@ impl SenderTerms {
         if parts.peek().is_none() {
             return b[self.senders[l]];
         }
-        let mut sent = [0.0; 3];
-        for (node, &w) in parts {
-            for c in 0..3 {
-                sent[c] += w * b[node][c];
-            }
-        }
-        sent
+        weighted(parts.map(|(node, &w)| (node, w)), b)
     }
+}
+
+/// `sum_j w_j B_j` over `terms` `(j, w_j)`, `j` a dense node index into
+/// `b`: what a sender's parts send ([`SenderTerms`]), and what they send a
+/// cluster's triangle ([`PartSource::Triangle`]).
+fn weighted(terms: impl Iterator<Item = (usize, f64)>, b: &[[f64; 3]]) -> [f64; 3] {
+    let mut sent = [0.0; 3];
+    for (node, w) in terms {
+        for c in 0..3 {
+            sent[c] += w * b[node][c];
+        }
+    }
+    sent
 }
 
 

@@ -188,18 +188,6 @@ impl PartSource {
             PartSource::Triangle { terms, .. } => terms.iter().map(|t| t.1).sum(),
         }
     }
-
-    /// The radiosity it sends with radiosity `b` on a triangle (a link's
-    /// is its sender terms', which the caller has).
-    pub fn on_triangle(terms: &[(usize, f64)], b: &[[f64; 3]]) -> [f64; 3] {
-        let mut sent = [0.0; 3];
-        for &(p, w) in terms {
-            for c in 0..3 {
-                sent[c] += w * b[p][c];
-            }
-        }
-        sent
-    }
 }
 
 impl ReceiverTerms {
@@ -215,7 +203,7 @@ impl ReceiverTerms {
     pub fn new(h: &Hierarchy, links: &mut [Link], visibility: Option<(&SceneRays, u64)>, cache: &mut WeightCache) -> Self {
         let to_parts: Vec<bool> = links.iter().map(|l| visibility.is_some() && matches!(l.receiver, Node::Element(e) if !h.elements[e as usize].is_leaf())).collect();
         let part_built: Vec<Option<(PartWeights, usize)>> =
-            links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l, visibility.filter(|_| l.partly_occluded())))).collect();
+            links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l.receiver, l.sender, visibility.filter(|_| l.partly_occluded())))).collect();
         let mut by_element: Vec<Vec<(usize, f64)>> = vec![Vec::new(); h.elements.len()];
         let mut part_sources = Vec::new();
         for (l, (list, _)) in part_built.iter().enumerate().filter_map(|(l, b)| Some((l, b.as_ref()?))) {
@@ -255,7 +243,7 @@ impl ReceiverTerms {
                     triangles
                         .into_iter()
                         .map(|t| {
-                            let (w, rays) = part_weights(h, &Link { receiver: Node::Element(t), ..*l }, visibility.filter(|_| l.partly_occluded()));
+                            let (w, rays) = part_weights(h, Node::Element(t), l.sender, visibility.filter(|_| l.partly_occluded()));
                             (t, w, rays)
                         })
                         .collect()
@@ -302,8 +290,8 @@ impl ReceiverTerms {
         self.rows.row(t)
     }
 
-    /// The links into inner elements above element `e` of which `e` is a
-    /// part, each as its place `k` in [`Self::part_links`] with its weight
+    /// What lights element `e` as a part of an inner element above it,
+    /// each as its place `k` in [`Self::part_sources`] with its weight
     /// `w_j`.
     pub fn of_element(&self, e: usize) -> impl Iterator<Item = (usize, &f64)> {
         self.element_rows.row(e)
@@ -333,27 +321,28 @@ fn seen_factor(h: &Hierarchy, visibility: Option<(&SceneRays, u64)>, receiver: u
 /// `(j, w_j)`: part (element index), weight.
 type PartWeights = Vec<(u32, f64)>;
 
-/// `(j, w_j)` for the parts `j` of link `l`'s inner element receiver `r`,
-/// `w_j = A_r F_js / sum_u A_u F_us` with `F_js` the factor from part `j`'s
-/// centroid to the sender (times their visibility, with `visibility`,
-/// given where the link is partly occluded and its sender is an element),
-/// and the rays cast. Where no part sees the sender, every part gets the
-/// same (`w_j = 1`).
-fn part_weights(h: &Hierarchy, l: &Link, visibility: Option<(&SceneRays, u64)>) -> (PartWeights, usize) {
-    let Node::Element(r) = l.receiver else { return (Vec::new(), 0) };
-    let nodes = h.parts(l.receiver, MAX_RECEIVER_PARTS);
+/// `(j, w_j)` for the parts `j` of an inner element `receiver` lit by
+/// `sender` (a link's ends, or a cluster link's sender and one of the
+/// cluster's triangles), `w_j = A_r F_js / sum_u A_u F_us` with `F_js` the
+/// factor from part `j`'s centroid to the sender (times their visibility,
+/// with `visibility`, given where the link is partly occluded and its
+/// sender is an element), and the rays cast. Where no part sees the
+/// sender, every part gets the same (`w_j = 1`).
+fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<(&SceneRays, u64)>) -> (PartWeights, usize) {
+    let Node::Element(r) = receiver else { return (Vec::new(), 0) };
+    let nodes = h.parts(receiver, MAX_RECEIVER_PARTS);
     let n = h.normal(r);
-    let sender = Part::new(h, l.sender, key(l.receiver));
+    let sending = Part::new(h, sender, key(receiver));
     let mut rays = 0;
     let parts: Vec<(u32, f64, f64)> = nodes
         .into_iter()
         .filter_map(|p| {
             let Node::Element(j) = p else { return None };
             let points = &h.elements[j as usize].points;
-            let f = sender.factor(h, (points[0] + points[1] + points[2]) / 3.0, n);
+            let f = sending.factor(h, (points[0] + points[1] + points[2]) / 3.0, n);
             // A cluster sender: every part sees the same one, so the link's
             // fraction would scale all weights alike; it is left out.
-            Some((j, h.area(p), seen_factor(h, visibility, j, l.sender, f, 1.0, &mut rays)))
+            Some((j, h.area(p), seen_factor(h, visibility, j, sender, f, 1.0, &mut rays)))
         })
         .collect();
     let area: f64 = parts.iter().map(|p| p.1).sum();
