@@ -99,11 +99,24 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, stream: &mut Stre
 }
 
 /// Measures the exposure of the elements that have none yet (those
-/// created since the last call); returns the rays cast.
+/// created since the last call); returns the rays cast. Only the leaves
+/// are measured: an element already split when this is called (made and
+/// refined in one pass) takes the mean of its children's exposure, the
+/// exposure the solve gives every inner element ([`crate::gather`]), and
+/// casts no rays. Elements along a contact line cost the most (each point
+/// under the solid casts all its [`radiometry::burial::EXPOSURE_RAYS`],
+/// and a straddling element [`STRADDLING_POINTS`] points), and a pass
+/// makes and splits several levels of them at once.
 pub fn extend(h: &mut Hierarchy, scene: &SceneRays, seed: u64) -> u64 {
-    let first = h.exposure.len() as u32;
-    let measured: Vec<(f64, u64)> = (first..h.elements.len() as u32).into_par_iter().map(|e| of_element(h, scene, e, seed)).collect();
+    let first = h.exposure.len();
+    let measured: Vec<(f64, u64)> = (first..h.elements.len()).into_par_iter().map(|e| if h.elements[e].is_leaf() { of_element(h, scene, e as u32, seed) } else { (f64::NAN, 0) }).collect();
     h.exposure.extend(measured.iter().map(|m| m.0));
+    for e in (first..h.elements.len()).rev() {
+        let element = &h.elements[e];
+        if !element.is_leaf() {
+            h.exposure[e] = (element.first_child..element.first_child + 4).map(|c| h.exposure[c as usize]).sum::<f64>() / 4.0;
+        }
+    }
     measured.iter().map(|m| m.1).sum()
 }
 
