@@ -125,12 +125,16 @@ fn summary(eps: &str) -> (f64, f64, f64, usize) {
 /// and at the default `EPS` -1.4%, 11.5%, 0.03%. Since hierarchical-solve's
 /// `RELATIVE_AT` went from 3 to 1/8 with the absolute threshold as a cap,
 /// `EPS` 1e-2 is 4e-4 (the same relative threshold): +0.35%, 10.6%, 0.03%;
-/// and the default (1.5e-5) -2.0%, 12.5%, 0.03%. What is left on a single
-/// straddling leaf is the noise of its links' 16 visibility rays, of which
-/// the buried part stops some.
+/// and the default (1.5e-5) -2.0%, 12.5%, 0.03%; later +0.49%, 6.95% and
+/// -1.94%, 6.33%. Since refinement judges a link into such a leaf by the
+/// visibility of its exposed part (`V / x`, `links::Link::on_exposed`)
+/// rather than by `V`, which the rays from the buried part pull down to
+/// about `x`: +1.75%, 7.89% at 4e-4 and +0.81%, 2.73% at 1.5e-5. What is
+/// left on a single straddling leaf is the noise of its links' visibility
+/// rays, of which the buried part stops some.
 #[test]
 fn a_leaf_crossing_a_solids_footprint_shows_its_exposed_parts_radiosity() {
-    for (eps, bias_limit, l2_limit, open_limit) in [("4e-4", 0.03, 0.12, 0.04), ("1.5e-5", 0.04, 0.15, 0.01)] {
+    for (eps, bias_limit, l2_limit, open_limit) in [("4e-4", 0.03, 0.12, 0.04), ("1.5e-5", 0.015, 0.04, 0.01)] {
         let (bias, l2, open, count) = summary(eps);
         assert!(count > 10, "EPS {eps}: {count} leaves cross the footprint; the scene does not test");
         assert!(bias.abs() <= bias_limit, "EPS {eps}: the leaves crossing the footprint are {:+.2}% off their open part's radiosity on average", 100.0 * bias);
