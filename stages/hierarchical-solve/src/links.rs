@@ -608,7 +608,7 @@ pub const MOST_RAYS_FACTOR: usize = 16;
 /// allowance ([`Allowance::for_link`], at the dimmest leaf, as [`decide`] takes it),
 /// at most [`MOST_RAYS_FACTOR`] times `least`. The link brings its
 /// receiver's exposed part `V_e T`, `T = rho_r F_e B_s` (brightest
-/// channel; [`Link::on_exposed`] with `V` 1, `F_e = F_rs / x`: the noise of
+/// channel; `Link::on_exposed` with `V` 1, `F_e = F_rs / x`: the noise of
 /// `V` lands on that part `1 / x` times as large); `n` rays
 /// estimate `V` with a standard deviation of at most `sqrt(V (1 - V) / n)
 /// <= 1 / (2 sqrt n)` (stratified pairs do better), so
