@@ -69,7 +69,7 @@
 //! `sum_j A_j E_j = A_r V F_rs B_sent`: the link's flux, shared by factor.
 //! Below a part the light is pushed alike; where the link is partly
 //! occluded, a part that a shadow edge crosses opens into its children
-//! first ([`part_weights`], at most [`MAX_SHADOWED_PARTS`] parts). Test `receiver_parts.rs` (a
+//! first (`part_weights`, at most [`MAX_SHADOWED_PARTS`] parts). Test `receiver_parts.rs` (a
 //! floor under a small lamp, against Lambert's closed form per leaf):
 //! worst leaf 14.8% -> 0.46% at `EPS` 1e-2, 6.0% -> 0.14% at 3e-3. The
 //! Cornell box (full gather against Mitsuba, relative RMSE): 1.77% ->
