@@ -352,39 +352,55 @@ fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<
     let n = h.normal(r);
     let sending = Part::new(h, sender, key(receiver));
     let mut rays = 0;
-    // (element, area, factor, seen factor)
     let mut weigh = |j: u32| {
         let points = &h.elements[j as usize].points;
-        let f = sending.factor(h, (points[0] + points[1] + points[2]) / 3.0, n);
+        let factor = sending.factor(h, (points[0] + points[1] + points[2]) / 3.0, n);
         // A cluster sender: every part sees the same one, so the link's
         // fraction would scale all weights alike; it is left out.
-        (j, h.area(Node::Element(j)), f, seen_factor(h, visibility, j, sender, f, 1.0, &mut rays))
+        let seen = seen_factor(h, visibility, j, sender, factor, 1.0, &mut rays);
+        Weighed { element: j, area: h.area(Node::Element(j)), factor, seen }
     };
-    let mut parts: Vec<(u32, f64, f64, f64)> = h.parts(receiver, MAX_RECEIVER_PARTS).into_iter().filter_map(|p| if let Node::Element(j) = p { Some(weigh(j)) } else { None }).collect();
+    let mut parts: Vec<Weighed> = h.parts(receiver, MAX_RECEIVER_PARTS).into_iter().filter_map(|p| if let Node::Element(j) = p { Some(weigh(j)) } else { None }).collect();
     // Parts a shadow edge crosses open into their children, the parts that
     // carry most light first, while the parts number at most
     // MAX_SHADOWED_PARTS.
     loop {
-        let mut crossed: Vec<usize> = (0..parts.len()).filter(|&k| {
-            let (j, _, f, seen) = parts[k];
-            seen > 0.0 && seen < f && !h.elements[j as usize].is_leaf()
-        }).collect();
+        let mut crossed: Vec<usize> = (0..parts.len()).filter(|&k| parts[k].crossed() && !h.elements[parts[k].element as usize].is_leaf()).collect();
         if crossed.is_empty() || parts.len() + 3 > MAX_SHADOWED_PARTS {
             break;
         }
-        crossed.sort_by(|&a, &b| (parts[b].1 * parts[b].2).total_cmp(&(parts[a].1 * parts[a].2)));
+        crossed.sort_by(|&a, &b| (parts[b].area * parts[b].factor).total_cmp(&(parts[a].area * parts[a].factor)));
         crossed.truncate((MAX_SHADOWED_PARTS - parts.len()) / 3);
         crossed.sort_unstable();
         for &k in crossed.iter().rev() {
-            let first = h.elements[parts[k].0 as usize].first_child;
-            let children: Vec<_> = (first..first + 4).map(&mut weigh).collect();
+            let first = h.elements[parts[k].element as usize].first_child;
+            let children: Vec<Weighed> = (first..first + 4).map(&mut weigh).collect();
             parts.splice(k..k + 1, children);
         }
     }
-    let area: f64 = parts.iter().map(|p| p.1).sum();
-    let seen: f64 = parts.iter().map(|p| p.1 * p.3).sum();
+    let area: f64 = parts.iter().map(|p| p.area).sum();
+    let seen: f64 = parts.iter().map(|p| p.area * p.seen).sum();
     let even = !(seen > 0.0 && seen.is_finite());
-    (parts.iter().map(|p| (p.0, if even { 1.0 } else { p.3 * area / seen })).collect(), rays)
+    (parts.iter().map(|p| (p.element, if even { 1.0 } else { p.seen * area / seen })).collect(), rays)
+}
+
+/// A part of a receiving element as [`part_weights`] weighs it.
+struct Weighed {
+    element: u32,
+    /// Its area, m².
+    area: f64,
+    /// Its factor to the sender.
+    factor: f64,
+    /// That factor times its visibility of the sender, where traced.
+    seen: f64,
+}
+
+impl Weighed {
+    /// Whether a shadow edge crosses it: it sees part of what its factor
+    /// reaches.
+    fn crossed(&self) -> bool {
+        self.seen > 0.0 && self.seen < self.factor
+    }
 }
 
 /// `(t, p, w_tp)`: triangle, part (flat node index), weight.
