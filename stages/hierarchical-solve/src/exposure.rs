@@ -101,9 +101,9 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, stream: &mut Stre
 /// Measures the exposure of the elements that have none yet (those
 /// created since the last call); returns the rays cast. Only the leaves
 /// are measured: an element already split when this is called (made and
-/// refined in one pass) takes the mean of its children's exposure, the
-/// exposure the solve gives every inner element ([`crate::gather`]), and
-/// casts no rays. Elements along a contact line cost the most (each point
+/// refined in one pass) takes its children's exposure weighted by their
+/// (opaque) area, as the solve weighs an inner element's
+/// ([`crate::gather`]), and casts no rays. Elements along a contact line cost the most (each point
 /// under the solid casts all its [`radiometry::burial::EXPOSURE_RAYS`],
 /// and a straddling element [`STRADDLING_POINTS`] points), and a pass
 /// makes and splits several levels of them at once.
@@ -114,7 +114,9 @@ pub fn extend(h: &mut Hierarchy, scene: &SceneRays, seed: u64) -> u64 {
     for e in (first..h.elements.len()).rev() {
         let element = &h.elements[e];
         if !element.is_leaf() {
-            h.exposure[e] = (element.first_child..element.first_child + 4).map(|c| h.exposure[c as usize]).sum::<f64>() / 4.0;
+            let children = || (element.first_child..element.first_child + 4).map(|c| (h.area(Node::Element(c)), h.exposure[c as usize]));
+            let area: f64 = children().map(|(a, _)| a).sum();
+            h.exposure[e] = if area > 0.0 { children().map(|(a, x)| a * x).sum::<f64>() / area } else { 1.0 };
         }
     }
     measured.iter().map(|m| m.1).sum()
