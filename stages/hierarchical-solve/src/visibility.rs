@@ -57,7 +57,7 @@ use schemas::solution::Node;
 pub fn of_link(h: &Hierarchy, scene: &SceneRays, link: &Link, rays: usize, linking: Linking) -> (f32, f32, usize) {
     match (link.receiver, link.sender) {
         (Node::Element(r), Node::Element(s)) => {
-            let e = estimate(h, scene, r, s, rays, linking.seed);
+            let e = estimate(h, scene, r, s, rays, linking.seed, Occluder::Nearest);
             (e.visibility, e.occluder_distance, e.rays)
         }
         (r, s) => {
@@ -99,7 +99,7 @@ pub fn visible_factor(h: &Hierarchy, scene: &SceneRays, receiver: u32, part: u32
     if factor <= 0.0 {
         return (factor, 0);
     }
-    let v = estimate(h, scene, receiver, part, PART_VISIBILITY_RAYS, seed);
+    let v = estimate(h, scene, receiver, part, PART_VISIBILITY_RAYS, seed, Occluder::Any);
     (factor * f64::from(v.visibility), v.rays)
 }
 
@@ -122,11 +122,23 @@ pub struct Visibility {
     pub rays: usize,
 }
 
-/// Kernel-weighted visibility (module docs) and nearest-occluder distance
-/// of the link `receiver <- sender`, from `rays` stratified pairs. The
-/// random stream is keyed by the two elements, so the estimate does not
-/// depend on the order links are processed in.
-pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, rays: usize, seed: u64) -> Visibility {
+/// What a blocked ray of [`estimate`] must tell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Occluder {
+    /// The distance to its nearest occluder (a closest-hit traversal).
+    Nearest,
+    /// Only that it is blocked (an any-hit traversal, which stops at the
+    /// first blocker it meets: the same clear or blocked verdict, found
+    /// sooner); the estimate's occluder distance is then infinite.
+    Any,
+}
+
+/// Kernel-weighted visibility (module docs) and, if `occluder` asks for
+/// it, the nearest-occluder distance of the link `receiver <- sender`,
+/// from `rays` stratified pairs. The random stream is keyed by the two
+/// elements, so the estimate does not depend on the order links are
+/// processed in.
+pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, rays: usize, seed: u64, occluder: Occluder) -> Visibility {
     let (r, s) = (&h.elements[receiver as usize], &h.elements[sender as usize]);
     let (nr, ns) = (h.normal(receiver), h.normal(sender));
     let skip = [r.triangle, s.triangle];
@@ -145,7 +157,10 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
             continue;
         }
         cast += 1;
-        let blocker = scene.first_blocker(from, to, skip);
+        let blocker = match occluder {
+            Occluder::Nearest => scene.first_blocker(from, to, skip),
+            Occluder::Any => (!scene.segment_clear(from, to, skip)).then_some(f64::INFINITY),
+        };
         visible.add(g, blocker.is_none());
         if let Some(distance) = blocker {
             nearest = nearest.min(distance);
