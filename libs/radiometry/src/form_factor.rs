@@ -91,6 +91,7 @@ pub fn point_to_one_sided_polygon(point: DVec3, normal: DVec3, polygon: &[DVec3]
 /// weighted by it (`V = sum G_k v_k / sum G_k`), so pairs that carry no
 /// light (a sender point behind the receiver's plane) carry no weight.
 /// Singular as `d -> 0`: callers clamp or refine where points nearly touch.
+#[inline]
 pub fn point_kernel(x: DVec3, nx: DVec3, y: DVec3, ny: DVec3) -> f64 {
     let d = y - x;
     let d2 = d.length_squared();
@@ -115,6 +116,7 @@ pub struct WeightedVisibility {
 
 impl WeightedVisibility {
     /// One ray of weight `weight`, clear or blocked.
+    #[inline]
     pub fn add(&mut self, weight: f64, clear: bool) {
         self.weight += weight;
         if clear {
@@ -124,6 +126,7 @@ impl WeightedVisibility {
 
     /// `sum G v / sum G` in [0, 1]; `None` where no ray had weight (the
     /// pairs carry no light: callers take 1, or leave a value alone).
+    #[inline]
     pub fn fraction(&self) -> Option<f64> {
         (self.weight > 0.0).then(|| (self.clear / self.weight).clamp(0.0, 1.0))
     }

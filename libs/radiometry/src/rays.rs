@@ -186,6 +186,7 @@ impl SceneRays {
     /// primitive is skipped (it or its twin is in `skip`) or shows the ray
     /// a twin's back face. `sheared` is `ray` set up for the watertight
     /// test.
+    #[inline]
     fn intersect(&self, ray: &Ray, sheared: &ShearedRay, id: usize, skip: [u32; 2]) -> f32 {
         let mesh = self.mesh_index[id];
         let skipped = skip.contains(&mesh) || self.twin[mesh as usize].is_some_and(|t| skip.contains(&t));
@@ -203,6 +204,7 @@ impl SceneRays {
 
     /// The nearest hit along `origin + t direction` for `t` in
     /// `(t_min, t_max)`, skipping the mesh triangles in `skip`.
+    #[inline]
     pub fn closest_hit(&self, origin: DVec3, direction: DVec3, t_min: f32, t_max: f32, skip: [u32; 2]) -> Option<Hit> {
         let ray = Ray::new(vec3a(origin), self::direction(direction), t_min, t_max);
         let sheared = ShearedRay::new(ray.origin, ray.direction);
@@ -215,6 +217,7 @@ impl SceneRays {
     /// ignoring the mesh triangles in `skip` (the segment's own end
     /// triangles) and the last millionth at each end; `None` if the segment
     /// is clear.
+    #[inline]
     pub fn first_blocker(&self, from: DVec3, to: DVec3, skip: [u32; 2]) -> Option<f64> {
         let d = to - from;
         let length = d.length();
@@ -227,6 +230,7 @@ impl SceneRays {
 
     /// Whether the segment is clear: [`Self::first_blocker`] with an
     /// any-hit traversal, which stops at the first blocker.
+    #[inline]
     pub fn segment_clear(&self, from: DVec3, to: DVec3, skip: [u32; 2]) -> bool {
         let d = to - from;
         let length = d.length();

@@ -7,6 +7,7 @@ use glam::DVec3;
 
 /// SplitMix64 finaliser (Steele, Lea, Flood, "Fast splittable pseudorandom
 /// number generators", OOPSLA 2014): a bijective 64-bit mix.
+#[inline]
 pub fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
@@ -27,6 +28,7 @@ impl Stream {
     }
 
     /// Next uniform number in [0, 1).
+    #[inline]
     pub fn next_f64(&mut self) -> f64 {
         self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
         (mix64(self.state) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
@@ -49,6 +51,7 @@ impl Stream {
 /// Maps the unit square to barycentric coordinates on a triangle, uniformly
 /// by area (Shirley's square-to-triangle map: `b0 = 1 - sqrt(u)`,
 /// `b1 = v sqrt(u)`). Points of the open square land strictly inside.
+#[inline]
 pub fn square_to_triangle(u: f64, v: f64) -> [f64; 3] {
     let su = u.sqrt();
     let b0 = 1.0 - su;
@@ -57,18 +60,40 @@ pub fn square_to_triangle(u: f64, v: f64) -> [f64; 3] {
 }
 
 /// The `k`-th of `n` jittered stratified samples on a triangle, as a
-/// world-space point: the strata are a `columns x rows` grid of the unit
-/// square ([`strata`]), `n` cells of equal area each visited once by `k` in
-/// `0..n`, mapped to the triangle by [`square_to_triangle`].
+/// world-space point: [`Strata::point`] of `Strata::of(n)`.
 pub fn stratified_point(corners: &[DVec3; 3], k: usize, n: usize, stream: &mut Stream) -> DVec3 {
-    let (columns, rows) = strata(n);
-    let (i, j) = (k % columns, (k / columns) % rows);
-    // Keep the jitter off the stratum border so points stay strictly inside.
-    let jitter = |s: &mut Stream| 0.001 + 0.998 * s.next_f64();
-    let u = (i as f64 + jitter(stream)) / columns as f64;
-    let v = (j as f64 + jitter(stream)) / rows as f64;
-    let b = square_to_triangle(u, v);
-    corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2]
+    Strata::of(n).point(corners, k, stream)
+}
+
+/// A `columns x rows` grid of the unit square ([`strata`]), found once for
+/// the many points a caller draws from it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Strata {
+    columns: usize,
+    rows: usize,
+}
+
+impl Strata {
+    /// The grid of `n` strata ([`strata`]).
+    pub fn of(n: usize) -> Self {
+        let (columns, rows) = strata(n);
+        Strata { columns, rows }
+    }
+
+    /// The `k`-th jittered stratified sample on a triangle, as a
+    /// world-space point: the grid's `n` cells of equal area are each
+    /// visited once by `k` in `0..n`, mapped to the triangle by
+    /// [`square_to_triangle`].
+    #[inline]
+    pub fn point(&self, corners: &[DVec3; 3], k: usize, stream: &mut Stream) -> DVec3 {
+        let (i, j) = (k % self.columns, (k / self.columns) % self.rows);
+        // Keep the jitter off the stratum border so points stay strictly inside.
+        let jitter = |s: &mut Stream| 0.001 + 0.998 * s.next_f64();
+        let u = (i as f64 + jitter(stream)) / self.columns as f64;
+        let v = (j as f64 + jitter(stream)) / self.rows as f64;
+        let b = square_to_triangle(u, v);
+        corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2]
+    }
 }
 
 /// The `(columns, rows)` of `n` strata over the unit square: `rows` the

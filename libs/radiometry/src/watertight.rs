@@ -55,6 +55,7 @@ impl ShearedRay {
     /// processed side by side, one per SIMD lane, each with the scalar
     /// operations of the module documentation in the same order (so the
     /// same rounding).
+    #[inline]
     pub fn intersect(&self, triangle: &Triangle, t_min: f32, t_max: f32) -> f32 {
         let (v0, v1, v2) = (triangle.v0, triangle.v1, triangle.v2);
         let relative = [

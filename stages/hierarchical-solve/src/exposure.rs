@@ -43,7 +43,7 @@
 use crate::elements::Hierarchy;
 use crate::nodes::key;
 use radiometry::rays::SceneRays;
-use radiometry::sampling::{stratified_point, Stream};
+use radiometry::sampling::{Strata, Stream};
 use rayon::prelude::*;
 use schemas::solution::Node;
 
@@ -85,8 +85,9 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, stream: &mut Stre
     let normal = h.normal(e);
     let t_min = t_min(element);
     let (mut existing, mut exposed, mut rays) = (0usize, 0usize, 0u64);
+    let strata = Strata::of(n);
     for k in 0..n {
-        let point = stratified_point(&element.points, k, n, stream);
+        let point = strata.point(&element.points, k, stream);
         if !crate::visibility::exists(h, element.triangle, point) {
             continue;
         }

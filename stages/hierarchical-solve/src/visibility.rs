@@ -47,7 +47,7 @@ use crate::shaft::Occluders;
 use crate::transfer;
 use radiometry::form_factor::{point_kernel, WeightedVisibility};
 use radiometry::rays::SceneRays;
-use radiometry::sampling::{stratified_point, Stream};
+use radiometry::sampling::{Strata, Stream};
 use schemas::solution::Node;
 
 /// Visible fraction and nearest occluder of `link`: kernel-weighted rays
@@ -146,12 +146,13 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
     // Pair receiver stratum k with a shuffled sender stratum, so that ray
     // directions are not correlated with position on the receiver.
     let order = stream.permutation(rays);
+    let strata = Strata::of(rays);
     let mut visible = WeightedVisibility::default();
     let mut nearest = f64::INFINITY;
     let mut cast = 0;
     for (k, &k_sender) in order.iter().enumerate() {
-        let from = stratified_point(&r.points, k, rays, &mut stream);
-        let to = stratified_point(&s.points, k_sender, rays, &mut stream);
+        let from = strata.point(&r.points, k, &mut stream);
+        let to = strata.point(&s.points, k_sender, &mut stream);
         let g = point_kernel(from, nr, to, ns);
         if g <= 0.0 || !exists(h, r.triangle, from) || !exists(h, s.triangle, to) {
             continue;
