@@ -99,15 +99,27 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, stream: &mut Stre
     (if existing == 0 { 1.0 } else { exposed as f64 / existing as f64 }, rays)
 }
 
+/// The exposure of an inner node: its children's `(area, exposure)`
+/// weighted by their (opaque) area, 1 where they have none. How the solve
+/// weighs an inner node ([`crate::gather`]) and how [`extend`] gives one
+/// to an element it does not measure.
+pub fn of_children(children: impl Iterator<Item = (f64, f64)> + Clone) -> f64 {
+    let area: f64 = children.clone().map(|(a, _)| a).sum();
+    if area > 0.0 {
+        children.map(|(a, x)| a * x).sum::<f64>() / area
+    } else {
+        1.0
+    }
+}
+
 /// Measures the exposure of the elements that have none yet (those
 /// created since the last call); returns the rays cast. Only the leaves
 /// are measured: an element already split when this is called (made and
-/// refined in one pass) takes its children's exposure weighted by their
-/// (opaque) area, as the solve weighs an inner element's
-/// ([`crate::gather`]), and casts no rays. Elements along a contact line cost the most (each point
-/// under the solid casts all its [`radiometry::burial::EXPOSURE_RAYS`],
-/// and a straddling element [`STRADDLING_POINTS`] points), and a pass
-/// makes and splits several levels of them at once.
+/// refined in one pass) takes [`of_children`] and casts no rays. Elements
+/// along a contact line cost the most (each point under the solid casts
+/// all its [`radiometry::burial::EXPOSURE_RAYS`], and a straddling element
+/// [`STRADDLING_POINTS`] points), and a pass makes and splits several
+/// levels of them at once.
 pub fn extend(h: &mut Hierarchy, scene: &SceneRays, seed: u64) -> u64 {
     let first = h.exposure.len();
     let measured: Vec<(f64, u64)> = (first..h.elements.len()).into_par_iter().map(|e| if h.elements[e].is_leaf() { of_element(h, scene, e as u32, seed) } else { (f64::NAN, 0) }).collect();
@@ -115,9 +127,7 @@ pub fn extend(h: &mut Hierarchy, scene: &SceneRays, seed: u64) -> u64 {
     for e in (first..h.elements.len()).rev() {
         let element = &h.elements[e];
         if !element.is_leaf() {
-            let children = || (element.first_child..element.first_child + 4).map(|c| (h.area(Node::Element(c)), h.exposure[c as usize]));
-            let area: f64 = children().map(|(a, _)| a).sum();
-            h.exposure[e] = if area > 0.0 { children().map(|(a, x)| a * x).sum::<f64>() / area } else { 1.0 };
+            h.exposure[e] = of_children((element.first_child..element.first_child + 4).map(|c| (h.area(Node::Element(c)), h.exposure[c as usize])));
         }
     }
     measured.iter().map(|m| m.1).sum()

@@ -111,15 +111,7 @@ impl Topology {
         for i in (0..n).rev() {
             t.exposure[i] = match h.node(i) {
                 Node::Element(e) if h.elements[e as usize].is_leaf() => h.exposure(e),
-                _ => {
-                    let children = &t.children[t.child_start[i]..t.child_start[i + 1]];
-                    let area: f64 = children.iter().map(|&c| t.area[c]).sum();
-                    if area > 0.0 {
-                        children.iter().map(|&c| t.area[c] * t.exposure[c]).sum::<f64>() / area
-                    } else {
-                        1.0
-                    }
-                }
+                _ => crate::exposure::of_children(t.children[t.child_start[i]..t.child_start[i + 1]].iter().map(|&c| (t.area[c], t.exposure[c]))),
             };
         }
         t
