@@ -315,7 +315,7 @@ pub const MAX_SHADOWED_PARTS: usize = 64;
 fn seen_factor(h: &Hierarchy, visibility: Option<(&SceneRays, u64)>, receiver: u32, part: Node, f: f64, v_link: f64, rays: &mut usize) -> f64 {
     match (visibility, part) {
         (Some((scene, seed)), Node::Element(e)) => {
-            let (visible, cast) = visibility::visible_factor(h, scene, receiver, e, f, seed);
+            let (visible, cast) = visibility::visible_factor(h, scene, receiver, e, f, visibility::PART_VISIBILITY_RAYS, seed);
             *rays += cast;
             visible
         }

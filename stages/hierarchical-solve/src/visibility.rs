@@ -91,15 +91,16 @@ pub const PART_VISIBILITY_RAYS: usize = 8;
 
 /// `factor`, receiver element `receiver`'s factor to element `part`, times
 /// the kernel-weighted visible fraction between the two ([`estimate`] with
-/// [`PART_VISIBILITY_RAYS`] pairs), and the rays cast: how a partly
+/// `rays` pairs, [`PART_VISIBILITY_RAYS`] but where a part's own parent
+/// was traced), and the rays cast: how a partly
 /// occluded link weighs the parts of its sender
 /// ([`crate::gather::SenderTerms`]) and the faces of a receiving cluster
 /// ([`crate::receivers`]). A factor of 0 stays 0 and casts none.
-pub fn visible_factor(h: &Hierarchy, scene: &SceneRays, receiver: u32, part: u32, factor: f64, seed: u64) -> (f64, usize) {
+pub fn visible_factor(h: &Hierarchy, scene: &SceneRays, receiver: u32, part: u32, factor: f64, rays: usize, seed: u64) -> (f64, usize) {
     if factor <= 0.0 {
         return (factor, 0);
     }
-    let v = estimate(h, scene, receiver, part, PART_VISIBILITY_RAYS, seed, Occluder::Any);
+    let v = estimate(h, scene, receiver, part, rays, seed, Occluder::Any);
     (factor * f64::from(v.visibility), v.rays)
 }
 
