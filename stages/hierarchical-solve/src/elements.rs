@@ -150,13 +150,19 @@ impl Hierarchy {
     /// spent weighing senders' parts on the Cornell box.
     pub fn weight_to_element(&self, x: DVec3, n: DVec3, e: u32) -> f64 {
         let el = &self.elements[e as usize];
-        let c = (el.points[0] + el.points[1] + el.points[2]) / 3.0;
+        let c = self.centroid(e);
         let radius2 = el.points.iter().map(|p| p.distance_squared(c)).fold(0.0, f64::max);
         if c.distance_squared(x) > FAR_PART * FAR_PART * radius2 {
             el.area * point_kernel(x, n, c, self.normal(e)) / PI * self.coverage(e)
         } else {
             self.factor_to_element(x, n, e)
         }
+    }
+
+    /// The centroid of element `e`.
+    pub fn centroid(&self, e: u32) -> DVec3 {
+        let p = &self.elements[e as usize].points;
+        (p[0] + p[1] + p[2]) / 3.0
     }
 
     /// Unit front normal of element `e` (its triangle's).

@@ -538,8 +538,7 @@ impl SenderTerms {
     fn of_link(h: &Hierarchy, l: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], uniform: [f64; 3], scene: &SceneRays, seed: u64) -> (Vec<(usize, f64)>, usize) {
         let whole = (vec![(h.flat(l.sender), 1.0)], 0);
         let Node::Element(r) = l.receiver else { return whole };
-        let receiver = &h.elements[r as usize];
-        let x = (receiver.points[0] + receiver.points[1] + receiver.points[2]) / 3.0;
+        let x = h.centroid(r);
         let n = h.normal(r);
         let partly_occluded = l.partly_occluded();
         let mut rays = 0;
@@ -644,33 +643,14 @@ fn open_near_parts(h: &Hierarchy, parts: &mut Vec<Part>, x: DVec3, radiosity: &[
         return;
     }
     let sent: [f64; 3] = std::array::from_fn(|c| parts.iter().map(|p| p.weight * radiosity[h.flat(Node::Element(p.element))][c]).sum::<f64>() / total);
-    // `e_j` over its allowance, 0 for a leaf.
+    // `e_j` over its allowance.
     let excess = |p: &Part| {
-        let el = &h.elements[p.element as usize];
-        if el.is_leaf() {
-            return 0.0;
-        }
-        let c = (el.points[0] + el.points[1] + el.points[2]) / 3.0;
-        let radius = el.points.iter().map(|q| q.distance(c)).fold(0.0, f64::max);
+        let c = h.centroid(p.element);
+        let radius = h.elements[p.element as usize].points.iter().map(|q| q.distance(c)).fold(0.0, f64::max);
         let variation = (2.0 * radius / c.distance(x)).min(1.0);
         (0..3).map(|k| p.weight / total * deviation[p.element as usize][k] * variation / (uniform[k] * sent[k])).filter(|r| r.is_finite()).fold(0.0, f64::max)
     };
-    let mut excesses: Vec<f64> = parts.iter().map(excess).collect();
-    while parts.len() + 3 <= MAX_NEAR_PARTS {
-        let mut over: Vec<usize> = (0..parts.len()).filter(|&k| excesses[k] > 1.0).collect();
-        if over.is_empty() {
-            return;
-        }
-        over.sort_by(|&a, &b| excesses[b].total_cmp(&excesses[a]));
-        over.truncate((MAX_NEAR_PARTS - parts.len()) / 3);
-        over.sort_unstable();
-        for &k in over.iter().rev() {
-            let (first, visible) = (h.elements[parts[k].element as usize].first_child, parts[k].visible);
-            let children: Vec<Part> = (first..first + 4).map(|c| Part::new(c, weigh(c, Some(visible)))).collect();
-            excesses.splice(k..k + 1, children.iter().map(excess));
-            parts.splice(k..k + 1, children);
-        }
-    }
+    h.open_parts(parts, MAX_NEAR_PARTS, |p| p.element, |p| Some(excess(p)).filter(|&e| e > 1.0), |c, parent| Part::new(c, weigh(c, Some(parent.visible))));
 }
 
 /// A part of a sender as [`SenderTerms`] weighs it.
@@ -846,12 +826,6 @@ mod tests {
     use crate::test_scenes::FloorAndWall;
     use radiometry::form_factor::point_to_polygon;
 
-    /// The centroid of element `e`.
-    fn centroid(h: &Hierarchy, e: u32) -> DVec3 {
-        let p = &h.elements[e as usize].points;
-        (p[0] + p[1] + p[2]) / 3.0
-    }
-
     /// A floor triangle subdivided five levels (1,024 leaves) whose leaves
     /// are dim within 0.25 m of the wall it meets (a contact shadow: 0.05
     /// at the wall, 1 from 0.25 m out), sending to a wall element at the
@@ -877,10 +851,10 @@ mod tests {
         }
         h.ensure_children(Node::Element(2));
         let first = h.elements[2].first_child;
-        let receiver = (first..first + 4).min_by(|&a, &b| centroid(h, a).z.total_cmp(&centroid(h, b).z)).unwrap();
+        let receiver = (first..first + 4).min_by(|&a, &b| h.centroid(a).z.total_cmp(&h.centroid(b).z)).unwrap();
         let mut b = vec![[0.0; 3]; h.cluster_count() + h.elements.len()];
         for &e in &leaves {
-            let from_wall = 1.0 - centroid(h, e).x;
+            let from_wall = 1.0 - h.centroid(e).x;
             b[h.flat(Node::Element(e))] = [0.05 + 0.95 * (from_wall / 0.25).min(1.0); 3];
         }
         pull(h, &mut b);
@@ -889,7 +863,7 @@ mod tests {
         let link = Link { receiver: Node::Element(receiver), sender: Node::Element(0), form_factor: 0.1, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: false };
         let senders = Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &rays, seed: 1, rates: [0.0; 3] };
         let sent = SenderTerms::new(h, &[link], senders).sent(&b)[0][0];
-        let x = centroid(h, receiver);
+        let x = h.centroid(receiver);
         let (mut weighted, mut total) = (0.0, 0.0);
         for &e in &leaves {
             let f = point_to_polygon(x, -DVec3::X, &h.elements[e as usize].points);

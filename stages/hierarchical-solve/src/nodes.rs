@@ -154,6 +154,27 @@ impl Hierarchy {
         }
     }
 
+    /// Opens element parts into their four children, those that
+    /// `priority` ranks highest first (`None`: not to open; a leaf never
+    /// opens), round by round while they number at most `most`; `child`
+    /// makes a part of a child element from its parent part.
+    pub fn open_parts<P>(&self, parts: &mut Vec<P>, most: usize, element: impl Fn(&P) -> u32, priority: impl Fn(&P) -> Option<f64>, mut child: impl FnMut(u32, &P) -> P) {
+        loop {
+            let mut open: Vec<(usize, f64)> = parts.iter().enumerate().filter(|(_, p)| !self.elements[element(p) as usize].is_leaf()).filter_map(|(k, p)| Some((k, priority(p)?))).collect();
+            if open.is_empty() || parts.len() + 3 > most {
+                return;
+            }
+            open.sort_by(|a, b| b.1.total_cmp(&a.1));
+            open.truncate((most - parts.len()) / 3);
+            open.sort_unstable_by_key(|o| o.0);
+            for &(k, _) in open.iter().rev() {
+                let first = self.elements[element(&parts[k]) as usize].first_child;
+                let children: Vec<P> = (first..first + 4).map(|c| child(c, &parts[k])).collect();
+                parts.splice(k..k + 1, children);
+            }
+        }
+    }
+
     /// A node opened level by level (clusters down to their input
     /// triangles, elements to their children) while its parts are at most
     /// `most`.

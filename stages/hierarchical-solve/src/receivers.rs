@@ -353,8 +353,7 @@ fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<
     let sending = Part::new(h, sender, key(receiver));
     let mut rays = 0;
     let mut weigh = |j: u32| {
-        let points = &h.elements[j as usize].points;
-        let factor = sending.factor(h, (points[0] + points[1] + points[2]) / 3.0, n);
+        let factor = sending.factor(h, h.centroid(j), n);
         // A cluster sender: every part sees the same one, so the link's
         // fraction would scale all weights alike; it is left out.
         let seen = seen_factor(h, visibility, j, sender, factor, 1.0, &mut rays);
@@ -364,20 +363,7 @@ fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<
     // Parts a shadow edge crosses open into their children, the parts that
     // carry most light first, while the parts number at most
     // MAX_SHADOWED_PARTS.
-    loop {
-        let mut crossed: Vec<usize> = (0..parts.len()).filter(|&k| parts[k].crossed() && !h.elements[parts[k].element as usize].is_leaf()).collect();
-        if crossed.is_empty() || parts.len() + 3 > MAX_SHADOWED_PARTS {
-            break;
-        }
-        crossed.sort_by(|&a, &b| (parts[b].area * parts[b].factor).total_cmp(&(parts[a].area * parts[a].factor)));
-        crossed.truncate((MAX_SHADOWED_PARTS - parts.len()) / 3);
-        crossed.sort_unstable();
-        for &k in crossed.iter().rev() {
-            let first = h.elements[parts[k].element as usize].first_child;
-            let children: Vec<Weighed> = (first..first + 4).map(&mut weigh).collect();
-            parts.splice(k..k + 1, children);
-        }
-    }
+    h.open_parts(&mut parts, MAX_SHADOWED_PARTS, |p| p.element, |p| p.crossed().then_some(p.area * p.factor), |c, _| weigh(c));
     let area: f64 = parts.iter().map(|p| p.area).sum();
     let seen: f64 = parts.iter().map(|p| p.area * p.seen).sum();
     let even = !(seen > 0.0 && seen.is_finite());

@@ -119,8 +119,4 @@ impl Hierarchy {
         let has = |h: &Hierarchy, x: u32| !h.elements[x as usize].is_leaf();
         (has(self, e) || has(self, other)).then(|| self.subdivide(e))
     }
-
-    fn centroid(&self, e: u32) -> glam::DVec3 {
-        self.elements[e as usize].points.iter().sum::<glam::DVec3>() / 3.0
-    }
 }
