@@ -57,6 +57,8 @@ pub struct SceneRays {
     ordered: Vec<Triangle>,
     /// Mesh triangle index of each BVH primitive.
     mesh_index: Vec<u32>,
+    /// BVH primitive of each mesh triangle.
+    primitive: Vec<u32>,
     /// Per BVH primitive: the front normal (unnormalised) of a triangle
     /// that has a twin, whose back face rays ignore; `None` otherwise.
     culled_normal: Vec<Option<Vec3A>>,
@@ -147,9 +149,13 @@ impl SceneRays {
         let twin = twins(&tris);
         let ordered: Vec<Triangle> = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
         let mesh_index = bvh.primitive_indices.clone();
+        let mut primitive = vec![0; mesh_index.len()];
+        for (id, &mesh) in mesh_index.iter().enumerate() {
+            primitive[mesh as usize] = id as u32;
+        }
         let culled_normal =
             mesh_index.iter().zip(&ordered).map(|(&i, t)| twin[i as usize].map(|_| (t.v1 - t.v0).cross(t.v2 - t.v0))).collect();
-        SceneRays { bvh, ordered, mesh_index, culled_normal, twin, alpha: None }
+        SceneRays { bvh, ordered, mesh_index, primitive, culled_normal, twin, alpha: None }
     }
 
     /// The same BVH whose rays pass through the transparent texels of
@@ -232,15 +238,33 @@ impl SceneRays {
     /// any-hit traversal, which stops at the first blocker.
     #[inline]
     pub fn segment_clear(&self, from: DVec3, to: DVec3, skip: [u32; 2]) -> bool {
-        let d = to - from;
-        let length = d.length();
-        if length <= 0.0 {
-            return true;
-        }
-        let ray = Ray::new(vec3a(from), direction(d / length), (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32);
-        let sheared = ShearedRay::new(ray.origin, ray.direction);
+        let Some((ray, sheared)) = segment(from, to) else { return true };
         self.bvh.ray_traverse_miss(ray, |ray, id| self.intersect(ray, &sheared, id, skip))
     }
+
+    /// [`Self::segment_clear`] with only the mesh triangles `among` tested,
+    /// one by one, without the BVH: the same verdict wherever every
+    /// triangle that may block the segment is among them (a shaft's
+    /// possible occluders), found without a traversal.
+    #[inline]
+    pub fn segment_clear_among(&self, from: DVec3, to: DVec3, skip: [u32; 2], among: &[u32]) -> bool {
+        let Some((ray, sheared)) = segment(from, to) else { return true };
+        among.iter().all(|&t| self.intersect(&ray, &sheared, self.primitive[t as usize] as usize, skip).is_infinite())
+    }
+}
+
+/// The ray of the segment from `from` to `to` without its last millionth
+/// at each end, set up for the watertight test; `None` for a segment of
+/// no length.
+#[inline]
+fn segment(from: DVec3, to: DVec3) -> Option<(Ray, ShearedRay)> {
+    let d = to - from;
+    let length = d.length();
+    if length <= 0.0 {
+        return None;
+    }
+    let ray = Ray::new(vec3a(from), direction(d / length), (1e-6 * length) as f32, ((1.0 - 1e-6) * length) as f32);
+    Some((ray, ShearedRay::new(ray.origin, ray.direction)))
 }
 
 #[cfg(test)]
@@ -265,6 +289,11 @@ mod tests {
         assert_eq!(rays.first_blocker(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 3.0), [u32::MAX; 2]), Some(1.0));
         assert!(!rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 3.0), [u32::MAX; 2]));
         assert!(rays.segment_clear(dvec3(0.1, 0.2, 0.0), dvec3(0.1, 0.2, 0.9), [u32::MAX; 2]));
+        // (0.2, 0.1) lies under triangles 0 and 2, not 1 and 3.
+        let (from, to) = (dvec3(0.2, 0.1, 0.0), dvec3(0.2, 0.1, 3.0));
+        assert!(!rays.segment_clear_among(from, to, [u32::MAX; 2], &[1, 2]), "a triangle the segment meets is among them");
+        assert!(rays.segment_clear_among(from, to, [u32::MAX; 2], &[1, 3]), "none is");
+        assert!(rays.segment_clear_among(from, to, [0, 2], &[0, 2]), "they are skipped");
         assert!(rays.closest_hit(dvec3(5.0, 5.0, 0.0), DVec3::Z, 0.0, f32::INFINITY, [u32::MAX; 2]).is_none());
     }
 

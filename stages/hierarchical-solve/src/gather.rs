@@ -34,8 +34,7 @@ use crate::links::Link;
 use crate::mirrors::Couplings;
 use crate::receivers::{PartSource, ReceiverTerms};
 use crate::rows::Rows;
-use crate::visibility::{self, PART_VISIBILITY_RAYS};
-use radiometry::rays::SceneRays;
+use crate::visibility::{self, Tracer, PART_VISIBILITY_RAYS};
 use rayon::prelude::*;
 use schemas::solution::Node;
 
@@ -400,10 +399,8 @@ pub enum Senders<'a> {
         radiosity: &'a [[f64; 3]],
         /// Per element, its leaves' largest deviation from its radiosity.
         deviation: &'a [[f64; 3]],
-        /// The scene, for the parts' visibility.
-        scene: &'a SceneRays,
-        /// Seed of the parts' visibility rays.
-        seed: u64,
+        /// What the parts' visibility is traced with.
+        tracer: Tracer<'a>,
         /// Per channel, the rate `q` at which the solve that gave
         /// `radiosity` converged ([`Convergence::rates`]; 0 unknown).
         rates: [f64; 3],
@@ -501,11 +498,11 @@ impl SenderTerms {
     pub fn new(h: &Hierarchy, links: &[Link], senders: Senders) -> Self {
         let (parts, rays) = match senders {
             Senders::Means => (Rows::default(), 0),
-            Senders::Resolved { radiosity, deviation, scene, seed, rates } => {
+            Senders::Resolved { radiosity, deviation, tracer, rates } => {
                 let uniform = rates.map(|q| UNIFORM_SENDER * damping(q));
                 let (lists, rays): (Vec<_>, Vec<usize>) = links
                     .par_iter()
-                    .map(|l| if Self::uniform(h, l, radiosity, deviation, uniform) { (Vec::new(), 0) } else { Self::of_link(h, l, radiosity, deviation, uniform, scene, seed) })
+                    .map(|l| if Self::uniform(h, l, radiosity, deviation, uniform) { (Vec::new(), 0) } else { Self::of_link(h, l, radiosity, deviation, uniform, tracer) })
                     .unzip();
                 (Rows::from_lists(lists), rays.iter().sum())
             }
@@ -535,12 +532,13 @@ impl SenderTerms {
     /// cast for them (a partly occluded link's parts' visibility, traced
     /// through `scene` with `seed`). The parts are opened as far as
     /// `open_near_parts` needs before any visibility ray is cast.
-    fn of_link(h: &Hierarchy, l: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], uniform: [f64; 3], scene: &SceneRays, seed: u64) -> (Vec<(usize, f64)>, usize) {
+    fn of_link(h: &Hierarchy, l: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], uniform: [f64; 3], tracer: Tracer) -> (Vec<(usize, f64)>, usize) {
         let whole = (vec![(h.flat(l.sender), 1.0)], 0);
         let Node::Element(r) = l.receiver else { return whole };
         let x = h.centroid(r);
         let n = h.normal(r);
         let partly_occluded = l.partly_occluded();
+        let tracer = if partly_occluded { tracer.within(h, l.receiver, l.sender) } else { tracer };
         let mut rays = 0;
         // A part's weight `F_rj V_rj` and visible fraction `V_rj`: traced
         // where the link is partly occluded, unless its parent part was
@@ -551,7 +549,7 @@ impl SenderTerms {
                 _ if !partly_occluded => (factor, 1.0),
                 Some(v) if v == 0.0 || v == 1.0 => (factor * v, v),
                 _ => {
-                    let (seen, cast) = visibility::visible_factor(h, scene, r, e, factor, if parent.is_some() { CHILD_PART_RAYS } else { PART_VISIBILITY_RAYS }, seed);
+                    let (seen, cast) = visibility::visible_factor(h, tracer, r, e, factor, if parent.is_some() { CHILD_PART_RAYS } else { PART_VISIBILITY_RAYS });
                     rays += cast;
                     (seen, if factor > 0.0 { seen / factor } else { 1.0 })
                 }
@@ -859,9 +857,9 @@ mod tests {
         }
         pull(h, &mut b);
         let deviation = leaf_deviation(h, &b);
-        let rays = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
+        let (scene, occluders) = crate::test_scenes::traced(h);
         let link = Link { receiver: Node::Element(receiver), sender: Node::Element(0), form_factor: 0.1, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: false };
-        let senders = Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &rays, seed: 1, rates: [0.0; 3] };
+        let senders = Senders::Resolved { radiosity: &b, deviation: &deviation, tracer: Tracer::new(&scene, &occluders, 1), rates: [0.0; 3] };
         let sent = SenderTerms::new(h, &[link], senders).sent(&b)[0][0];
         let x = h.centroid(receiver);
         let (mut weighted, mut total) = (0.0, 0.0);

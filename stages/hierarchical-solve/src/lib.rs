@@ -478,8 +478,9 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
-            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, scene: &scene, seed: params.seed, rates: convergence.rates });
-            receivers = receivers::ReceiverTerms::new(&h, &mut all_links, Some((&scene, params.seed)), &mut receiver_weights);
+            let tracer = visibility::Tracer::new(&scene, &occluders, params.seed);
+            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, tracer, rates: convergence.rates });
+            receivers = receivers::ReceiverTerms::new(&h, &mut all_links, Some(tracer), &mut receiver_weights);
             work.part_rays = (senders.rays() + receivers.rays) as u64;
             work.resolved_links = senders.resolved();
             let means = convergence;

@@ -107,9 +107,8 @@ use crate::elements::Hierarchy;
 use crate::links::Link;
 use crate::nodes::key;
 use crate::rows::Rows;
-use crate::visibility;
+use crate::visibility::{self, Tracer};
 use radiometry::form_factor::{point_kernel, DUNAVANT_5};
-use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use rayon::prelude::*;
 use schemas::solution::Node;
@@ -202,7 +201,7 @@ impl ReceiverTerms {
     /// distributed to its triangles takes the factor, and with visibility
     /// the visible fraction, that its triangles' weights measured
     /// ([`Measured`]).
-    pub fn new(h: &Hierarchy, links: &mut [Link], visibility: Option<(&SceneRays, u64)>, cache: &mut WeightCache) -> Self {
+    pub fn new(h: &Hierarchy, links: &mut [Link], visibility: Option<Tracer>, cache: &mut WeightCache) -> Self {
         let to_parts: Vec<bool> = links.iter().map(|l| visibility.is_some() && matches!(l.receiver, Node::Element(e) if !h.elements[e as usize].is_leaf())).collect();
         let part_built: Vec<Option<(PartWeights, usize)>> =
             links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l.receiver, l.sender, visibility.filter(|_| l.partly_occluded())))).collect();
@@ -312,10 +311,10 @@ pub const MAX_SHADOWED_PARTS: usize = 64;
 /// its visible fraction) by visibility: an element part's own
 /// ([`visibility::visible_factor`]), a cluster part the link's. Adds the
 /// rays cast to `rays`.
-fn seen_factor(h: &Hierarchy, visibility: Option<(&SceneRays, u64)>, receiver: u32, part: Node, f: f64, v_link: f64, rays: &mut usize) -> f64 {
+fn seen_factor(h: &Hierarchy, visibility: Option<Tracer>, receiver: u32, part: Node, f: f64, v_link: f64, rays: &mut usize) -> f64 {
     match (visibility, part) {
-        (Some((scene, seed)), Node::Element(e)) => {
-            let (visible, cast) = visibility::visible_factor(h, scene, receiver, e, f, visibility::PART_VISIBILITY_RAYS, seed);
+        (Some(tracer), Node::Element(e)) => {
+            let (visible, cast) = visibility::visible_factor(h, tracer, receiver, e, f, visibility::PART_VISIBILITY_RAYS);
             *rays += cast;
             visible
         }
@@ -347,9 +346,10 @@ type PartWeights = Vec<(u32, f64)>;
 /// 0.98% at 2.5e-4, for 6-7% more solve time (one thread; `plants-2k`
 /// 2%, its relative RMSE 2.96% -> 2.95%). 256 parts everywhere gave the
 /// same band for much more.
-fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<(&SceneRays, u64)>) -> (PartWeights, usize) {
+fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<Tracer>) -> (PartWeights, usize) {
     let Node::Element(r) = receiver else { return (Vec::new(), 0) };
     let n = h.normal(r);
+    let visibility = visibility.map(|t| t.within(h, receiver, sender));
     let sending = Part::new(h, sender, key(receiver));
     let mut rays = 0;
     let mut weigh = |j: u32| {
@@ -438,7 +438,7 @@ impl Measured {
 /// and the parts `p` (flat node index) of its sender, `nodes`, the link as
 /// they measure it ([`Measured`]), and the rays cast for them (with
 /// `visibility`, given where the link is partly occluded).
-fn weights(h: &Hierarchy, l: &Link, nodes: &[Node], visibility: Option<(&SceneRays, u64)>) -> (Weights, Measured, usize) {
+fn weights(h: &Hierarchy, l: &Link, nodes: &[Node], visibility: Option<Tracer>) -> (Weights, Measured, usize) {
     let v_link = f64::from(l.visibility.unwrap_or(1.0));
     let mut rays = 0;
     let triangles = h.triangles_below(l.receiver);
@@ -579,10 +579,10 @@ mod tests {
                 first..first + 4
             }).collect();
         }
-        let rays = SceneRays::new(&h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
+        let (scene, occluders) = crate::test_scenes::traced(&h);
         let link = Link { receiver: Node::Element(0), sender: Node::Element(2), form_factor: 0.1, spread: 0.0, visibility: Some(0.5), occluder_distance: 0.5, clear: false };
         let mut links = [link];
-        let terms = ReceiverTerms::new(&h, &mut links, Some((&rays, 1)), &mut WeightCache::default());
+        let terms = ReceiverTerms::new(&h, &mut links, Some(Tracer::new(&scene, &occluders, 1)), &mut WeightCache::default());
         // Each leaf's share: its own part's weight, or the part above it.
         let share = |leaf: u32| {
             let mut e = leaf;
@@ -655,10 +655,10 @@ mod tests {
         for c in first..first + 4 {
             scene.h.ensure_children(Node::Element(c));
         }
-        let rays = SceneRays::new(&scene.h.triangles.iter().map(|t| t.corners).collect::<Vec<_>>());
+        let (rays, occluders) = crate::test_scenes::traced(&scene.h);
         let kept = Link { receiver: Node::Cluster(1), sender: Node::Element(4), form_factor: 0.02, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: false };
         let mut links = [kept];
-        let terms = ReceiverTerms::new(&scene.h, &mut links, Some((&rays, 1)), &mut WeightCache::default());
+        let terms = ReceiverTerms::new(&scene.h, &mut links, Some(Tracer::new(&rays, &occluders, 1)), &mut WeightCache::default());
         assert_eq!(terms.of_triangle(0).count(), 0, "the triangle's own share");
         let whole = scene.triangle_factor(&scene.h.elements[0].points, DVec3::Z, 60);
         let parts = scene.h.parts(Node::Element(0), MAX_RECEIVER_PARTS);

@@ -110,9 +110,20 @@ impl Occluders {
     /// their twins reaches into the convex hull of `receiver` and `sender`
     /// (module docs): `true` is a proof, `false` may be wrong.
     pub fn clear(&self, receiver: &[DVec3; 3], sender: &[DVec3; 3], ends: [u32; 2]) -> bool {
+        self.among(receiver, sender, ends, 0).is_some()
+    }
+
+    /// The triangles but `ends` and their twins that may reach into the
+    /// convex hull of `receiver` and `sender` (every other one is proven
+    /// not to, module docs), if there are at most `most` of them (at most
+    /// [`MOST_AMONG`]): every segment between the two ends' interiors that
+    /// a triangle blocks, one of these blocks.
+    pub fn among(&self, receiver: &[DVec3; 3], sender: &[DVec3; 3], ends: [u32; 2], most: usize) -> Option<Among> {
+        let mut among = Among { triangles: [0; MOST_AMONG], count: 0 };
         if self.nodes.is_empty() {
-            return true;
+            return Some(among);
         }
+        let most = most.min(MOST_AMONG);
         let mut shaft = Shaft::new(receiver, sender, self.touch);
         let skipped = |t: u32| ends.iter().any(|&e| e == t || self.twins[e as usize] == Some(t));
         // The tree is balanced, so its depth is under 64 for any mesh.
@@ -130,11 +141,40 @@ impl Occluders {
             }
             for &t in &self.order[node.first..node.first + node.count] {
                 if !skipped(t) && shaft.may_meet_triangle(&self.corners[t as usize], self.normals[t as usize]) {
-                    return false;
+                    if among.count == most {
+                        return None;
+                    }
+                    among.triangles[among.count] = t;
+                    among.count += 1;
                 }
             }
         }
-        true
+        Some(among)
+    }
+}
+
+/// Most triangles an [`Among`] holds: a ray tests each of them
+/// ([`SceneRays::segment_clear_among`]), where the BVH's traversal costs
+/// about what a few such tests do, so a longer list would cost what it
+/// saves. On the built-in Cornell box at `EPS` 4e-4 the shafts of 6,324
+/// of the 6,411 partly occluded links whose parts the last solve traces
+/// hold at most 16 (5.9 on average), and the solve is 7% faster on one
+/// thread (0.57 s -> 0.53 s, medians of 7 interleaved), with the same
+/// solution to the bit; plants-2k's, the same too, takes as long.
+pub const MOST_AMONG: usize = 16;
+
+/// The triangles that may block the segments between two elements
+/// ([`Occluders::among`]), mesh indices.
+#[derive(Clone, Copy, Debug)]
+pub struct Among {
+    triangles: [u32; MOST_AMONG],
+    count: usize,
+}
+
+impl Among {
+    /// The triangles.
+    pub fn triangles(&self) -> &[u32] {
+        &self.triangles[..self.count]
     }
 }
 
@@ -290,5 +330,38 @@ mod tests {
             });
             assert_eq!(rays_blocked, blocked, "rays, {occluder:?}");
         }
+    }
+
+    /// Of three blockers, two between a floor and a ceiling element and one
+    /// beside them, the shaft's list holds the two between (one triangle
+    /// each, where they block), none beside; with room for fewer it is
+    /// refused; and 4,096 segments between the two ends, tested against the
+    /// list alone, are blocked exactly where the BVH finds them blocked.
+    #[test]
+    fn the_triangles_among_a_shaft_block_every_segment_the_scene_blocks() {
+        let floor = [dvec3(0.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0)];
+        let ceiling = [dvec3(0.0, 0.0, 2.0), dvec3(0.0, 1.0, 2.0), dvec3(1.0, 0.0, 2.0)];
+        let mut corners = vec![floor, ceiling];
+        for (x, y, z) in [(0.2, 0.2, 0.7), (3.0, 0.0, 1.0), (0.5, 0.1, 1.4)] {
+            corners.extend(quad(z, x, y, 0.12));
+        }
+        let scene = SceneRays::new(&corners);
+        let occluders = Occluders::new(&corners, &scene);
+        let among = occluders.among(&floor, &ceiling, [0, 1], MOST_AMONG).expect("few enough");
+        let mut listed = among.triangles().to_vec();
+        listed.sort();
+        assert!(listed.iter().all(|&t| [2, 3, 6, 7].contains(&t)) && listed.len() >= 2, "{listed:?}");
+        assert!(occluders.among(&floor, &ceiling, [0, 1], listed.len() - 1).is_none());
+        let mut stream = Stream::new(7, 1, 2);
+        let (mut blocked, mut agree) = (0, 0);
+        for k in 0..4096 {
+            let from = radiometry::sampling::stratified_point(&floor, k, 4096, &mut stream);
+            let to = radiometry::sampling::stratified_point(&ceiling, k, 4096, &mut stream);
+            let clear = scene.segment_clear(from, to, [0, 1]);
+            blocked += usize::from(!clear);
+            agree += usize::from(clear == scene.segment_clear_among(from, to, [0, 1], among.triangles()));
+        }
+        assert!(blocked > 100, "{blocked} segments blocked");
+        assert_eq!(agree, 4096);
     }
 }

@@ -1,6 +1,8 @@
 //! Scenes the unit tests share.
 
 use crate::elements::Hierarchy;
+use crate::shaft::Occluders;
+use radiometry::rays::SceneRays;
 use glam::{dvec3, DVec3};
 use radiometry::form_factor::point_to_one_sided_polygon;
 use schemas::solution::NONE;
@@ -70,4 +72,13 @@ impl FloorAndWall {
         }
         sum / (m * m) as f64
     }
+}
+
+/// The rays and the occluders' box tree over `h`'s triangles, for a
+/// [`crate::visibility::Tracer`].
+pub fn traced(h: &Hierarchy) -> (SceneRays, Occluders) {
+    let corners: Vec<_> = h.triangles.iter().map(|t| t.corners).collect();
+    let scene = SceneRays::new(&corners);
+    let occluders = Occluders::new(&corners, &scene);
+    (scene, occluders)
 }

@@ -43,7 +43,7 @@
 
 use crate::elements::Hierarchy;
 use crate::links::{Link, Linking};
-use crate::shaft::Occluders;
+use crate::shaft::{Among, Occluders, MOST_AMONG};
 use crate::transfer;
 use radiometry::form_factor::{point_kernel, WeightedVisibility};
 use radiometry::rays::SceneRays;
@@ -96,12 +96,49 @@ pub const PART_VISIBILITY_RAYS: usize = 8;
 /// occluded link weighs the parts of its sender
 /// ([`crate::gather::SenderTerms`]) and the faces of a receiving cluster
 /// ([`crate::receivers`]). A factor of 0 stays 0 and casts none.
-pub fn visible_factor(h: &Hierarchy, scene: &SceneRays, receiver: u32, part: u32, factor: f64, rays: usize, seed: u64) -> (f64, usize) {
+pub fn visible_factor(h: &Hierarchy, tracer: Tracer, receiver: u32, part: u32, factor: f64, rays: usize) -> (f64, usize) {
     if factor <= 0.0 {
         return (factor, 0);
     }
-    let v = estimate(h, scene, receiver, part, rays, seed, Occluder::Any);
+    let v = estimate(h, tracer.scene, receiver, part, rays, tracer.seed, Occluder::Any(tracer.among));
     (factor * f64::from(v.visibility), v.rays)
+}
+
+/// What the last solve traces the visibility of a link's parts with
+/// ([`visible_factor`]).
+#[derive(Clone, Copy)]
+pub struct Tracer<'a> {
+    /// The scene's rays.
+    scene: &'a SceneRays,
+    /// Its triangles as occluders of a shaft.
+    occluders: &'a Occluders,
+    /// Seed of the rays' streams.
+    seed: u64,
+    /// The only triangles that may block the rays, where known.
+    among: Option<Among>,
+}
+
+impl<'a> Tracer<'a> {
+    /// Rays through the whole `scene` (`occluders` over the same triangles).
+    pub fn new(scene: &'a SceneRays, occluders: &'a Occluders, seed: u64) -> Self {
+        Tracer { scene, occluders, seed, among: None }
+    }
+
+    /// This tracer for rays between the parts of `receiver` and `sender`
+    /// (two elements; a cluster end keeps the whole scene): each tested
+    /// against only the few triangles that may reach into the shaft of the
+    /// two ([`Occluders::among`], which holds every part's), not through
+    /// the BVH. The verdicts are the same.
+    pub fn within(self, h: &Hierarchy, receiver: Node, sender: Node) -> Self {
+        let among = match (receiver, sender) {
+            (Node::Element(r), Node::Element(s)) => {
+                let (r, s) = (&h.elements[r as usize], &h.elements[s as usize]);
+                self.occluders.among(&r.points, &s.points, [r.triangle, s.triangle], MOST_AMONG)
+            }
+            _ => None,
+        };
+        Tracer { among, ..self }
+    }
 }
 
 /// Whether `point` of `triangle` exists: not on a transparent texel of
@@ -124,14 +161,15 @@ pub struct Visibility {
 }
 
 /// What a blocked ray of [`estimate`] must tell.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 pub enum Occluder {
     /// The distance to its nearest occluder (a closest-hit traversal).
     Nearest,
     /// Only that it is blocked (an any-hit traversal, which stops at the
     /// first blocker it meets: the same clear or blocked verdict, found
-    /// sooner); the estimate's occluder distance is then infinite.
-    Any,
+    /// sooner; or, given the triangles that may block it, a test of each
+    /// of them); the estimate's occluder distance is then infinite.
+    Any(Option<Among>),
 }
 
 /// Kernel-weighted visibility (module docs) and, if `occluder` asks for
@@ -161,7 +199,13 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
         cast += 1;
         let blocker = match occluder {
             Occluder::Nearest => scene.first_blocker(from, to, skip),
-            Occluder::Any => (!scene.segment_clear(from, to, skip)).then_some(f64::INFINITY),
+            Occluder::Any(among) => {
+                let clear = match &among {
+                    Some(among) => scene.segment_clear_among(from, to, skip, among.triangles()),
+                    None => scene.segment_clear(from, to, skip),
+                };
+                (!clear).then_some(f64::INFINITY)
+            }
         };
         visible.add(g, blocker.is_none());
         if let Some(distance) = blocker {
