@@ -192,11 +192,15 @@ struct Shaft {
     touch: f64,
 }
 
+/// Most axes a shaft tries: the two elements' normals and the side
+/// faces', an edge of one with a corner of the other (2 x 3 x 3).
+const AXES: usize = 2 + 18;
+
 impl Shaft {
     fn new(receiver: &[DVec3; 3], sender: &[DVec3; 3], touch: f64) -> Self {
         let ends = [*receiver, *sender];
         let (lo, hi) = ends.as_flattened().iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let mut shaft = Shaft { ends, lo: lo + DVec3::splat(touch), hi: hi - DVec3::splat(touch), axes: Vec::new(), touch };
+        let mut shaft = Shaft { ends, lo: lo + DVec3::splat(touch), hi: hi - DVec3::splat(touch), axes: Vec::with_capacity(AXES), touch };
         for t in ends {
             shaft.push((t[1] - t[0]).cross(t[2] - t[0]));
         }
