@@ -530,7 +530,7 @@ impl SenderTerms {
 
     /// The terms `(dense index, w_j)` of link `l`'s sender, and the rays
     /// cast for them (a partly occluded link's parts' visibility, traced
-    /// through `scene` with `seed`). The parts are opened as far as
+    /// with `tracer` within the link's shaft). The parts are opened as far as
     /// `open_near_parts` needs before any visibility ray is cast.
     fn of_link(h: &Hierarchy, l: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], uniform: [f64; 3], tracer: Tracer) -> (Vec<(usize, f64)>, usize) {
         let whole = (vec![(h.flat(l.sender), 1.0)], 0);

@@ -127,8 +127,9 @@ impl<'a> Tracer<'a> {
     /// This tracer for rays between the parts of `receiver` and `sender`
     /// (two elements; a cluster end keeps the whole scene): each tested
     /// against only the few triangles that may reach into the shaft of the
-    /// two ([`Occluders::among`], which holds every part's), not through
-    /// the BVH. The verdicts are the same.
+    /// two ([`Occluders::among`]: a part's shaft lies inside it), not
+    /// through the BVH, where there are at most [`MOST_AMONG`] of them.
+    /// The verdicts are the same.
     pub fn within(self, h: &Hierarchy, receiver: Node, sender: Node) -> Self {
         let among = match (receiver, sender) {
             (Node::Element(r), Node::Element(s)) => {
