@@ -273,7 +273,7 @@ pub fn solve(
             .par_iter()
             .map(|source| match source {
                 PartSource::Link(l) => senders.radiosity(*l, b),
-                PartSource::Triangle { terms, .. } => weighted(terms.iter().copied(), b),
+                PartSource::Parts { terms, .. } => weighted(terms.iter().copied(), b),
             })
             .collect();
         let gathered: Vec<[f64; 3]> = (0..n)
@@ -390,21 +390,45 @@ pub enum Senders<'a> {
     /// refinement, and the cheapest.
     Means,
     /// Its parts weighted by the kernel ([`SenderTerms`]), where its
-    /// leaves' radiosities in `radiosity` stray from its mean by more than
-    /// [`UNIFORM_SENDER`] of it (`deviation`: [`crate::links::leaf_deviation`]
-    /// of `radiosity`): for the final solve; up to [`MAX_SENDER_PARTS`]
-    /// terms per link.
+    /// leaves stray from its mean (`resolution`): for the final solve; up
+    /// to [`MAX_SENDER_PARTS`] terms per link.
     Resolved {
-        /// Radiosity per node, dense index (a solved iterate).
-        radiosity: &'a [[f64; 3]],
-        /// Per element, its leaves' largest deviation from its radiosity.
-        deviation: &'a [[f64; 3]],
+        /// The solved radiosity, and where it is uniform.
+        resolution: Resolution<'a>,
         /// What the parts' visibility is traced with.
         tracer: Tracer<'a>,
-        /// Per channel, the rate `q` at which the solve that gave
-        /// `radiosity` converged ([`Convergence::rates`]; 0 unknown).
-        rates: [f64; 3],
     },
+}
+
+/// What the last solve resolves senders by: a solved radiosity and how far
+/// each element's leaves stray from it.
+#[derive(Clone, Copy)]
+pub struct Resolution<'a> {
+    /// Radiosity per node, dense index (a solved iterate).
+    radiosity: &'a [[f64; 3]],
+    /// Per element, its leaves' largest deviation from its radiosity
+    /// ([`crate::links::leaf_deviation`] of `radiosity`).
+    deviation: &'a [[f64; 3]],
+    /// Per channel, the fraction of its mean a sender's leaves may stray
+    /// by and it still send its mean: [`UNIFORM_SENDER`] times
+    /// [`damping`] of the rate the solve that gave `radiosity` converged
+    /// at ([`Convergence::rates`]; 0 unknown).
+    uniform: [f64; 3],
+}
+
+impl<'a> Resolution<'a> {
+    /// `radiosity` with its `deviation`, solved at per-channel rates `rates`.
+    pub fn new(radiosity: &'a [[f64; 3]], deviation: &'a [[f64; 3]], rates: [f64; 3]) -> Self {
+        Resolution { radiosity, deviation, uniform: rates.map(|q| UNIFORM_SENDER * damping(q)) }
+    }
+
+    /// Whether link `l`'s sender is an element whose leaves all lie within
+    /// `uniform` (per channel, a fraction) of its mean.
+    pub fn uniform_sender(&self, h: &Hierarchy, l: &Link) -> bool {
+        let Node::Element(e) = l.sender else { return false };
+        let (mean, spread) = (self.radiosity[h.flat(l.sender)], self.deviation[e as usize]);
+        (0..3).all(|c| spread[c] <= self.uniform[c] * mean[c])
+    }
 }
 
 /// What each link's sender sends, as the gather reads it. A link carries
@@ -498,11 +522,10 @@ impl SenderTerms {
     pub fn new(h: &Hierarchy, links: &[Link], senders: Senders) -> Self {
         let (parts, rays) = match senders {
             Senders::Means => (Rows::default(), 0),
-            Senders::Resolved { radiosity, deviation, tracer, rates } => {
-                let uniform = rates.map(|q| UNIFORM_SENDER * damping(q));
+            Senders::Resolved { resolution, tracer } => {
                 let (lists, rays): (Vec<_>, Vec<usize>) = links
                     .par_iter()
-                    .map(|l| if Self::uniform(h, l, radiosity, deviation, uniform) { (Vec::new(), 0) } else { Self::of_link(h, l, radiosity, deviation, uniform, tracer) })
+                    .map(|l| if resolution.uniform_sender(h, l) { (Vec::new(), 0) } else { Self::of_link(h, l, resolution, tracer) })
                     .unzip();
                 (Rows::from_lists(lists), rays.iter().sum())
             }
@@ -515,14 +538,6 @@ impl SenderTerms {
         self.rays
     }
 
-    /// Whether link `l`'s sender is an element whose leaves all lie within
-    /// `uniform` (per channel, a fraction) of its mean.
-    fn uniform(h: &Hierarchy, l: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], uniform: [f64; 3]) -> bool {
-        let Node::Element(e) = l.sender else { return false };
-        let (mean, spread) = (radiosity[h.flat(l.sender)], deviation[e as usize]);
-        (0..3).all(|c| spread[c] <= uniform[c] * mean[c])
-    }
-
     /// How many links send their sender's parts rather than its mean.
     pub fn resolved(&self) -> usize {
         (0..self.senders.len()).filter(|&l| self.parts.row(l).next().is_some()).count()
@@ -532,9 +547,16 @@ impl SenderTerms {
     /// cast for them (a partly occluded link's parts' visibility, traced
     /// with `tracer` within the link's shaft). The parts are opened as far as
     /// `open_near_parts` needs before any visibility ray is cast.
-    fn of_link(h: &Hierarchy, l: &Link, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], uniform: [f64; 3], tracer: Tracer) -> (Vec<(usize, f64)>, usize) {
+    fn of_link(h: &Hierarchy, l: &Link, resolution: Resolution, tracer: Tracer) -> (Vec<(usize, f64)>, usize) {
+        let Node::Element(r) = l.receiver else { return (vec![(h.flat(l.sender), 1.0)], 0) };
+        Self::seen_from(h, r, l, resolution, tracer)
+    }
+
+    /// [`Self::of_link`] as element `r`, the link's receiver or a part of
+    /// it, sees the sender from its centroid
+    /// ([`crate::receivers::NEAR_RECEIVER`]).
+    pub(crate) fn seen_from(h: &Hierarchy, r: u32, l: &Link, resolution: Resolution, tracer: Tracer) -> (Vec<(usize, f64)>, usize) {
         let whole = (vec![(h.flat(l.sender), 1.0)], 0);
-        let Node::Element(r) = l.receiver else { return whole };
         let x = h.centroid(r);
         let n = h.normal(r);
         let partly_occluded = l.partly_occluded();
@@ -557,7 +579,7 @@ impl SenderTerms {
         };
         let parts: Option<Vec<Part>> = h.parts(l.sender, MAX_SENDER_PARTS).into_iter().map(|p| if let Node::Element(e) = p { Some(Part::new(e, weigh(e, None))) } else { None }).collect();
         let Some(mut parts) = parts else { return whole };
-        open_near_parts(h, &mut parts, x, radiosity, deviation, uniform, &mut weigh);
+        open_near_parts(h, &mut parts, x, resolution, &mut weigh);
         let total: f64 = parts.iter().map(|p| p.weight).sum();
         if parts.len() < 2 || total <= 0.0 || !total.is_finite() {
             return (whole.0, rays);
@@ -633,7 +655,8 @@ pub const MAX_NEAR_PARTS: usize = 64;
 /// coarse `EPS` (ceiling -3.7% at 7e-4); a looser bound (4 or 16 times
 /// [`UNIFORM_SENDER`]) kept part of the ceiling's error (-0.16%, -0.30%
 /// at 4e-4).
-fn open_near_parts(h: &Hierarchy, parts: &mut Vec<Part>, x: DVec3, radiosity: &[[f64; 3]], deviation: &[[f64; 3]], uniform: [f64; 3], weigh: &mut impl FnMut(u32, Option<f64>) -> (f64, f64)) {
+fn open_near_parts(h: &Hierarchy, parts: &mut Vec<Part>, x: DVec3, resolution: Resolution, weigh: &mut impl FnMut(u32, Option<f64>) -> (f64, f64)) {
+    let Resolution { radiosity, deviation, uniform } = resolution;
     // `total` and what the parts send are those of the first parts: the
     // opened parts change them by about the error they remove.
     let total: f64 = parts.iter().map(|p| p.weight).sum();
@@ -669,7 +692,7 @@ impl Part {
 
 /// `sum_j w_j B_j` over `terms` `(j, w_j)`, `j` a dense node index into
 /// `b`: what a sender's parts send ([`SenderTerms`]), and what they send a
-/// cluster's triangle ([`PartSource::Triangle`]).
+/// cluster's triangle ([`PartSource::Parts`]).
 fn weighted(terms: impl Iterator<Item = (usize, f64)>, b: &[[f64; 3]]) -> [f64; 3] {
     let mut sent = [0.0; 3];
     for (node, w) in terms {
@@ -859,7 +882,7 @@ mod tests {
         let deviation = leaf_deviation(h, &b);
         let (scene, occluders) = crate::test_scenes::traced(h);
         let link = Link { receiver: Node::Element(receiver), sender: Node::Element(0), form_factor: 0.1, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: false };
-        let senders = Senders::Resolved { radiosity: &b, deviation: &deviation, tracer: Tracer::new(&scene, &occluders, 1), rates: [0.0; 3] };
+        let senders = Senders::Resolved { resolution: Resolution::new(&b, &deviation, [0.0; 3]), tracer: Tracer::new(&scene, &occluders, 1) };
         let sent = SenderTerms::new(h, &[link], senders).sent(&b)[0][0];
         let x = h.centroid(receiver);
         let (mut weighted, mut total) = (0.0, 0.0);

@@ -473,14 +473,15 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // and partly occluded links into clusters weighing each face by
         // its visibility (receivers).
         senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
-        let mut receivers = receivers::ReceiverTerms::new(&h, &mut all_links, None, &mut receiver_weights);
+        let mut receivers = receivers::ReceiverTerms::new(&h, &mut all_links, None, None, &mut receiver_weights);
         let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders, &receivers);
         let left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
             let deviation = links::leaf_deviation(&h, &b);
             let tracer = visibility::Tracer::new(&scene, &occluders, params.seed);
-            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { radiosity: &b, deviation: &deviation, tracer, rates: convergence.rates });
-            receivers = receivers::ReceiverTerms::new(&h, &mut all_links, Some(tracer), &mut receiver_weights);
+            let resolution = gather::Resolution::new(&b, &deviation, convergence.rates);
+            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { resolution, tracer });
+            receivers = receivers::ReceiverTerms::new(&h, &mut all_links, Some(tracer), Some(resolution), &mut receiver_weights);
             work.part_rays = (senders.rays() + receivers.rays) as u64;
             work.resolved_links = senders.resolved();
             let means = convergence;
