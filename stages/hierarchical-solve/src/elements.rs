@@ -165,6 +165,13 @@ impl Hierarchy {
         (p[0] + p[1] + p[2]) / 3.0
     }
 
+    /// The radius of element `e` about its centroid: its farthest corner's
+    /// distance.
+    pub fn radius(&self, e: u32) -> f64 {
+        let c = self.centroid(e);
+        self.elements[e as usize].points.iter().map(|p| p.distance(c)).fold(0.0, f64::max)
+    }
+
     /// Unit front normal of element `e` (its triangle's).
     pub fn normal(&self, e: u32) -> DVec3 {
         self.triangles[self.elements[e as usize].triangle as usize].normal

@@ -666,9 +666,7 @@ fn open_near_parts(h: &Hierarchy, parts: &mut Vec<Part>, x: DVec3, resolution: R
     let sent: [f64; 3] = std::array::from_fn(|c| parts.iter().map(|p| p.weight * radiosity[h.flat(Node::Element(p.element))][c]).sum::<f64>() / total);
     // `e_j` over its allowance.
     let excess = |p: &Part| {
-        let c = h.centroid(p.element);
-        let radius = h.elements[p.element as usize].points.iter().map(|q| q.distance(c)).fold(0.0, f64::max);
-        let variation = (2.0 * radius / c.distance(x)).min(1.0);
+        let variation = (2.0 * h.radius(p.element) / h.centroid(p.element).distance(x)).min(1.0);
         (0..3).map(|k| p.weight / total * deviation[p.element as usize][k] * variation / (uniform[k] * sent[k])).filter(|r| r.is_finite()).fold(0.0, f64::max)
     };
     h.open_parts(parts, MAX_NEAR_PARTS, |p| p.element, |p| Some(excess(p)).filter(|&e| e > 1.0), |c, parent| Part::new(c, weigh(c, Some(parent.visible))));

@@ -325,7 +325,7 @@ fn plane(h: &Hierarchy, node: Node) -> Option<(DVec3, DVec3)> {
 }
 
 /// Distance between two axis-aligned boxes (0 where they overlap).
-fn box_distance(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> f64 {
+pub(crate) fn box_distance(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> f64 {
     let gap = (b.0 - a.1).max(a.0 - b.1).max(DVec3::ZERO);
     gap.length()
 }

@@ -104,7 +104,7 @@
 //! +85% in the preview against Mitsuba (issue 10).
 
 use crate::elements::Hierarchy;
-use crate::links::Link;
+use crate::links::{box_distance, Link};
 use crate::nodes::key;
 use crate::rows::Rows;
 use crate::gather::{Resolution, SenderTerms};
@@ -207,7 +207,7 @@ impl ReceiverTerms {
         let to_parts: Vec<bool> = links.iter().map(|l| visibility.is_some() && matches!(l.receiver, Node::Element(e) if !h.elements[e as usize].is_leaf())).collect();
         let part_built: Vec<Option<(PartWeights, usize)>> =
             links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l.receiver, l.sender, visibility.filter(|_| l.partly_occluded())))).collect();
-        let seen: Vec<Option<Vec<Vec<(usize, f64)>>>> = links
+        let mut seen: Vec<Option<PartViews>> = links
             .par_iter()
             .zip(&part_built)
             .map(|(l, built)| near_sender_terms(h, l, &built.as_ref()?.0, resolution?, visibility?))
@@ -215,10 +215,10 @@ impl ReceiverTerms {
         let mut by_element: Vec<Vec<(usize, f64)>> = vec![Vec::new(); h.elements.len()];
         let mut part_sources = Vec::new();
         for (l, (list, _)) in part_built.iter().enumerate().filter_map(|(l, b)| Some((l, b.as_ref()?))) {
-            if let Some(seen) = &seen[l] {
+            if let Some(seen) = seen[l].take() {
                 for (&(e, w), terms) in list.iter().zip(seen) {
                     by_element[e as usize].push((part_sources.len(), w));
-                    part_sources.push(PartSource::Parts { link: l, terms: terms.clone() });
+                    part_sources.push(PartSource::Parts { link: l, terms });
                 }
                 continue;
             }
@@ -354,16 +354,13 @@ pub const NEAR_RECEIVER: f64 = 1.0;
 /// (seeds 1-5: relative RMSE 1.355% -> 1.352%), for 4% more solve time on
 /// one thread. Partly occluded links keep the one list: each part's view
 /// would need its own visibility to each sender part.
-fn near_sender_terms(h: &Hierarchy, l: &Link, parts: &PartWeights, resolution: Resolution, tracer: Tracer) -> Option<Vec<Vec<(usize, f64)>>> {
+fn near_sender_terms(h: &Hierarchy, l: &Link, parts: &PartWeights, resolution: Resolution, tracer: Tracer) -> Option<PartViews> {
     let Node::Element(r) = l.receiver else { return None };
     if l.partly_occluded() || resolution.uniform_sender(h, l) {
         return None;
     }
     let c = h.centroid(r);
-    let radius = h.elements[r as usize].points.iter().map(|p| p.distance(c)).fold(0.0, f64::max);
-    let (lo, hi) = h.bounds(l.sender);
-    let gap = (lo - c).max(c - hi).max(glam::DVec3::ZERO).length();
-    (gap <= NEAR_RECEIVER * radius).then(|| parts.iter().map(|&(j, _)| SenderTerms::seen_from(h, j, l, resolution, tracer).0).collect())
+    (box_distance((c, c), h.bounds(l.sender)) <= NEAR_RECEIVER * h.radius(r)).then(|| parts.iter().map(|&(j, _)| SenderTerms::seen_from(h, j, l, resolution, tracer).0).collect())
 }
 
 /// `f`, receiving element `receiver`'s factor to sender part `part`,
@@ -385,6 +382,9 @@ fn seen_factor(h: &Hierarchy, visibility: Option<Tracer>, receiver: u32, part: N
 
 /// `(j, w_j)`: part (element index), weight.
 type PartWeights = Vec<(u32, f64)>;
+
+/// Per part of a receiver, the sender terms `(flat node index, w)` it sees.
+type PartViews = Vec<Vec<(usize, f64)>>;
 
 /// `(j, w_j)` for the parts `j` of an inner element `receiver` lit by
 /// `sender` (a link's ends, or a cluster link's sender and one of the
