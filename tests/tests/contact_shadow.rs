@@ -135,24 +135,28 @@ fn reference(setup: Setup) -> (Cells, Cells) {
     }
 }
 
-/// Each leaf of `object` ("wall" or "floor") as `(distance from the
-/// crease, relative error against the reference)`, solved with `args`.
-fn errors(test: &str, setup: Setup, object: &str, args: &[&str]) -> Vec<(f64, f64)> {
+/// The scene solved with `args` and its reference: each leaf of `objects`
+/// ("wall", "floor") as `(distance from the crease, relative error)`, one
+/// list per object.
+fn errors(test: &str, setup: Setup, objects: &[&str], args: &[&str]) -> Vec<Vec<(f64, f64)>> {
     let dir = scratch(test);
     let solved = Solved::new(&dir, &setup.scene().write(&dir), args);
     let (floor, wall) = reference(setup);
-    let (normal, rho, from) = if object == "wall" { ([-1.0, 0.0, 0.0], setup.wall_rho, &floor) } else { ([0.0, 0.0, 1.0], FLOOR_RHO, &wall) };
-    let own = |x: [f64; 3]| if object == "floor" { setup.direct(x) } else { 0.0 };
-    solved
-        .leaves_of(object)
-        .into_iter()
-        .map(|(e, corners)| {
-            let want = mean_over_triangle(&corners, 2, &|x| own(x) + gathered(x, normal, rho, from));
-            let centroid: [f64; 3] = std::array::from_fn(|a| (corners[0][a] + corners[1][a] + corners[2][a]) / 3.0);
-            let distance = if object == "wall" { centroid[2] } else { WALL_X - centroid[0] };
-            (distance, f64::from(e.radiosity[0]) / want - 1.0)
-        })
-        .collect()
+    let of = |object: &str| {
+        let (normal, rho, from) = if object == "wall" { ([-1.0, 0.0, 0.0], setup.wall_rho, &floor) } else { ([0.0, 0.0, 1.0], FLOOR_RHO, &wall) };
+        let own = |x: [f64; 3]| if object == "floor" { setup.direct(x) } else { 0.0 };
+        solved
+            .leaves_of(object)
+            .into_iter()
+            .map(|(e, corners)| {
+                let want = mean_over_triangle(&corners, 2, &|x| own(x) + gathered(x, normal, rho, from));
+                let centroid: [f64; 3] = std::array::from_fn(|a| (corners[0][a] + corners[1][a] + corners[2][a]) / 3.0);
+                let distance = if object == "wall" { centroid[2] } else { WALL_X - centroid[0] };
+                (distance, f64::from(e.radiosity[0]) / want - 1.0)
+            })
+            .collect()
+    };
+    objects.iter().map(|o| of(o)).collect()
 }
 
 /// The worst leaf `(distance, error)` and the mean error of the leaves
@@ -174,7 +178,7 @@ fn worst_and_crease(errors: &[(f64, f64)]) -> ((f64, f64), f64) {
 /// (+3.7% at 5e-5).
 #[test]
 fn a_wall_sees_the_contact_shadow_at_its_base_within_two_percent_per_leaf() {
-    let ((height, worst), base) = worst_and_crease(&errors("contact_shadow", DIM, "wall", &[]));
+    let ((height, worst), base) = worst_and_crease(&errors("contact_shadow", DIM, &["wall"], &[])[0]);
     eprintln!("contact shadow, default settings: worst wall leaf {:+.2}% at z {height:.4} m, the base's mean {:+.2}%", 100.0 * worst, 100.0 * base);
     assert!(worst.abs() <= 0.02, "a wall leaf {height:.4} m up is {:+.2}% off the reference", 100.0 * worst);
     assert!(base.abs() <= 0.01, "the wall's leaves within 2 cm of its base are {:+.2}% off the reference on average", 100.0 * base);
@@ -190,9 +194,8 @@ fn a_wall_sees_the_contact_shadow_at_its_base_within_two_percent_per_leaf() {
 /// +2.89% (+7.84%).
 #[test]
 fn the_parts_of_a_floor_element_at_a_crease_each_see_the_wall_for_themselves() {
-    let args = ["--eps", "4e-4"];
-    let (_, floor) = worst_and_crease(&errors("contact_shadow_floor", BRIGHT, "floor", &args));
-    let (_, wall) = worst_and_crease(&errors("contact_shadow_wall", BRIGHT, "wall", &args));
+    let both = errors("contact_shadow_crease", BRIGHT, &["floor", "wall"], &["--eps", "4e-4"]);
+    let ((_, floor), (_, wall)) = (worst_and_crease(&both[0]), worst_and_crease(&both[1]));
     eprintln!("contact shadow, EPS 4e-4: floor within 2 cm of the crease {:+.2}%, wall {:+.2}% on average", 100.0 * floor, 100.0 * wall);
     assert!(floor.abs() <= 0.1, "the floor's leaves along the crease are {:+.2}% off the reference on average", 100.0 * floor);
     assert!(wall.abs() <= 0.04, "the wall's leaves along its base are {:+.2}% off the reference on average", 100.0 * wall);
