@@ -187,16 +187,18 @@ fn a_wall_sees_the_contact_shadow_at_its_base_within_two_percent_per_leaf() {
 /// At `EPS` 4e-4 on the bright wall, a link from a whole wall triangle
 /// into a floor element along the crease is kept: the parts of that
 /// element each weigh the wall's parts from their own centroid
-/// (hierarchical-solve's `receivers::NEAR_RECEIVER`). Measured: the floor
-/// leaves within 2 cm of the crease +7.37% on average (+26.77% with every
-/// part taking what the wall sends the element's centroid, the leaves
-/// right at the crease +51% to +58%), the wall's within 2 cm of the base
-/// +2.89% (+7.84%).
+/// (hierarchical-solve's `receivers::NEAR_RECEIVER`), and the floor
+/// leaves the lamp's shadow edge crosses open in the last solve
+/// (hierarchical-solve's `shadowed`). Measured: the floor leaves within 2
+/// cm of the crease +3.08% on average (+7.37% with those leaves left
+/// whole; +26.77% with every part also taking what the wall sends the
+/// element's centroid, the leaves right at the crease +51% to +58%), the
+/// wall's within 2 cm of the base +2.13% (+2.89%; +7.84%).
 #[test]
 fn the_parts_of_a_floor_element_at_a_crease_each_see_the_wall_for_themselves() {
     let both = errors("contact_shadow_crease", BRIGHT, &["floor", "wall"], &["--eps", "4e-4"]);
     let ((_, floor), (_, wall)) = (worst_and_crease(&both[0]), worst_and_crease(&both[1]));
     eprintln!("contact shadow, EPS 4e-4: floor within 2 cm of the crease {:+.2}%, wall {:+.2}% on average", 100.0 * floor, 100.0 * wall);
-    assert!(floor.abs() <= 0.1, "the floor's leaves along the crease are {:+.2}% off the reference on average", 100.0 * floor);
-    assert!(wall.abs() <= 0.04, "the wall's leaves along its base are {:+.2}% off the reference on average", 100.0 * wall);
+    assert!(floor.abs() <= 0.05, "the floor's leaves along the crease are {:+.2}% off the reference on average", 100.0 * floor);
+    assert!(wall.abs() <= 0.03, "the wall's leaves along its base are {:+.2}% off the reference on average", 100.0 * wall);
 }

@@ -880,7 +880,7 @@ mod tests {
         let deviation = leaf_deviation(h, &b);
         let (scene, occluders) = crate::test_scenes::traced(h);
         let link = Link { receiver: Node::Element(receiver), sender: Node::Element(0), form_factor: 0.1, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: false };
-        let senders = Senders::Resolved { resolution: Resolution::new(&b, &deviation, [0.0; 3]), tracer: Tracer::new(&scene, &occluders, 1) };
+        let senders = Senders::Resolved { resolution: Resolution::new(&b, &deviation, [0.0; 3]), tracer: Tracer::new(&scene, &occluders, 1, 16) };
         let sent = SenderTerms::new(h, &[link], senders).sent(&b)[0][0];
         let x = h.centroid(receiver);
         let (mut weighted, mut total) = (0.0, 0.0);

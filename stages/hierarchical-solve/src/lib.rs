@@ -59,6 +59,7 @@ pub mod nodes;
 pub mod receivers;
 pub mod report;
 pub mod rows;
+pub mod shadowed;
 pub mod shaft;
 #[cfg(test)]
 mod test_scenes;
@@ -221,6 +222,9 @@ pub struct Work {
     /// Links whose sender the last solve resolved into parts
     /// ([`gather::SenderTerms`]).
     pub resolved_links: usize,
+    /// Leaves the last solve opened where a shadow edge crosses them
+    /// ([`shadowed`]).
+    pub opened_leaves: usize,
     /// Visibility rays the last solve cast to weigh a partly occluded
     /// link's sender parts and receiving faces ([`gather::SenderTerms`],
     /// [`receivers`]); not in `rays`, whose rate is the links' visibility.
@@ -429,10 +433,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         }
         // The faces of translucent surfaces refine alike (crate::transmission).
         if h.pair_faces() {
-            while b.len() < h.cluster_count() + h.elements.len() {
-                let parent = h.elements[b.len() - h.cluster_count()].parent;
-                b.push(b[h.flat(Node::Element(parent))]);
-            }
+            inherit_radiosity(&h, &mut b);
         }
         work.refine_seconds += started.elapsed().as_secs_f64();
 
@@ -465,7 +466,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         progress(&Progress { pass, phase: Phase::Gathering, links: all_links.len(), elements: h.elements.len() });
         let started = Instant::now();
         all_links = sort_links(&h, all_links, in_order.unwrap_or(0));
-        let offsets = csr_offsets(&h, &all_links, b.len());
+        let mut offsets = csr_offsets(&h, &all_links, b.len());
         // The passes refine with senders' area means; the last one then
         // solves on with the senders whose radiosity varies resolved by the
         // kernel (gather::SenderTerms), judged on the means' solution,
@@ -473,21 +474,46 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // and partly occluded links into clusters weighing each face by
         // its visibility (receivers).
         senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Means);
-        let mut receivers = receivers::ReceiverTerms::new(&h, &mut all_links, None, None, &mut receiver_weights);
+        let mut receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Means, &mut receiver_weights);
         let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders, &receivers);
-        let left = params.max_iterations - convergence.iterations;
+        let mut left = params.max_iterations - convergence.iterations;
         if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
-            let deviation = links::leaf_deviation(&h, &b);
-            let tracer = visibility::Tracer::new(&scene, &occluders, params.seed);
-            let resolution = gather::Resolution::new(&b, &deviation, convergence.rates);
-            senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { resolution, tracer });
-            receivers = receivers::ReceiverTerms::new(&h, &mut all_links, Some(tracer), Some(resolution), &mut receiver_weights);
-            work.part_rays = (senders.rays() + receivers.rays) as u64;
-            work.resolved_links = senders.resolved();
-            let means = convergence;
-            convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
-            work.iterations += means.iterations;
-            work.extrapolations += means.extrapolations;
+            let tracer = visibility::Tracer::new(&scene, &occluders, params.seed, params.visibility_rays);
+            // Leaves a shadow edge crosses open into their children
+            // (crate::shadowed), which a means' solve lights by their own
+            // visibility before the senders are resolved.
+            let opened = if specular.is_none() && !h.pair_faces() { shadowed::shadowed_leaves(&h, &all_links, &b, floors.shadow) } else { Vec::new() };
+            if !opened.is_empty() {
+                for &e in &opened {
+                    h.ensure_children(Node::Element(e));
+                }
+                let mut is_opened = vec![false; h.elements.len()];
+                opened.iter().for_each(|&e| is_opened[e as usize] = true);
+                work.opened_leaves = opened.len();
+                inherit_radiosity(&h, &mut b);
+                work.luminaire_rays += luminaires::extend(&mut h, &direct, params.quadrature_depth);
+                work.exposure_rays += exposure::extend(&mut h, &scene, params.seed);
+                offsets = csr_offsets(&h, &all_links, b.len());
+                receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Opened { tracer, opened: &is_opened }, &mut receiver_weights);
+                work.part_rays += receivers.rays as u64;
+                let means = convergence;
+                convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
+                left -= convergence.iterations;
+                work.iterations += means.iterations;
+                work.extrapolations += means.extrapolations;
+            }
+            if convergence.converged && left > 0 {
+                let deviation = links::leaf_deviation(&h, &b);
+                let resolution = gather::Resolution::new(&b, &deviation, convergence.rates);
+                senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { resolution, tracer });
+                receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Last { tracer, resolution: Some(resolution) }, &mut receiver_weights);
+                work.part_rays += (senders.rays() + receivers.rays) as u64;
+                work.resolved_links = senders.resolved();
+                let means = convergence;
+                convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
+                work.iterations += means.iterations;
+                work.extrapolations += means.extrapolations;
+            }
         }
         rates = convergence.rates;
         work.iterations += convergence.iterations;
@@ -570,6 +596,15 @@ fn sort_links(h: &Hierarchy, mut links: Vec<Link>, in_order: usize) -> Vec<Link>
     merged.extend(a);
     merged.extend(b);
     merged
+}
+
+/// Gives each element that `b` (radiosity per node, dense index) has no
+/// entry for yet, new ones at the end, its parent's radiosity.
+fn inherit_radiosity(h: &Hierarchy, b: &mut Vec<[f64; 3]>) {
+    while b.len() < h.cluster_count() + h.elements.len() {
+        let parent = h.elements[b.len() - h.cluster_count()].parent;
+        b.push(b[h.flat(Node::Element(parent))]);
+    }
 }
 
 /// `offsets[i]..offsets[i + 1]` indexes the links into the node of dense

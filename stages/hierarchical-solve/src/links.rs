@@ -95,6 +95,13 @@ impl Link {
         2.0 * v.min(1.0 - v) * reflected * f
     }
 
+    /// The oracle's shadow term ([`Self::shadow_error`]) of a link into
+    /// element `r`, with `r`'s reflectance and the sender's radiosity in
+    /// `radiosity` (dense index), as [`decide`] takes it.
+    pub(crate) fn shadow_term(&self, h: &Hierarchy, r: u32, radiosity: &[[f64; 3]]) -> f64 {
+        self.shadow_error(h, brightest_reflected(h.reflectance_of(r), radiosity[h.flat(self.sender)]))
+    }
+
     /// Its share of `allowance` ([`Allowance::for_link`]) with its receiver's
     /// radiosity and what it brings the receiver's exposed part, `rho_r V_e
     /// F_e B_s` (`reflected` = `rho_r B_s`, [`Link::on_exposed`]), both

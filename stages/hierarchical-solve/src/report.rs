@@ -16,6 +16,7 @@ pub fn done(work: &Work, params: &Params, mesh: &Mesh, manifest: &Manifest, surf
         ("passes", w.passes as f64),
         ("links", w.links as f64),
         ("resolved_links", w.resolved_links as f64),
+        ("opened_leaves", w.opened_leaves as f64),
         ("part_visibility_rays", w.part_rays as f64),
         ("cluster_links", w.cluster_links as f64),
         ("elements", w.elements as f64),

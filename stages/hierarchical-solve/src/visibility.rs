@@ -116,12 +116,20 @@ pub struct Tracer<'a> {
     seed: u64,
     /// The only triangles that may block the rays, where known.
     among: Option<Among>,
+    /// The fewest rays a link's own visibility takes (`--visibility-rays`).
+    link_rays: usize,
 }
 
 impl<'a> Tracer<'a> {
-    /// Rays through the whole `scene` (`occluders` over the same triangles).
-    pub fn new(scene: &'a SceneRays, occluders: &'a Occluders, seed: u64) -> Self {
-        Tracer { scene, occluders, seed, among: None }
+    /// Rays through the whole `scene` (`occluders` over the same
+    /// triangles), for links traced with at least `link_rays` rays.
+    pub fn new(scene: &'a SceneRays, occluders: &'a Occluders, seed: u64, link_rays: usize) -> Self {
+        Tracer { scene, occluders, seed, among: None, link_rays }
+    }
+
+    /// The fewest rays a link's own visibility takes.
+    pub fn link_rays(&self) -> usize {
+        self.link_rays
     }
 
     /// This tracer for rays between the parts of `receiver` and `sender`
