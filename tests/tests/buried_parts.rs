@@ -129,12 +129,14 @@ fn summary(eps: &str) -> (f64, f64, f64, usize) {
 /// -1.94%, 6.33%. Since refinement judges a link into such a leaf by the
 /// visibility of its exposed part (`V / x`, `links::Link::on_exposed`)
 /// rather than by `V`, which the rays from the buried part pull down to
-/// about `x`: +1.75%, 7.89% at 4e-4 and +0.81%, 2.73% at 1.5e-5. What is
-/// left on a single straddling leaf is the noise of its links' visibility
-/// rays, of which the buried part stops some.
+/// about `x`: +1.75%, 7.89% at 4e-4 and +0.81%, 2.73% at 1.5e-5; since a
+/// link into an inner element takes the visible fraction its parts
+/// measured (hierarchical-solve's `receivers`), +0.08%, 2.03% at 1.5e-5.
+/// What is left on a single straddling leaf is the noise of its links'
+/// visibility rays, of which the buried part stops some.
 #[test]
 fn a_leaf_crossing_a_solids_footprint_shows_its_exposed_parts_radiosity() {
-    for (eps, bias_limit, l2_limit, open_limit) in [("4e-4", 0.03, 0.12, 0.04), ("1.5e-5", 0.015, 0.04, 0.01)] {
+    for (eps, bias_limit, l2_limit, open_limit) in [("4e-4", 0.03, 0.12, 0.04), ("1.5e-5", 0.005, 0.03, 0.01)] {
         let (bias, l2, open, count) = summary(eps);
         assert!(count > 10, "EPS {eps}: {count} leaves cross the footprint; the scene does not test");
         assert!(bias.abs() <= bias_limit, "EPS {eps}: the leaves crossing the footprint are {:+.2}% off their open part's radiosity on average", 100.0 * bias);

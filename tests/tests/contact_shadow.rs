@@ -190,10 +190,10 @@ fn a_wall_sees_the_contact_shadow_at_its_base_within_two_percent_per_leaf() {
 /// (hierarchical-solve's `receivers::NEAR_RECEIVER`), and the floor
 /// leaves the lamp's shadow edge crosses open in the last solve
 /// (hierarchical-solve's `shadowed`). Measured: the floor leaves within 2
-/// cm of the crease +3.08% on average (+7.37% with those leaves left
+/// cm of the crease +3.29% on average (+7.37% with those leaves left
 /// whole; +26.77% with every part also taking what the wall sends the
 /// element's centroid, the leaves right at the crease +51% to +58%), the
-/// wall's within 2 cm of the base +2.13% (+2.89%; +7.84%).
+/// wall's within 2 cm of the base +2.03% (+2.89%; +7.84%).
 #[test]
 fn the_parts_of_a_floor_element_at_a_crease_each_see_the_wall_for_themselves() {
     let both = errors("contact_shadow_crease", BRIGHT, &["floor", "wall"], &["--eps", "4e-4"]);
