@@ -85,9 +85,10 @@
 //! `EPS` 5e-4 (seed 8) a floor leaf 2.7 cm from the short block's face, in
 //! its umbra, got 25% more light from a ceiling triangle it sees whole
 //! than that triangle's factor brings it, through a link into a coarse
-//! floor element with `V` 0.244; the floor within 5 cm of the face was 8.9%
-//! over what a gather of the solution's own leaves gives it (5.4% now),
-//! and the face it lights 3.1% over the `EPS` 2.5e-5 solve (2.2% now).
+//! floor element with `V` 0.244; the floor within 5 cm of the face was 5.1%
+//! over what a gather of the solution's own leaves gives its exposed
+//! points (1.7% now), and the face it lights 3.1% over the `EPS` 2.5e-5
+//! solve (2.2% now).
 //! Over seeds 1-5 the preview against Mitsuba went from 1.252% to 1.164%
 //! relative RMSE at 4e-4 (the worst surface per seed 0.34-0.52% ->
 //! 0.18-0.28%) and from 1.486% to 1.375% at 5e-4 (0.51-1.04% ->
