@@ -92,7 +92,8 @@
 //! Over seeds 1-5 the preview against Mitsuba went from 1.252% to 1.164%
 //! relative RMSE at 4e-4 (the worst surface per seed 0.34-0.52% ->
 //! 0.18-0.28%) and from 1.486% to 1.375% at 5e-4 (0.51-1.04% ->
-//! 0.36-0.56%), for no more rays. Test `receiver_parts.rs` (a
+//! 0.36-0.56%), for no more rays; `plants-2k` at its default `EPS` 1e-3
+//! from 2.93% to 2.70%. Test `receiver_parts.rs` (a
 //! floor under a small lamp, against Lambert's closed form per leaf):
 //! worst leaf 14.8% -> 0.46% at `EPS` 1e-2, 6.0% -> 0.14% at 3e-3. The
 //! Cornell box (full gather against Mitsuba, relative RMSE): 1.77% ->
