@@ -9,32 +9,46 @@ use schemas::solution::NONE;
 use test_support::meshes::{manifest, material, quads};
 
 /// A unit floor and a unit wall standing on its far edge, facing back over
-/// it (triangles 0-3, cluster 1), under a unit lamp quad at `height`
-/// facing down (triangles 4-5, cluster 2).
+/// it (triangles 0-1 and 2 onwards, cluster 1), under a unit lamp quad at
+/// `height` facing down (the last two triangles, cluster 2).
 pub struct FloorAndWall {
     /// The hierarchy over them.
     pub h: Hierarchy,
-    /// Triangle 4, the lamp's first.
+    /// The lamp's first triangle.
     pub lamp: [DVec3; 3],
+    /// Its triangle (and root element) index.
+    pub lamp_triangle: u32,
 }
 
 impl FloorAndWall {
-    /// The scene with its lamp at `height` (the wall's top is at 1).
+    /// The scene with its lamp at `height` (the wall's top is at 1) and
+    /// the wall one quad (triangles 0-3 below cluster 1, the lamp 4-5).
     pub fn new(height: f64) -> Self {
-        let mesh = quads(&[
-            (dvec3(0.0, 0.0, 0.0), DVec3::X, DVec3::Y, 0, 0),
-            (dvec3(1.0, 0.0, 0.0), DVec3::Z, DVec3::Y, 0, 0),
-            (dvec3(0.0, 0.0, height), DVec3::Y, DVec3::X, 1, 1),
-        ]);
+        Self::with_wall_quads(height, 1)
+    }
+
+    /// The scene with the wall made of `n` x `n` quads (cluster 1 holds
+    /// `2 + 2 n^2` triangles).
+    pub fn with_wall_quads(height: f64, n: usize) -> Self {
+        let step = 1.0 / n as f64;
+        let mut faces = vec![(dvec3(0.0, 0.0, 0.0), DVec3::X, DVec3::Y, 0, 0)];
+        for i in 0..n {
+            for j in 0..n {
+                faces.push((dvec3(1.0, j as f64 * step, i as f64 * step), DVec3::Z * step, DVec3::Y * step, 0, 0));
+            }
+        }
+        faces.push((dvec3(0.0, 0.0, height), DVec3::Y, DVec3::X, 1, 1));
+        let mesh = quads(&faces);
+        let lit = 2 + 2 * n * n;
         let mut clusters = test_support::artifacts::clusters_over(&mesh);
         clusters.nodes.truncate(3);
-        for (c, first, count) in [(1, 0, 4), (2, 4, 2)] {
+        for (c, first, count) in [(1, 0, lit), (2, lit, 2)] {
             let node = &mut clusters.nodes[c];
-            (node.first_triangle, node.triangle_count, node.first_child, node.child_count) = (first, count, NONE, 0);
+            (node.first_triangle, node.triangle_count, node.first_child, node.child_count) = (first as u32, count as u32, NONE, 0);
         }
         let manifest = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [1.0; 3])]);
         let h = Hierarchy::new(&mesh, &manifest, Some(clusters), None);
-        FloorAndWall { h, lamp: [dvec3(0.0, 0.0, height), dvec3(0.0, 1.0, height), dvec3(1.0, 1.0, height)] }
+        FloorAndWall { h, lamp: [dvec3(0.0, 0.0, height), dvec3(0.0, 1.0, height), dvec3(1.0, 1.0, height)], lamp_triangle: lit as u32 }
     }
 
     /// The floor's and the wall's mean factor to the lamp triangle: an
