@@ -482,7 +482,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
             // Leaves a shadow edge crosses open into their children
             // (crate::shadowed), which a means' solve lights by their own
             // visibility before the senders are resolved.
-            let opened = if specular.is_none() && !h.pair_faces() { shadowed::shadowed_leaves(&h, &all_links, &b, floors.shadow) } else { Vec::new() };
+            let opened = if specular.is_none() && h.transmission.is_none() { shadowed::shadowed_leaves(&h, &all_links, &b, floors.shadow) } else { Vec::new() };
             if !opened.is_empty() {
                 for &e in &opened {
                     h.ensure_children(Node::Element(e));
