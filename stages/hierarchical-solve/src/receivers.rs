@@ -307,8 +307,8 @@ impl ReceiverTerms {
             part_sources.push(PartSource::Link(l));
         }
         // Links into clusters are traced in the last solve only.
-        let visibility = tracer.filter(|_| matches!(build, Build::Last { .. }));
         let last = matches!(build, Build::Last { .. });
+        let visibility = tracer.filter(|_| last);
         let to_triangles: Vec<bool> = links.iter().map(|l| to_triangles(h, l, last)).collect();
         let built: Vec<Option<Built>> = links
             .par_iter()
