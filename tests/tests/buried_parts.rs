@@ -131,7 +131,11 @@ fn summary(eps: &str) -> (f64, f64, f64, usize) {
 /// rather than by `V`, which the rays from the buried part pull down to
 /// about `x`: +1.75%, 7.89% at 4e-4 and +0.81%, 2.73% at 1.5e-5; since a
 /// link into an inner element takes the visible fraction its parts
-/// measured (hierarchical-solve's `receivers`), +0.08%, 2.03% at 1.5e-5.
+/// measured (hierarchical-solve's `receivers`), +0.08%, 2.03% at 1.5e-5;
+/// since the last solve opens the leaves a shadow edge crosses at a
+/// sixteenth of their radiosity, not a quarter (the straddling leaves'
+/// neighbours), +2.76%, 7.93% at 4e-4 (was +1.75%, 7.89%: within the
+/// noise of 64 leaves' mean at that L2) and +0.10%, 2.03% at 1.5e-5.
 /// What is left on a single straddling leaf is the noise of its links'
 /// visibility rays, of which the buried part stops some.
 #[test]

@@ -30,20 +30,35 @@
 //! the children share their parent's radiosity when the links out of it
 //! are weighed, and the short block kept +0.53%.
 //!
-//! Preview against Mitsuba, `EPS` 4e-4: the short block +0.60% ->
-//! +0.41% (mean over seeds 1-5), the worst surface per seed 0.29-0.72% ->
-//! 0.29-0.55% over seeds 1-8, relative RMSE 1.352% -> 1.252% (seeds 1-5),
-//! with 27-38 leaves opened, for 4% more solve time on one thread. In
+//! Preview against Mitsuba, `EPS` 4e-4, opening at a quarter of the
+//! radiosity: the short block +0.60% -> +0.41% (mean over seeds 1-5), the
+//! worst surface per seed 0.29-0.72% -> 0.29-0.55% over seeds 1-8,
+//! relative RMSE 1.352% -> 1.252% (seeds 1-5), with 27-38 leaves opened,
+//! for 4% more solve time on one thread. In
 //! `tests/tests/contact_shadow.rs` at 4e-4 the floor within 2 cm of the
 //! wall's base went from +7.4% to +3.1% over the reference, and the wall's
 //! base, which that floor lights, from +2.9% to +2.1% (means of per-leaf
 //! errors); the penumbra of `tests/tests/receiver_parts.rs`, where
 //! refinement had already placed the leaves, from 0.35% to 0.31% (L2 over
-//! the leaves). Opening more leaves bought more on the Cornell box and cost
-//! more time (measured with 8 rays per child): a sixteenth of the
-//! radiosity 1.133% (worst surface 0.21-0.42% over seeds 1-5) for 14% more
-//! than a quarter, every leaf a partly occluded link lights 1.103% for 24%
-//! more; half opened 2 leaves and changed nothing.
+//! the leaves).
+//!
+//! **A sixteenth** opens about eight times the leaves (290 against 34 at
+//! 4e-4, seed 1) for 8% more solve time at the same `EPS` (one thread,
+//! medians of 9 interleaved; 14% at 2.5e-4), and buys more accuracy than
+//! that time buys by tightening `EPS`: the errors it removes are one-signed
+//! (a dim face lit by the floor's contact shadow next to it), not the
+//! refinement's. Over seeds 1-8 of the built-in Cornell box (against a
+//! Mitsuba reference of 0.2% noise) every surface of every seed is within
+//! 0.7% from `EPS` 6e-4 (worst 0.30-0.63%, 19.4k links), where a quarter
+//! needed 4.75e-4 (0.23-0.62%, 26.8k links): 0.83 times the solve time
+//! (medians of 11 interleaved, one thread). At 6e-4 a quarter left
+//! 0.55-0.96% (short block +0.70% on average, now +0.37%), at 5e-4
+//! 0.36-0.78% (now 0.31-0.54%); relative RMSE over seeds 1-5 at 4e-4
+//! 1.166% -> 1.046%, at 2.5e-4 0.897% -> 0.852%. In `contact_shadow.rs`
+//! at 4e-4 the crease's floor +3.1% -> +2.5%, its wall +2.1% -> +1.9%.
+//! An eighth left seed 3 at 0.73% at 6e-4; a thirty-second was about as
+//! accurate as a sixteenth (0.21-0.65%) for more time; opening two levels at once
+//! (the children that may split again) changed the short block by 0.07%.
 //!
 //! **Not a leaf a solid stands on** (exposure under 1, [`crate::exposure`]):
 //! its links count the rays from the buried part as occluded, and its
@@ -65,7 +80,7 @@ use schemas::solution::Node;
 /// Fraction of a leaf's radiosity (brightest channel) that its partly
 /// occluded links' shadow terms must reach together for the last solve to
 /// open it (module docs).
-pub const SHADOWED_LEAF: f64 = 0.25;
+pub const SHADOWED_LEAF: f64 = 1.0 / 16.0;
 
 /// The leaves (element indices, ascending) that `links` may light with a
 /// shadow edge across by at least [`SHADOWED_LEAF`] of their radiosity in
@@ -97,11 +112,11 @@ mod tests {
     use radiometry::form_factor::Quadrature;
 
     /// The floor's first triangle under the lamp with a partly occluded
-    /// link: opened where the link's shadow term reaches a quarter of its
-    /// radiosity, not where it falls short, nor where the link is clear or
+    /// link: opened where the link's shadow term reaches a sixteenth of
+    /// its radiosity, not where it falls short, nor where the link is clear or
     /// wholly hidden, nor below the floor, nor where a solid stands on it.
     #[test]
-    fn a_leaf_opens_where_its_shadow_term_reaches_a_quarter_of_its_radiosity() {
+    fn a_leaf_opens_where_its_shadow_term_reaches_a_sixteenth_of_its_radiosity() {
         let mut h = FloorAndWall::new(1.0).h;
         h.exposure = vec![1.0; h.elements.len()];
         let linking = Linking { cluster_samples: 16, seed: 1, quadrature: Quadrature::to_depth(3) };
@@ -114,7 +129,7 @@ mod tests {
         assert!((term - 0.5 * lamp.form_factor).abs() < 1e-12, "{term}");
         let floor = h.flat(Node::Element(0));
         let area = h.area(Node::Element(0));
-        for (radiosity, v, floor_area, opened) in [(3.9, 0.5, 0.0, true), (4.1, 0.5, 0.0, false), (3.9, 1.0, 0.0, false), (3.9, 0.0, 0.0, false), (3.9, 0.5, area, false)] {
+        for (radiosity, v, floor_area, opened) in [(15.9, 0.5, 0.0, true), (16.1, 0.5, 0.0, false), (15.9, 1.0, 0.0, false), (15.9, 0.0, 0.0, false), (15.9, 0.5, area, false)] {
             let x = radiosity * term;
             b[floor] = [0.5 * x, x, 0.25 * x];
             lamp.visibility = Some(v);
@@ -125,7 +140,7 @@ mod tests {
         h.exposure[0] = 0.5;
         lamp.visibility = Some(0.25);
         assert!((lamp.shadow_term(&h, 0, &b) - term).abs() < 1e-12);
-        b[floor] = [3.9 * term; 3];
+        b[floor] = [15.9 * term; 3];
         assert!(shadowed_leaves(&h, &[lamp], &b, 0.0).is_empty());
     }
 }
