@@ -193,12 +193,14 @@ fn a_wall_sees_the_contact_shadow_at_its_base_within_two_percent_per_leaf() {
 /// cm of the crease +3.29% on average (+7.37% with those leaves left
 /// whole; +26.77% with every part also taking what the wall sends the
 /// element's centroid, the leaves right at the crease +51% to +58%), the
-/// wall's within 2 cm of the base +2.03% (+2.89%; +7.84%).
+/// wall's within 2 cm of the base +2.03% (+2.89%; +7.84%). Since the last
+/// solve opens a leaf from a sixteenth of its radiosity, not a quarter:
+/// the floor +2.54%, the wall +1.91%; the floor's limit, 3%, holds that.
 #[test]
 fn the_parts_of_a_floor_element_at_a_crease_each_see_the_wall_for_themselves() {
     let both = errors("contact_shadow_crease", BRIGHT, &["floor", "wall"], &["--eps", "4e-4"]);
     let ((_, floor), (_, wall)) = (worst_and_crease(&both[0]), worst_and_crease(&both[1]));
     eprintln!("contact shadow, EPS 4e-4: floor within 2 cm of the crease {:+.2}%, wall {:+.2}% on average", 100.0 * floor, 100.0 * wall);
-    assert!(floor.abs() <= 0.05, "the floor's leaves along the crease are {:+.2}% off the reference on average", 100.0 * floor);
+    assert!(floor.abs() <= 0.03, "the floor's leaves along the crease are {:+.2}% off the reference on average", 100.0 * floor);
     assert!(wall.abs() <= 0.03, "the wall's leaves along its base are {:+.2}% off the reference on average", 100.0 * wall);
 }

@@ -55,7 +55,7 @@
 //! 0.55-0.96% (short block +0.70% on average, now +0.37%), at 5e-4
 //! 0.36-0.78% (now 0.31-0.54%); relative RMSE over seeds 1-5 at 4e-4
 //! 1.166% -> 1.046%, at 2.5e-4 0.897% -> 0.852%. In `contact_shadow.rs`
-//! at 4e-4 the crease's floor +3.1% -> +2.5%, its wall +2.1% -> +1.9%.
+//! at 4e-4 the crease's floor +3.3% -> +2.5%, its wall +2.0% -> +1.9%.
 //! An eighth left seed 3 at 0.73% at 6e-4; a thirty-second was about as
 //! accurate as a sixteenth (0.21-0.65%) for more time; opening two levels at once
 //! (the children that may split again) changed the short block by 0.07%.
