@@ -57,8 +57,9 @@
 //! 1.166% -> 1.046%, at 2.5e-4 0.897% -> 0.852%. In `contact_shadow.rs`
 //! at 4e-4 the crease's floor +3.3% -> +2.5%, its wall +2.0% -> +1.9%.
 //! An eighth left seed 3 at 0.73% at 6e-4; a thirty-second was about as
-//! accurate as a sixteenth (0.21-0.65%) for more time; opening two levels at once
-//! (the children that may split again) changed the short block by 0.07%.
+//! accurate as a sixteenth (0.21-0.65%) for more time; opening two levels
+//! at once (the children that may split again) changed the short block by
+//! 0.07%.
 //!
 //! **Not a leaf a solid stands on** (exposure under 1, [`crate::exposure`]):
 //! its links count the rays from the buried part as occluded, and its
@@ -129,7 +130,10 @@ mod tests {
         assert!((term - 0.5 * lamp.form_factor).abs() < 1e-12, "{term}");
         let floor = h.flat(Node::Element(0));
         let area = h.area(Node::Element(0));
-        for (radiosity, v, floor_area, opened) in [(15.9, 0.5, 0.0, true), (16.1, 0.5, 0.0, false), (15.9, 1.0, 0.0, false), (15.9, 0.0, 0.0, false), (15.9, 0.5, area, false)] {
+        // The leaf's radiosity as a multiple of the term: just under the
+        // threshold's, and just over.
+        let (under, over) = (1.0 / SHADOWED_LEAF - 0.1, 1.0 / SHADOWED_LEAF + 0.1);
+        for (radiosity, v, floor_area, opened) in [(under, 0.5, 0.0, true), (over, 0.5, 0.0, false), (under, 1.0, 0.0, false), (under, 0.0, 0.0, false), (under, 0.5, area, false)] {
             let x = radiosity * term;
             b[floor] = [0.5 * x, x, 0.25 * x];
             lamp.visibility = Some(v);
@@ -140,7 +144,7 @@ mod tests {
         h.exposure[0] = 0.5;
         lamp.visibility = Some(0.25);
         assert!((lamp.shadow_term(&h, 0, &b) - term).abs() < 1e-12);
-        b[floor] = [15.9 * term; 3];
+        b[floor] = [under * term; 3];
         assert!(shadowed_leaves(&h, &[lamp], &b, 0.0).is_empty());
     }
 }
