@@ -65,8 +65,14 @@ pub struct Group {
     pub centroid: [f32; 3],
     /// Total area of the group, m² (its opaque part under an alpha mask).
     pub area: f32,
-    /// The opaque fraction of `polygon`: 1, or less where an alpha mask
-    /// removes texels ([`Atlas::cover`]).
+    /// Area of `polygon`, m²: the group's size, masks and burial aside,
+    /// which decides how the receiver pass integrates it (a group mostly
+    /// buried is still as wide as its polygon).
+    pub extent: f32,
+    /// The group's opaque area over the nominal area of the texels that
+    /// `polygon` less `hidden` stands for ([`Atlas::cover`]): 1, less where
+    /// an alpha mask removes texels, or where buried texels have no
+    /// `hidden` part to leave them out.
     pub opaque: f32,
     /// The part of the triangle the group covers, mesh frame, m: its block
     /// of texels, `[gi g, (gi + 1) g] x [gj g, (gj + 1) g] / n` in
@@ -75,16 +81,25 @@ pub struct Group {
     pub polygon: [[f32; 3]; 5],
     /// Corners of `polygon` (3 to 5).
     pub corners: u32,
+    /// The buried part of `polygon` (under a solid standing on it), convex,
+    /// mesh frame, m; `hidden_corners` of them are used, none where the
+    /// group has no buried texel or its buried part is not convex
+    /// ([`crate::exposure::Burial::hide`]).
+    pub hidden: [[f32; 3]; HIDDEN_CORNERS],
+    /// Corners of `hidden` (0, or 3 to [`HIDDEN_CORNERS`]).
+    pub hidden_corners: u32,
 }
 
-/// The barycentric square `[u0, u1] x [v0, v1]` cut by the hypotenuse
-/// `u + v <= 1` (Sutherland-Hodgman against one line), counter-clockwise.
-pub fn block_polygon(u0: f64, u1: f64, v0: f64, v1: f64) -> Vec<[f64; 2]> {
-    let square = [[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
-    let inside = |p: [f64; 2]| 1.0 - p[0] - p[1];
-    let mut out = Vec::with_capacity(5);
-    for k in 0..4 {
-        let (a, b) = (square[k], square[(k + 1) % 4]);
+/// Most corners of a group's buried part ([`Group::hidden`]).
+pub const HIDDEN_CORNERS: usize = 8;
+
+/// `polygon` (barycentric, convex, counter-clockwise) cut to where
+/// `inside` is at least 0, `inside` affine (Sutherland-Hodgman against one
+/// line).
+fn clip(polygon: &[[f64; 2]], inside: impl Fn([f64; 2]) -> f64) -> Vec<[f64; 2]> {
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for k in 0..polygon.len() {
+        let (a, b) = (polygon[k], polygon[(k + 1) % polygon.len()]);
         let (da, db) = (inside(a), inside(b));
         if da >= 0.0 {
             out.push(a);
@@ -95,6 +110,43 @@ pub fn block_polygon(u0: f64, u1: f64, v0: f64, v1: f64) -> Vec<[f64; 2]> {
         }
     }
     out
+}
+
+/// The convex hull of `points`, counter-clockwise, collinear points
+/// dropped (Andrew's monotone chain), cut down to at most `most` corners
+/// by dropping, one at a time, the corner whose triangle with its two
+/// neighbours is smallest (the hull only shrinks).
+pub fn convex_hull(mut points: Vec<[f64; 2]>, most: usize) -> Vec<[f64; 2]> {
+    points.sort_by(|a, b| a.partial_cmp(b).expect("finite barycentrics"));
+    points.dedup();
+    if points.len() < 3 {
+        return points;
+    }
+    let turn = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * points.len());
+    for pass in [points.clone(), points.into_iter().rev().collect()] {
+        let start = hull.len();
+        for p in pass {
+            while hull.len() >= start + 2 && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    while hull.len() > most.max(3) {
+        let n = hull.len();
+        let corner = |k: usize| turn(hull[(k + n - 1) % n], hull[k], hull[(k + 1) % n]);
+        let smallest = (0..n).min_by(|&a, &b| corner(a).total_cmp(&corner(b))).expect("a corner");
+        hull.remove(smallest);
+    }
+    hull
+}
+
+/// The barycentric square `[u0, u1] x [v0, v1]` cut by the hypotenuse
+/// `u + v <= 1` (Sutherland-Hodgman against one line), counter-clockwise.
+pub fn block_polygon(u0: f64, u1: f64, v0: f64, v1: f64) -> Vec<[f64; 2]> {
+    clip(&[[u0, v0], [u1, v0], [u1, v1], [u0, v1]], |p| 1.0 - p[0] - p[1])
 }
 
 /// Per-triangle ranges into the texel and group lists.
@@ -254,7 +306,8 @@ pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, level: u32) -> Atlas {
                     for (slot, uv) in polygon.iter_mut().zip(&corners) {
                         *slot = geometry.point(*uv).as_vec3().to_array();
                     }
-                    groups.push(Group { first: start, count, centroid, area: (region.texel_area as f64 * area) as f32, opaque: 1.0, polygon, corners: corners.len() as u32 });
+                    let area = (region.texel_area as f64 * area) as f32;
+                    groups.push(Group { first: start, count, centroid, area, extent: area, opaque: 1.0, polygon, corners: corners.len() as u32, hidden: [[0.0; 3]; HIDDEN_CORNERS], hidden_corners: 0 });
                 }
             }
         }
@@ -273,19 +326,25 @@ impl Atlas {
     /// fraction `coverage[k]` of its area (0: it does not exist), and the
     /// groups of the triangles `masked` picks get their opaque area, its
     /// centroid (the area-weighted mean of their texels' points; a group
-    /// with nothing opaque keeps its own) and their opaque fraction. The
-    /// areas of a triangle then sum to `A n_o / n_c`, counted over
-    /// sub-samples of the texels ([`crate::detail`]).
+    /// with nothing opaque keeps its own) and their opaque fraction of
+    /// the polygon less its hidden part ([`crate::exposure::Burial::hide`],
+    /// called first). The areas of a triangle then sum to `A n_o / n_c`, counted
+    /// over sub-samples of the texels ([`crate::detail`]).
     pub fn cover(&mut self, coverage: &[f64], masked: &dyn Fn(usize) -> bool) {
         for (t, range) in self.triangles.iter().enumerate() {
             if !masked(t) {
                 continue;
             }
             for g in &mut self.groups[range.group_first as usize..(range.group_first + range.group_count) as usize] {
-                let (mut sum, mut area, mut nominal) = (DVec3::ZERO, 0.0f64, 0.0f64);
+                // `open`: the nominal area of the texels `polygon` less
+                // `hidden` stands for (the exposed ones where the group has
+                // a hidden part).
+                let (mut sum, mut area, mut open) = (DVec3::ZERO, 0.0f64, 0.0f64);
                 let range = g.first as usize..(g.first + g.count) as usize;
                 for (texel, &fraction) in self.texels[range.clone()].iter_mut().zip(&coverage[range]) {
-                    nominal += texel.area as f64;
+                    if g.hidden_corners == 0 || !texel.buried {
+                        open += texel.area as f64;
+                    }
                     texel.area = (texel.area as f64 * fraction) as f32;
                     sum += DVec3::from(texel.position.map(f64::from)) * texel.area as f64;
                     area += texel.area as f64;
@@ -294,7 +353,7 @@ impl Atlas {
                     g.centroid = (sum / area).as_vec3().to_array();
                 }
                 g.area = area as f32;
-                g.opaque = (area / nominal) as f32;
+                g.opaque = if open > 0.0 { (area / open) as f32 } else { 0.0 };
             }
         }
     }

@@ -10,6 +10,7 @@
 //! adapters (lavapipe vs a hardware GPU) differ in rounding (FMA
 //! contraction, rasterization rules) and agree only within tolerances.
 
+use crate::atlas::HIDDEN_CORNERS;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -178,8 +179,11 @@ pub struct GpuSample {
     pub shading: [f32; 4],
     /// xyz: the corners of the part of the shooter the group covers
     /// ([`crate::atlas::Group::polygon`]), m; w of the first: their number
-    /// (0 for a light).
+    /// (0 for a light), of the second: its area ([`crate::atlas::Group::extent`]).
     pub polygon: [[f32; 4]; 5],
+    /// xyz: the corners of its buried part ([`crate::atlas::Group::hidden`]),
+    /// m; w of the first: their number (0: none).
+    pub hidden: [[f32; 4]; HIDDEN_CORNERS],
 }
 
 /// Host mirror of `Selection` in solver.wgsl.

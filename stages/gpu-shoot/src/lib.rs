@@ -47,7 +47,7 @@ pub mod report;
 pub mod tiling;
 pub mod transmission;
 
-use atlas::Atlas;
+use atlas::{Atlas, HIDDEN_CORNERS};
 use detail::{Detail, TexelDetail};
 use glam::DVec3;
 use radiometry::geometry::frame_with_normal;
@@ -367,7 +367,7 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
     };
     let detail_of = |k: usize| details.get(k).copied().flatten();
     let masks = detail.as_ref().filter(|d| d.masked(mesh));
-    let (buried, burial_rays) = c.burial.texels(&atlas, tiles);
+    let (buried, mut burial_rays) = c.burial.texels(&atlas, tiles);
     if masks.is_some() || buried.contains(&true) {
         let mut has_buried = vec![false; mesh.triangles.len()];
         for (texel, _) in atlas.texels.iter().zip(&buried).filter(|(_, b)| **b) {
@@ -377,6 +377,7 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
         for (texel, &b) in atlas.texels.iter_mut().zip(&buried) {
             texel.buried = b;
         }
+        burial_rays += c.burial.hide(&mut atlas, mesh, tiles, &buried);
         atlas.cover(&coverage, &|t| has_buried[t] || masks.is_some_and(|d| d.mask(mesh, t).is_some()));
     }
     let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
@@ -505,6 +506,9 @@ fn samples_of(b: &Built, mesh: &Mesh, tiles: &[Tile], shooter: usize, offset: f6
             let c = DVec3::from(g.centroid.map(f64::from)) + n * offset;
             let mut polygon = g.polygon.map(|p| [p[0], p[1], p[2], 0.0]);
             polygon[0][3] = g.corners as f32;
+            polygon[1][3] = g.extent;
+            let mut hidden = g.hidden.map(|p| [p[0], p[1], p[2], 0.0]);
+            hidden[0][3] = g.hidden_corners as f32;
             GpuSample {
                 position_area: [c.x as f32, c.y as f32, c.z as f32, g.area],
                 t: f4(t.to_array()),
@@ -513,6 +517,7 @@ fn samples_of(b: &Built, mesh: &Mesh, tiles: &[Tile], shooter: usize, offset: f6
                 power: [0.0; 4],
                 shading: [shading.x as f32, shading.y as f32, shading.z as f32, g.opaque],
                 polygon,
+                hidden,
             }
         })
         .collect()
@@ -667,6 +672,7 @@ pub fn solve(
             power: [i, i, i, 1.0],
             shading: [0.0; 4],
             polygon: [[0.0; 4]; 5],
+            hidden: [[0.0; 4]; HIDDEN_CORNERS],
         };
         built.gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
         let p = GpuParams { shooter: u32::MAX, sample_first: 0, sample_count: 1, layers_per_sample: 6, mode: 0, ..base };

@@ -190,6 +190,7 @@ pub fn virtual_sample(s: &GpuSample, window: &Window) -> GpuSample {
         power: s.power,
         shading: vector(s.shading),
         polygon: s.polygon.map(point),
+        hidden: s.hidden.map(point),
     }
 }
 

@@ -60,7 +60,8 @@ pub fn texel_patch(position: DVec3, half_u: DVec3, half_v: DVec3, hypotenuse: bo
 }
 
 /// Near field of the receiver pass: a receiver nearer than
-/// `sqrt(NEAR_FIELD (A_r + A_s))` gets the exact point-to-patch factor.
+/// `sqrt(NEAR_FIELD (A_r + A_s))` (`A_s` the sample's extent) gets the exact
+/// point-to-patch factor.
 /// Beyond it the disc approximation's loss `A_s / (pi d^2 + A_s)` is below
 /// `1 / (100 pi) = 0.3%` of the pair's share, and the point-to-patch factor
 /// differs from the point-to-point one by `O(A_r / d^2)`, so the closed box
@@ -88,9 +89,15 @@ pub const RECIPROCAL: f64 = 16.0;
 /// of polygons that tile a hemisphere sum to 1, 004 Eq. 2.3) and the
 /// smaller one taken as a point:
 ///
+/// A sample's size in these two choices is its polygon's area (`extent`),
+/// not its exposed area `A_s`: a floor group mostly buried under a block,
+/// taken as the point of its exposed texels, gave the block's lowest
+/// texels up to 1.8 times Lambert's value.
+///
 /// - sample over [`RECIPROCAL`] times the texel (a group of texels):
-///   `F(receiver -> sender.polygon)`, the irradiance a uniform polygon
-///   gives the texel's point (reciprocity). The group's centroid as a
+///   `F(receiver -> sender.polygon) - F(receiver -> sender.hidden)`, the
+///   irradiance a uniform polygon less its buried part gives the texel's
+///   point (reciprocity). The group's centroid as a
 ///   point put the power of the group's near part half a group away: the
 ///   texels next to a shared edge were off by up to +-90% in the period of
 ///   the groups (issue 10, item 7).
@@ -113,17 +120,19 @@ pub fn area_transfer(receiver: DVec3, receiver_normal: DVec3, a_r: f64, patch: &
     if d2 <= 0.0 || sender.normal.dot(receiver - sender.polygon[0]) <= 0.0 {
         return 0.0;
     }
-    let reciprocal = d2 < NEAR_FIELD * (a_r + sender.area) && sender.area > RECIPROCAL * a_r;
+    let near = d2 < NEAR_FIELD * (a_r + sender.extent);
+    let reciprocal = near && sender.extent > RECIPROCAL * a_r;
     // Behind the receiver's plane only a sample taken by reciprocity
     // counts, for its part in front (the clip in point_to_polygon).
     if -receiver_normal.dot(v) / d <= 0.0 && !reciprocal {
         return 0.0;
     }
-    if d2 >= NEAR_FIELD * (a_r + sender.area) {
+    if !near {
         return disc_form_factor(receiver, receiver_normal, sender.point, sender.normal, sender.area);
     }
     if reciprocal {
-        return point_to_polygon(receiver, receiver_normal, sender.polygon);
+        let hidden = if sender.hidden.is_empty() { 0.0 } else { point_to_polygon(receiver, receiver_normal, sender.hidden) };
+        return (point_to_polygon(receiver, receiver_normal, sender.polygon) - hidden).max(0.0);
     }
     sender.area * point_to_polygon(sender.point, sender.normal, patch) / a_r
 }
@@ -137,8 +146,13 @@ pub struct AreaSample<'a> {
     pub normal: DVec3,
     /// Its area, m².
     pub area: f64,
+    /// Its polygon's area, m² ([`crate::atlas::Group::extent`]), which
+    /// decides near and far, and reciprocity.
+    pub extent: f64,
     /// The part of the shooter it stands for ([`crate::atlas::Group::polygon`]).
     pub polygon: &'a [DVec3],
+    /// Its buried part ([`crate::atlas::Group::hidden`]; empty: none).
+    pub hidden: &'a [DVec3],
 }
 
 /// The patch of covered texel `k` of `atlas` ([`texel_patch`] with its

@@ -30,7 +30,8 @@ struct Sample {
     n: vec4<f32>,        // frame: normal (light: n0, the nadir)
     power: vec4<f32>,    // rgb: unshot radiosity dB of the group, W/m^2 (light: I_max, W/sr); w: kind
     shading: vec4<f32>,  // xyz: the group's normal for its cosine (normal map; else n); w: opaque fraction of its polygon
-    polygon: array<vec4<f32>, 5>, // xyz: corners of the group's part of the shooter, m; [0].w: their number
+    polygon: array<vec4<f32>, 5>, // xyz: corners of the group's part of the shooter, m; [0].w: their number; [1].w: its area (extent), m^2
+    hidden: array<vec4<f32>, 8>,  // xyz: corners of its buried part (HIDDEN_CORNERS), m; [0].w: their number (0: none)
 };
 
 // Which cube face looks along which axis of the sample frame, and the

@@ -410,11 +410,11 @@ fn ldt_lookup(c_deg: f32, gamma: f32) -> f32 {
 const NEAR_FIELD: f32 = 100.0;
 
 // Form factor from a differential area at the origin with normal n to the
-// polygon corners[0..count] (relative to that area), clipped to its
+// convex polygon corners[0..count] (relative to that area), clipped to its
 // hemisphere: Lambert's contour formula, mirrors
 // radiometry::form_factor::point_to_polygon.
-fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 5>, count: u32) -> f32 {
-    var clipped: array<vec3<f32>, 6>;
+fn polygon_form_factor(n: vec3<f32>, corners: array<vec3<f32>, 8>, count: u32) -> f32 {
+    var clipped: array<vec3<f32>, 9>;
     var m = 0u;
     for (var k = 0u; k < count; k += 1u) {
         let a = corners[k];
@@ -447,12 +447,16 @@ fn patch_area(k: u32) -> f32 {
     return a;
 }
 
+// Whether texel k at squared distance d2 is in the near field of area
+// sample s (by the sample's extent, area_transfer).
+fn near(k: u32, s: Sample, d2: f32) -> bool {
+    return d2 < NEAR_FIELD * (patch_area(k) + s.polygon[1].w);
+}
+
 // Whether texel k takes area sample s, at squared distance d2, by
 // reciprocity.
 fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
-    let a_r = patch_area(k);
-    let a_s = s.position.w;
-    return d2 < NEAR_FIELD * (a_r + a_s) && a_s > RECIPROCAL * a_r;
+    return near(k, s, d2) && s.polygon[1].w > RECIPROCAL * patch_area(k);
 }
 
 // Irradiance per unit radiosity of the area sample s on the receiving
@@ -460,8 +464,13 @@ fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
 // mirrors reference::area_transfer. Far: the disc approximation. Near, the
 // larger of the two patches is integrated exactly (Lambert's formula) and
 // the smaller one taken as a point:
-//   sample over RECIPROCAL texels:  H = F(p -> sample's polygon)  (reciprocity)
+//   sample over RECIPROCAL texels:  H = F(p -> sample's polygon) - F(p -> its
+//                                   buried part)  (reciprocity)
 //   otherwise:      H = A_s F(s -> texel's patch) / A_r
+// A sample's size here is its polygon's area (atlas::Group::extent), not
+// its exposed area A_s: a floor group mostly buried under a block, taken
+// as the point of its exposed texels, gave the block's lowest texels up to
+// 1.8 times Lambert's value.
 // A group of 8 x 8 texels taken as its centroid misplaced the power of its
 // near part by half a group, +-90% on the texels next to a shared edge
 // (issue 10, item 7), and a texel patch much smaller than its distance
@@ -474,15 +483,22 @@ fn reciprocal(k: u32, s: Sample, d2: f32) -> bool {
 fn area_transfer(k: u32, p: vec3<f32>, nr: vec3<f32>, ns: vec3<f32>, s: Sample, d2: f32, cos_s: f32, cos_r: f32) -> f32 {
     let a_r = patch_area(k);
     let a_s = s.position.w;
-    if (d2 >= NEAR_FIELD * (a_r + a_s)) {
+    if (!near(k, s, d2)) {
         // 004 Eq. 2.2 / 4.1 with one disc per sample.
         return a_s * cos_s * cos_r / (PI * d2 + a_s);
     }
-    var corners: array<vec3<f32>, 5>;
+    var corners: array<vec3<f32>, 8>;
     if (reciprocal(k, s, d2)) {
+        // The group's polygon less its buried part (atlas::Group::hidden).
         let m = u32(s.polygon[0].w);
         for (var c = 0u; c < m; c += 1u) { corners[c] = s.polygon[c].xyz - p; }
-        return s.shading.w * polygon_form_factor(ns, corners, m);
+        var f = polygon_form_factor(ns, corners, m);
+        let h = u32(s.hidden[0].w);
+        if (h > 0u) {
+            for (var c = 0u; c < h; c += 1u) { corners[c] = s.hidden[c].xyz - p; }
+            f = max(f - polygon_form_factor(ns, corners, h), 0.0);
+        }
+        return s.shading.w * f;
     }
     let tri = tris[bitcast<u32>(texels[k].normal.w)];
     let a = tri.half_u.xyz;
