@@ -184,6 +184,9 @@ pub struct GpuSample {
     /// xyz: the corners of its buried part ([`crate::atlas::Group::hidden`]),
     /// m; w of the first: their number (0: none).
     pub hidden: [[f32; 4]; HIDDEN_CORNERS],
+    /// The group's quadrants, written by the GPU (`prepare_samples`):
+    /// their centroids and areas, and their unshot power about the mean.
+    pub quadrants: [[f32; 4]; 8],
 }
 
 /// Host mirror of `Selection` in solver.wgsl.

@@ -518,6 +518,7 @@ fn samples_of(b: &Built, mesh: &Mesh, tiles: &[Tile], shooter: usize, offset: f6
                 shading: [shading.x as f32, shading.y as f32, shading.z as f32, g.opaque],
                 polygon,
                 hidden,
+                quadrants: [[0.0; 4]; 8],
             }
         })
         .collect()
@@ -673,6 +674,7 @@ pub fn solve(
             shading: [0.0; 4],
             polygon: [[0.0; 4]; 5],
             hidden: [[0.0; 4]; HIDDEN_CORNERS],
+            quadrants: [[0.0; 4]; 8],
         };
         built.gpu.upload_samples(queue, &[sample], Some(&light_table(light)));
         let p = GpuParams { shooter: u32::MAX, sample_first: 0, sample_count: 1, layers_per_sample: 6, mode: 0, ..base };

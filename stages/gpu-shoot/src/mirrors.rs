@@ -191,6 +191,8 @@ pub fn virtual_sample(s: &GpuSample, window: &Window) -> GpuSample {
         shading: vector(s.shading),
         polygon: s.polygon.map(point),
         hidden: s.hidden.map(point),
+        // Read only by the receiver pass of the shot itself (variation).
+        quadrants: [[0.0; 4]; 8],
     }
 }
 

@@ -32,6 +32,7 @@ struct Sample {
     shading: vec4<f32>,  // xyz: the group's normal for its cosine (normal map; else n); w: opaque fraction of its polygon
     polygon: array<vec4<f32>, 5>, // xyz: corners of the group's part of the shooter, m; [0].w: their number; [1].w: its area (extent), m^2
     hidden: array<vec4<f32>, 8>,  // xyz: corners of its buried part (HIDDEN_CORNERS), m; [0].w: their number (0: none)
+    quadrants: array<vec4<f32>, 8>, // the group's quadrants about its point (prepare_samples): [2q] xyz their centroid, m, w area, m^2; [2q+1] xyz sum A (dB - mean), W
 };
 
 // Which cube face looks along which axis of the sample frame, and the
