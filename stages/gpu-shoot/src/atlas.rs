@@ -377,6 +377,18 @@ mod tests {
     }
 
     #[test]
+    fn the_hull_keeps_the_extreme_points_counter_clockwise_and_sheds_its_smallest_corner() {
+        let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let mut points = vec![[0.5, 0.5], [0.5, 0.0], [0.25, 0.75]];
+        points.extend(square.iter().rev());
+        assert_eq!(convex_hull(points.clone(), 8), square.to_vec());
+        // A fifth corner barely outside the square's top edge goes first.
+        points.push([0.5, 1.01]);
+        assert_eq!(convex_hull(points.clone(), 8).len(), 5);
+        assert_eq!(convex_hull(points, 4), square.to_vec());
+    }
+
+    #[test]
     fn texel_areas_sum_to_triangle_areas_and_regions_do_not_overlap() {
         let (mesh, manifest) = two_triangle_mesh();
         let atlas = bake(&mesh, &manifest, 2000.0, 2, 256, 2);

@@ -90,9 +90,10 @@ impl Burial {
     /// lowest texels see (the hull of the texels' squares left them 5-19%
     /// dark), while one that stopped at the buried points let the rim
     /// beyond them shoot (the cube's faces received 1% more than the floor
-    /// shot). That hull is the buried part where one convex solid buries
-    /// it (a block standing on a floor); where an exposed texel's point
-    /// lies inside it (two solids, a concave one) the group keeps no hidden
+    /// shot). That hull, cut to [`HIDDEN_CORNERS`] corners by dropping its
+    /// smallest ones, is the buried part where one convex solid buries it
+    /// (a block standing on a floor); where an exposed texel's point lies
+    /// inside it (two solids, a concave one) the group keeps no hidden
     /// part, and shoots its polygon's light scaled by its exposed fraction
     /// (`Group::opaque`), as before.
     pub fn hide(&self, atlas: &mut Atlas, mesh: &Mesh, tiles: &[Tile], buried: &[bool]) -> u64 {
