@@ -93,23 +93,10 @@ pub struct Group {
 /// Most corners of a group's buried part ([`Group::hidden`]).
 pub const HIDDEN_CORNERS: usize = 8;
 
-/// `polygon` (barycentric, convex, counter-clockwise) cut to where
-/// `inside` is at least 0, `inside` affine (Sutherland-Hodgman against one
-/// line).
-fn clip(polygon: &[[f64; 2]], inside: impl Fn([f64; 2]) -> f64) -> Vec<[f64; 2]> {
-    let mut out = Vec::with_capacity(polygon.len() + 1);
-    for k in 0..polygon.len() {
-        let (a, b) = (polygon[k], polygon[(k + 1) % polygon.len()]);
-        let (da, db) = (inside(a), inside(b));
-        if da >= 0.0 {
-            out.push(a);
-        }
-        if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
-            let t = da / (da - db);
-            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
-        }
-    }
-    out
+/// Twice the signed area of the triangle `o`, `a`, `b`: positive where
+/// `b` lies left of the line from `o` to `a` (a counter-clockwise turn).
+pub fn turn(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 }
 
 /// The convex hull of `points`, counter-clockwise, collinear points
@@ -122,7 +109,6 @@ pub fn convex_hull(mut points: Vec<[f64; 2]>, most: usize) -> Vec<[f64; 2]> {
     if points.len() < 3 {
         return points;
     }
-    let turn = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
     let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * points.len());
     for pass in [points.clone(), points.into_iter().rev().collect()] {
         let start = hull.len();
@@ -146,7 +132,21 @@ pub fn convex_hull(mut points: Vec<[f64; 2]>, most: usize) -> Vec<[f64; 2]> {
 /// The barycentric square `[u0, u1] x [v0, v1]` cut by the hypotenuse
 /// `u + v <= 1` (Sutherland-Hodgman against one line), counter-clockwise.
 pub fn block_polygon(u0: f64, u1: f64, v0: f64, v1: f64) -> Vec<[f64; 2]> {
-    clip(&[[u0, v0], [u1, v0], [u1, v1], [u0, v1]], |p| 1.0 - p[0] - p[1])
+    let square = [[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
+    let inside = |p: [f64; 2]| 1.0 - p[0] - p[1];
+    let mut out = Vec::with_capacity(5);
+    for k in 0..4 {
+        let (a, b) = (square[k], square[(k + 1) % 4]);
+        let (da, db) = (inside(a), inside(b));
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
+            let t = da / (da - db);
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        }
+    }
+    out
 }
 
 /// Per-triangle ranges into the texel and group lists.

@@ -14,7 +14,7 @@
 //! -2.2%, ceiling -1.2% -> -0.8%, back wall -0.6% -> -0.4%. A group
 //! partly buried shoots its polygon less its buried part ([`Burial::hide`]).
 
-use crate::atlas::{convex_hull, texel_point, Atlas, HIDDEN_CORNERS};
+use crate::atlas::{convex_hull, texel_point, turn, Atlas, HIDDEN_CORNERS};
 use crate::tiling::Tile;
 use glam::DVec3;
 use radiometry::burial::buried;
@@ -136,12 +136,7 @@ impl Burial {
                     }
                 }
                 let part = convex_hull(points, HIDDEN_CORNERS);
-                let within = |p: [f64; 2]| {
-                    (0..part.len()).all(|k| {
-                        let (a, b) = (part[k], part[(k + 1) % part.len()]);
-                        (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 0.0
-                    })
-                };
+                let within = |p: [f64; 2]| (0..part.len()).all(|k| turn(part[k], part[(k + 1) % part.len()], p) > 0.0);
                 if part.len() < 3 || open.into_iter().any(|k| within(point(k))) {
                     continue;
                 }

@@ -212,7 +212,9 @@ fn prepare_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     samples[id.x].power = vec4<f32>(mean + selection.overshoot.xyz, 0.0);
     // Its quadrants about its point, along the sample frame's axes, for the
     // variation beyond SQUARES (quadrant_variation).
-    let s = samples[id.x];
+    let origin = samples[id.x].position.xyz;
+    let t = samples[id.x].t.xyz;
+    let b = samples[id.x].b.xyz;
     var q_area = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
     var q_point = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     var q_power = array<vec3<f32>, 4>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
@@ -221,8 +223,8 @@ fn prepare_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         if (a <= 0.0) { continue; }
         let x = texels[g.first + k].position.xyz;
         var q = 0u;
-        if (dot(x - s.position.xyz, s.t.xyz) >= 0.0) { q += 1u; }
-        if (dot(x - s.position.xyz, s.b.xyz) >= 0.0) { q += 2u; }
+        if (dot(x - origin, t) >= 0.0) { q += 1u; }
+        if (dot(x - origin, b) >= 0.0) { q += 2u; }
         q_area[q] += a;
         q_point[q] += x * a;
         q_power[q] += (residual[g.first + k].xyz - mean) * a;
@@ -764,11 +766,14 @@ fn irradiance(k: u32) -> vec3<f32> {
             h += s.power.xyz * ldt_lookup(c, gamma) * cos_r / d2;
         } else {
             h += s.power.xyz * area_transfer(k, p, nr, ns, s, d2, cos_s, cos_r);
-            if (reciprocal(k, s, d2) && d2 < SQUARES * s.polygon[1].w) {
-                let g = tris[params.shooter].group_first + params.sample_first + i;
-                h += variation(p, ns, g, s.power.xyz - selection.overshoot.xyz);
-            } else if (reciprocal(k, s, d2) && d2 < VARIATION * s.polygon[1].w) {
-                h += quadrant_variation(p, ns, s);
+            if (reciprocal(k, s, d2)) {
+                let extent = s.polygon[1].w;
+                if (d2 < SQUARES * extent) {
+                    let g = tris[params.shooter].group_first + params.sample_first + i;
+                    h += variation(p, ns, g, s.power.xyz - selection.overshoot.xyz);
+                } else if (d2 < VARIATION * extent) {
+                    h += quadrant_variation(p, ns, s);
+                }
             }
         }
     }
