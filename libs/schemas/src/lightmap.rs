@@ -119,6 +119,55 @@ fn image_channel3(values: &[[f32; 3]], names: [&str; 3], meaning: &str) -> Vec<C
 }
 
 impl Lightmap {
+    /// Bilinear lookup of radiosity at barycentric `uv` of region `t`
+    /// (triangle `t` of the mesh the lightmap was made of): the four
+    /// texels around the point, in the region's texel grid (interior texel
+    /// `i` centred at `u = (i + 1/2) / size`, [`Region::uv`]).
+    ///
+    /// In region pixels (gutter included) interior texel `i` is pixel `i +
+    /// 1`, so `u` lies at pixel coordinate `f = u size + 1/2` measured from
+    /// the centre of pixel 0: `u = (i + 1/2) / size` gives `f = i + 1`, that
+    /// texel's own value. (The lookup used to subtract another half pixel,
+    /// which read every point half a texel down both axes: gpu-shoot's
+    /// solution elements were shifted a texel diagonal's half from the
+    /// lightmap, 5.4% off Lambert's formula under a tilted emitter where the
+    /// texels were within 1.2%; issue 10, item 7.)
+    pub fn radiosity_at(&self, t: usize, uv: [f64; 2]) -> [f64; 3] {
+        self.lookup(&self.radiosity, t, uv)
+    }
+
+    /// [`Lightmap::radiosity_at`] of `values` (the radiosity or the
+    /// residual), over the texels that hold a value (covered or filled),
+    /// their weights renormalised; 0 where none of the four does.
+    ///
+    /// A texel buried inside a solid holds none: gpu-shoot's seam fill
+    /// extrapolates into it from the exposed texels beside it as it does
+    /// beyond a triangle's edge. Read as a covered texel of radiosity 0, it
+    /// darkened every lookup within a texel of a block's footprint, and the
+    /// floor along the blocks' bases showed a dark band in gpu-shoot's
+    /// preview.
+    pub fn lookup(&self, values: &[[f32; 3]], t: usize, uv: [f64; 2]) -> [f64; 3] {
+        let r = self.regions[t];
+        let n = r.size as f64;
+        let fx = (uv[0] * n + 0.5).clamp(0.0, n + 1.0);
+        let fy = (uv[1] * n + 0.5).clamp(0.0, n + 1.0);
+        let (ix, iy) = (fx.floor().min(n), fy.floor().min(n));
+        let (tx, ty) = (fx - ix, fy - iy);
+        let (mut sum, mut weight) = ([0.0; 3], 0.0);
+        for (dx, dy, w) in [(0.0, 0.0, (1.0 - tx) * (1.0 - ty)), (1.0, 0.0, tx * (1.0 - ty)), (0.0, 1.0, (1.0 - tx) * ty), (1.0, 1.0, tx * ty)] {
+            let k = (r.y as usize + (iy + dy) as usize) * self.width + r.x as usize + (ix + dx) as usize;
+            if self.coverage[k] != 0.0 {
+                (0..3).for_each(|c| sum[c] += w * f64::from(values[k][c]));
+                weight += w;
+            }
+        }
+        if weight > 0.0 {
+            sum.map(|v| v / weight)
+        } else {
+            [0.0; 3]
+        }
+    }
+
     /// Writes `lightmap.exr`: image layer `atlas` and table layer `region`.
     pub fn write(&self, path: &Path) -> Result<()> {
         let n = self.width * self.height;

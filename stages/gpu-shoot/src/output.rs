@@ -185,54 +185,6 @@ pub fn lightmap_of(a: &Atlas, radiosity: &[[f32; 3]], residual: &[[f32; 3]], mes
     lm
 }
 
-/// Bilinear lookup of radiosity at barycentric `uv` of triangle `t`: the
-/// four texels around the point, in the region's texel grid (interior
-/// texel `i` centred at `u = (i + 1/2) / size`, [`schemas::lightmap::Region::uv`]).
-///
-/// In region pixels (gutter included) interior texel `i` is pixel `i + 1`,
-/// so `u` lies at pixel coordinate `f = u size + 1/2` measured from the
-/// centre of pixel 0: `u = (i + 1/2) / size` gives `f = i + 1`, that
-/// texel's own value. (The lookup used to subtract another half pixel,
-/// which read every point half a texel down both axes: the solution's
-/// elements were shifted a texel diagonal's half from the lightmap, 5.4%
-/// off Lambert's formula under a tilted emitter where the texels were
-/// within 1.2%; issue 10, item 7.)
-pub fn bilinear(lm: &Lightmap, t: usize, uv: [f64; 2]) -> [f64; 3] {
-    bilinear_of(lm, &lm.radiosity, t, uv)
-}
-
-/// [`bilinear`] of `values` (the lightmap's radiosity or residual), over
-/// the texels that hold a value (covered or filled), their weights
-/// renormalised; 0 where none of the four does.
-///
-/// A texel buried inside a solid ([`crate::atlas::Texel::buried`]) holds
-/// none: [`fill_seams`] extrapolates into it from the exposed texels
-/// beside it as it does beyond a triangle's edge. Read as a covered texel of radiosity
-/// 0, it darkened every lookup within a texel of a block's footprint, and
-/// the floor along the blocks' bases showed a dark band in gpu-shoot's
-/// preview.
-pub fn bilinear_of(lm: &Lightmap, values: &[[f32; 3]], t: usize, uv: [f64; 2]) -> [f64; 3] {
-    let r = lm.regions[t];
-    let n = r.size as f64;
-    let fx = (uv[0] * n + 0.5).clamp(0.0, n + 1.0);
-    let fy = (uv[1] * n + 0.5).clamp(0.0, n + 1.0);
-    let (ix, iy) = (fx.floor().min(n), fy.floor().min(n));
-    let (tx, ty) = (fx - ix, fy - iy);
-    let (mut sum, mut weight) = ([0.0; 3], 0.0);
-    for (dx, dy, w) in [(0.0, 0.0, (1.0 - tx) * (1.0 - ty)), (1.0, 0.0, tx * (1.0 - ty)), (0.0, 1.0, (1.0 - tx) * ty), (1.0, 1.0, tx * ty)] {
-        let k = (r.y as usize + (iy + dy) as usize) * lm.width + r.x as usize + (ix + dx) as usize;
-        if lm.coverage[k] != 0.0 {
-            (0..3).for_each(|c| sum[c] += w * f64::from(values[k][c]));
-            weight += w;
-        }
-    }
-    if weight > 0.0 {
-        sum.map(|v| v / weight)
-    } else {
-        [0.0; 3]
-    }
-}
-
 /// Whether barycentric `uv` of region `t` lies in a buried texel (one of
 /// the triangle's texels that holds no value of its own,
 /// [`crate::atlas::Texel::buried`]).
@@ -267,7 +219,7 @@ pub fn copy_down(old: &Lightmap, old_tiles: &[Tile], atlas: &Atlas, tiles: &[Til
                 return (old.radiosity[k].map(f64::from), old.residual[k].map(f64::from));
             }
             let at = from_root(&old_tiles[o].corners, to_root(&tiles[t].corners, texel_point(atlas.regions[t], i, j)));
-            (bilinear_of(old, &old.radiosity, o, at), bilinear_of(old, &old.residual, o, at))
+            (old.lookup(&old.radiosity, o, at), old.lookup(&old.residual, o, at))
         })
         .collect();
     // Power per old tile that was split: in the old lightmap, and copied.
@@ -418,7 +370,7 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile],
                     continue;
                 }
                 exposed += 1;
-                for (s, v) in sum.iter_mut().zip(bilinear(lm, tile, uv)) {
+                for (s, v) in sum.iter_mut().zip(lm.radiosity_at(tile, uv)) {
                     *s += v;
                 }
             }
