@@ -36,20 +36,22 @@ $(GPU_OUT)/solution.exr $(GPU_OUT)/lightmap.exr &: $(BIN)/gpu-shoot $(GPU_OUT)/p
 	  -o $(GPU_OUT)/solution.exr --lightmap $(GPU_OUT)/lightmap.exr --convergence-log $(GPU_OUT)/convergence.ron \
 	  --plot $(GPU_OUT)/convergence.svg --report $(GPU_OUT)/gpu-shoot.report.ron
 
-# preview(solution, image, report): grid-gather's preview of a solution of
-# the prepared scene, with its surface detail as hierarchical.mk passes it
-# (read only for a scene with textures, alpha masks or normal maps: the
-# display modulates the element's irradiance by the texture per hit, taking
-# as the element's reflectance the texture average where the solver read
-# surface.exr, as gpu-shoot does, else the material's). photon.mk uses it
-# too (the pipelines are included in name order).
+# preview(solution, image, report[, lightmap]): grid-gather's preview of a
+# solution of the prepared scene, with its surface detail as
+# hierarchical.mk passes it (read only for a scene with textures, alpha
+# masks or normal maps: the display modulates the element's irradiance by
+# the texture per hit, taking as the element's reflectance the texture
+# average where the solver read surface.exr, as gpu-shoot does, else the
+# material's), showing gpu-shoot's lightmap where one is given (README,
+# gpu-shoot). photon.mk uses it too (the pipelines are included in name
+# order).
 define preview
-$(2): $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(1)
+$(2): $(BIN)/grid-gather $(OUT)/params/grid-gather.ron $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(1) $(4)
 	$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview \
-	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr --solution $(1) -o $$@ --report $(3)
+	  --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr --solution $(1) $(if $(4),--lightmap $(4)) -o $$@ --report $(3)
 endef
 
-$(eval $(call preview,$(GPU_OUT)/solution.exr,$(GPU_OUT)/preview.exr,$(GPU_OUT)/gather.report.ron))
+$(eval $(call preview,$(GPU_OUT)/solution.exr,$(GPU_OUT)/preview.exr,$(GPU_OUT)/gather.report.ron,$(GPU_OUT)/lightmap.exr))
 
 $(GPU_OUT)/image.png: $(BIN)/tonemap $(OUT)/params/tonemap.ron $(GPU_OUT)/preview.exr
 	$(BIN)/tonemap --params $(OUT)/params/tonemap.ron $(GPU_OUT)/preview.exr -o $@ --report $(GPU_OUT)/tonemap.report.ron

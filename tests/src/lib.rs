@@ -155,3 +155,38 @@ pub fn solve_prepared(dir: &Path, solve_args: &[&str], leaf_size: Option<u32>) -
     run_ok("hierarchical-solve", &args);
     solution
 }
+
+/// The world points a pinhole camera sees on the plane z = 0 through an
+/// `n x n` grid of points inside pixel `(x, y)` of a `width` x `height`
+/// image (pixel `(0, 0)` top left; the manifest's camera, mesh frame, with
+/// `origin` the world position of the mesh frame's origin): the camera
+/// model written out here from the manifest's fields, not the renderer's.
+pub fn pixel_points_on_ground(manifest: &Manifest, width: u32, height: u32, x: u32, y: u32, n: u32) -> Vec<[f64; 3]> {
+    let c = &manifest.camera;
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let unit = |a: [f64; 3]| {
+        let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        a.map(|v| v / l)
+    };
+    let forward = unit(sub(c.target, c.eye));
+    let right = unit(cross(forward, c.up));
+    let up = cross(right, forward);
+    let half_h = (0.5 * c.vertical_fov_deg.to_radians()).tan();
+    let half_w = half_h * f64::from(width) / f64::from(height);
+    let origin = manifest.world_from_mesh_translation;
+    let eye: [f64; 3] = std::array::from_fn(|a| c.eye[a] + origin[a]);
+    let mut points = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let px = f64::from(x) + (f64::from(i) + 0.5) / f64::from(n);
+            let py = f64::from(y) + (f64::from(j) + 0.5) / f64::from(n);
+            let sx = (2.0 * px / f64::from(width) - 1.0) * half_w;
+            let sy = (1.0 - 2.0 * py / f64::from(height)) * half_h;
+            let d: [f64; 3] = std::array::from_fn(|a| forward[a] + sx * right[a] + sy * up[a]);
+            let t = -eye[2] / d[2];
+            points.push(std::array::from_fn(|a| eye[a] + t * d[a]));
+        }
+    }
+    points
+}

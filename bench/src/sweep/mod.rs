@@ -281,6 +281,11 @@ pub fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solve
         args.extend(config.width.map(|w| format!("--width={w}")));
         args.extend(config.height.map(|h| format!("--height={h}")));
     }
+    // gpu-shoot's lightmap, which its preview shows (README, gpu-shoot).
+    let lightmap = (solver == Solver::Gpu).then(|| dir.join("lightmap.exr"));
+    if let Some(lightmap) = &lightmap {
+        args.extend(["--lightmap".into(), s(lightmap)]);
+    }
     args.extend(solve_flags(solver, setting, seeds.0));
     let solve_report = stages.run(solver.stage(), &args, &dir.join("solve.report.ron"))?;
     solve_stages.push((solver.stage().to_string(), solve_report.wall_time_s));
@@ -296,6 +301,9 @@ pub fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solve
         args.extend(["--solution".into(), s(&solution), "-o".into(), s(&image)]);
         if let Some(clusters) = &clusters {
             args.extend(["--clusters".into(), s(clusters)]);
+        }
+        if let Some(lightmap) = lightmap.as_ref().filter(|_| gather == Gather::Preview) {
+            args.extend(["--lightmap".into(), s(lightmap)]);
         }
         args.extend(gather_flags(config, gather, setting, seeds.1));
         let report = stages.run("grid-gather", &args, &dir.join(format!("{}.report.ron", gather.name())))?;

@@ -9,11 +9,12 @@ use schemas::cluster::Clusters;
 use schemas::diagnostics::{Diagnostics, GatherDiagnostics};
 use schemas::header::{Input, Schema};
 use schemas::image::HdrImage;
+use schemas::lightmap::Lightmap;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Solution;
 use schemas::surface::Surface;
 use schemas::threshold::ThresholdImage;
-use schemas::Result;
+use schemas::{Error, Result};
 use stage_kit::run::{read_surface, Outputs, Run};
 use stage_kit::stage::Done;
 use std::path::Path;
@@ -30,6 +31,8 @@ pub struct Given<'a> {
     pub threshold: Option<&'a Path>,
     /// mesh-prep's surface artifact.
     pub surface: Option<&'a Path>,
+    /// gpu-shoot's lightmap of the run that wrote the solution.
+    pub lightmap: Option<&'a Path>,
 }
 
 /// The files read.
@@ -43,6 +46,8 @@ pub struct Read {
     /// The surface artifact and its input record, if given and the scene
     /// has surface detail (textures, alpha masks, normal maps).
     pub surface: Option<(Surface, Input)>,
+    /// The lightmap, if given ([`lightmap`]).
+    pub lightmap: Option<Lightmap>,
 }
 
 impl Given<'_> {
@@ -61,7 +66,8 @@ impl Given<'_> {
         if let Some((_, input)) = &surface {
             run.input(schemas::header::Input { made_by: None, ..input.clone() })?;
         }
-        Ok(Read { solution, clusters, threshold, surface })
+        let lightmap = self.lightmap.map(|path| lightmap(path, mesh, &solution, self.solution).and_then(|(l, input)| run.input(input).map(|_| l))).transpose()?;
+        Ok(Read { solution, clusters, threshold, surface, lightmap })
     }
 }
 
@@ -75,8 +81,38 @@ impl Read {
 
     /// The gather's extras: the clusters, the threshold and `detail`.
     pub fn extras<'a>(&'a self, detail: Option<&'a Detail<'a>>) -> Extras<'a> {
-        Extras { clusters: self.clusters.as_ref(), threshold: self.threshold.as_ref(), detail }
+        Extras { clusters: self.clusters.as_ref(), threshold: self.threshold.as_ref(), detail, lightmap: self.lightmap.as_ref() }
     }
+}
+
+/// Reads the lightmap at `path` for the preview's shading, and checks that
+/// it is one of `mesh` (a region per triangle) written by the gpu-shoot
+/// run that wrote `solution` (read from `solution_path`): the same
+/// provenance. A run that added `rho x ambient` to its solution
+/// (`--ambient`, a display aid) is refused, as the lightmap does not hold
+/// that term and the preview would lose it.
+fn lightmap(path: &Path, mesh: &Mesh, solution: &Solution, solution_path: &Path) -> Result<(Lightmap, Input)> {
+    let (lightmap, input) = Lightmap::read(path)?;
+    if lightmap.regions.len() != mesh.triangles.len() {
+        let message = format!("{} regions for a mesh of {} triangles: not a lightmap of this mesh", lightmap.regions.len(), mesh.triangles.len());
+        return Err(Error::invalid(path, None, message));
+    }
+    let run = &lightmap.header.provenance;
+    if *run != solution.header.provenance {
+        return Err(Error::invalid(path, None, format!("not written by the run that wrote {} (their provenance differs)", solution_path.display())));
+    }
+    if ron::from_str::<AmbientAdded>(run.parameters.get_ron()).is_ok_and(|p| p.ambient) {
+        return Err(Error::invalid(path, None, "its run added rho x ambient to the solution (--ambient), which the lightmap does not hold: leave out --lightmap or --ambient"));
+    }
+    Ok((lightmap, input))
+}
+
+/// Of a gpu-shoot run's parameters, whether it added `rho x ambient` to
+/// its solution (absent: it did not; other fields are ignored).
+#[derive(serde::Deserialize)]
+struct AmbientAdded {
+    #[serde(default)]
+    ambient: bool,
 }
 
 /// The files the gather writes.

@@ -228,6 +228,9 @@ pub struct Extras<'a> {
     /// Surface detail (textures, alpha masks, normal maps) from mesh-prep's
     /// surface artifact, for a scene that has some.
     pub detail: Option<&'a detail::Detail<'a>>,
+    /// gpu-shoot's lightmap, which the preview shades with where given
+    /// ([`preview`]).
+    pub lightmap: Option<&'a schemas::lightmap::Lightmap>,
 }
 
 /// The inputs of a gather. The paths only name the files in error

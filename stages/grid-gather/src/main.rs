@@ -35,6 +35,9 @@ struct Args {
     /// Cluster hierarchy (clusters.exr) of a clustered solution.
     #[arg(long, value_name = "CLUSTERS.exr")]
     clusters: Option<PathBuf>,
+    /// Lightmap (lightmap.exr) of the gpu-shoot run that wrote the solution: the preview shows it, bilinear between texel centres, instead of the solution's leaves (a textured surface keeps the leaves' irradiance times its texture).
+    #[arg(long, value_name = "LIGHTMAP.exr")]
+    lightmap: Option<PathBuf>,
     /// Per-pixel samples and classes, per-vertex class counts (full, brute).
     #[arg(long, value_name = "DIAGNOSTICS.exr")]
     diagnostics: Option<PathBuf>,
@@ -45,7 +48,7 @@ impl Stage for Args {
 
     fn files(&self) -> (Vec<Option<&Path>>, Vec<Option<&Path>>) {
         let [mesh, manifest] = self.scene.paths();
-        (vec![mesh, manifest, self.solution.as_deref(), self.surface.as_deref()], vec![self.output.as_deref(), self.diagnostics.as_deref()])
+        (vec![mesh, manifest, self.solution.as_deref(), self.surface.as_deref(), self.lightmap.as_deref()], vec![self.output.as_deref(), self.diagnostics.as_deref()])
     }
 
     fn settle(&self, params: &mut Params) -> Result<()> {
@@ -56,6 +59,9 @@ impl Stage for Args {
         if self.threshold.is_some() && params.mode != Mode::Full {
             return Err(bad_parameter("--threshold is read only by --mode full"));
         }
+        if self.lightmap.is_some() && params.mode != Mode::Preview {
+            return Err(bad_parameter("--lightmap is read only by --mode preview"));
+        }
         if self.diagnostics.is_some() && params.mode == Mode::Preview {
             return Err(bad_parameter("--diagnostics is written only by --mode full and brute"));
         }
@@ -65,7 +71,7 @@ impl Stage for Args {
     fn run(self, params: &Params, run: &mut Run, outputs: &mut Outputs) -> Result<Done> {
         let (mesh, manifest) = self.scene.read(run)?;
         let solution_path = required(&self.solution, "--solution")?;
-        let given = Given { mesh: required(&self.scene.mesh, "--mesh")?, solution: solution_path, clusters: self.clusters.as_deref(), threshold: self.threshold.as_deref(), surface: self.surface.as_deref() };
+        let given = Given { mesh: required(&self.scene.mesh, "--mesh")?, solution: solution_path, clusters: self.clusters.as_deref(), threshold: self.threshold.as_deref(), surface: self.surface.as_deref(), lightmap: self.lightmap.as_deref() };
         let read = given.read(run, &mesh, &manifest)?;
         let detail = read.detail(&mesh, &manifest);
         let scene = Scene { mesh: &mesh, manifest: &manifest, manifest_path: required(&self.scene.manifest, "--manifest")?, solution: &read.solution, solution_path };

@@ -1,5 +1,9 @@
 //! The preview: the solution's radiosity made continuous over the leaf
-//! elements ([`crate::gouraud`]) and seen through the camera. A front-face
+//! elements ([`crate::gouraud`]), or gpu-shoot's lightmap where given
+//! (bilinear between texel centres, [`Lightmap::radiosity_at`]; the
+//! leaves average the lightmap over a few texels, and a step inside
+//! coarse leaves rings in their interpolation), and seen through the
+//! camera. A front-face
 //! hit shows `L = B / pi` (Lambertian exitance to radiance, W/(m² sr));
 //! with textures `B(x) = E + rho(x) H(x)` ([`crate::detail`]); a back-face
 //! hit is black, since radiosity is one-sided; mirrors and glass are
@@ -15,6 +19,7 @@ use glam::DVec3;
 use radiometry::camera::Pinhole;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::{Hit, SceneRays};
+use schemas::lightmap::Lightmap;
 use schemas::Result;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -42,6 +47,8 @@ pub struct Preview<'a> {
     pub rays: Option<&'a SceneRays>,
     /// Radiosity over the surfaces.
     pub shading: &'a Gouraud,
+    /// gpu-shoot's lightmap, shown instead of `shading` where given.
+    pub lightmap: Option<&'a Lightmap>,
     /// Textures, in a scene that has them.
     pub textured: Option<Textured<'a>>,
     /// The mirrors and glass camera rays continue through, in a scene
@@ -94,7 +101,10 @@ impl Preview<'_> {
                 let (e, h) = (t.emission[hit.triangle as usize], t.irradiance.radiosity(hit.triangle, uv));
                 std::array::from_fn(|c| e[c] + rho[c] * h[c])
             }
-            None => self.shading.radiosity(hit.triangle, uv),
+            None => match self.lightmap {
+                Some(lightmap) => lightmap.radiosity_at(hit.triangle as usize, uv),
+                None => self.shading.radiosity(hit.triangle, uv),
+            },
         };
         Some(radiosity.map(|b| b / PI))
     }
@@ -120,7 +130,7 @@ pub fn render(params: &Params, scene: &Scene, extras: Extras, frame: &Frame, sha
     let textured = textures.zip(irradiance.as_ref()).map(|(detail, irradiance)| Textured { detail, irradiance, emission: &emission });
     let ids = pixel_surfaces::surface_ids(scene.mesh, scene.manifest);
     let specular = Specular::new(scene.mesh, scene.manifest, triangles, params.specular_depth, params.specular_min_weight);
-    let preview = Preview { camera, triangles, rays: rays.as_ref(), shading, textured, specular: specular.as_ref() };
+    let preview = Preview { camera, triangles, rays: rays.as_ref(), shading, lightmap: extras.lightmap, textured, specular: specular.as_ref() };
     let lens = Lens { camera, triangles, rays: rays.as_ref(), surfaces: &ids, crease_angle_deg: params.crease_angle_deg };
     let film = expose(&lens, Sampling { width, height, spp: params.spp, seed: params.seed }, &preview, rows_done);
 
@@ -136,6 +146,9 @@ pub fn render(params: &Params, scene: &Scene, extras: Extras, frame: &Frame, sha
         ("leaf_elements".to_string(), shading.leaves() as f64),
         ("vertices".to_string(), shading.vertices() as f64),
     ]);
+    if let Some(lightmap) = extras.lightmap {
+        counters.insert("lightmap_texels".to_string(), lightmap.regions.iter().map(|r| f64::from(r.covered)).sum());
+    }
     if specular.is_some() {
         specular::count(&mut counters, film.specular);
     }
