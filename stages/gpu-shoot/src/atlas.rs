@@ -234,14 +234,27 @@ pub fn texel_point(region: Region, i: u32, j: u32) -> [f64; 2] {
 /// Bakes the atlas: region sizes per object, shelf packing (regions sorted
 /// by decreasing size, then triangle index, into rows of a power-of-two
 /// wide atlas), covered texels with positions and areas, and groups of
-/// `2^level` x `2^level` texels for substructured shooting.
+/// `2^level` x `2^level` texels for substructured shooting (finer for a
+/// small emitter clear of other surfaces, [`crate::emitters`]).
 pub fn bake(mesh: &Mesh, manifest: &Manifest, texels: f64, min_size: u32, max_size: u32, level: u32) -> Atlas {
-    bake_sized(mesh, object_sizes(mesh, manifest.objects.len(), texels, min_size, max_size), level)
+    let sizes = object_sizes(mesh, manifest.objects.len(), texels, min_size, max_size);
+    let levels = crate::emitters::shoot_levels(mesh, manifest, &sizes, level);
+    bake_sized(mesh, sizes, &levels)
+}
+
+/// Groups of `2^level` x `2^level` texels that hold a covered texel in a
+/// region of `size` texels a side: the blocks `(a, b)` whose first texel
+/// is covered, `(a + b) 2^level < size`.
+pub fn group_count(size: u32, level: u32) -> u32 {
+    let g = 1u32 << level;
+    let blocks = size.div_ceil(g);
+    (0..blocks).map(|a| (0..blocks).filter(|&b| (a + b) * g < size).count() as u32).sum()
 }
 
 /// [`bake`] with given region sizes per object (the input mesh's, for the
-/// tiles of an adaptive subdivision, [`crate::tiling`]).
-pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, level: u32) -> Atlas {
+/// tiles of an adaptive subdivision, [`crate::tiling`]) and shooting
+/// levels per triangle ([`crate::emitters::shoot_levels`]).
+pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, levels: &[u32]) -> Atlas {
     let size_of = |t: usize| sizes[mesh.triangles[t].object as usize];
     let footprint: u64 = (0..mesh.triangles.len()).map(|t| ((size_of(t) + 2) as u64).pow(2)).sum();
     let largest = (0..mesh.triangles.len()).map(|t| size_of(t) + 2).max().unwrap_or(1);
@@ -265,7 +278,6 @@ pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, level: u32) -> Atlas {
         row_height = row_height.max(side);
     }
     let height = (y + row_height).max(1);
-    let g = 1u32 << level;
     let mut triangles = Vec::with_capacity(mesh.triangles.len());
     let mut all_texels = Vec::new();
     let mut groups = Vec::new();
@@ -273,6 +285,7 @@ pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, level: u32) -> Atlas {
         let geometry = TriangleGeometry::new(tri.vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from))));
         let region = regions[t];
         let n = region.size;
+        let g = 1u32 << levels[t];
         let (first, group_first) = (all_texels.len() as u32, groups.len() as u32);
         let blocks = n.div_ceil(g);
         for gj in 0..blocks {

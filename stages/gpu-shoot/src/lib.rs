@@ -38,6 +38,7 @@
 pub mod atlas;
 pub mod convergence;
 pub mod detail;
+pub mod emitters;
 pub mod exposure;
 pub mod gpu;
 pub mod mirrors;
@@ -86,7 +87,7 @@ stage_kit::knobs! {
         min_size: u32 = 2, "texels", value(2..=4096);
         /// Largest side of a triangle's lightmap region (at least `min_size`).
         max_size: u32 = 512, "texels", value(2..=4096);
-        /// Substructuring: shoot from groups of `2^level` x `2^level` texels.
+        /// Substructuring: shoot from groups of `2^level` x `2^level` texels (a small emitter clear of other surfaces from finer ones).
         shoot_level: u32 = 3, "", value(0..=8);
         /// How visibility from a shooting sample is found: `hemicube` or
         /// `stereographic`.
@@ -350,7 +351,8 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
         s => s,
     };
     let manifest = c.manifest;
-    let mut atlas = atlas::bake_sized(mesh, c.sizes.clone(), c.params.shoot_level);
+    let levels = emitters::shoot_levels(mesh, manifest, &c.sizes, c.params.shoot_level);
+    let mut atlas = atlas::bake_sized(mesh, c.sizes.clone(), &levels);
     let detail = surface.and_then(|s| Detail::new(mesh, s));
     // Per covered texel, what its textures make of it (None: its material has none).
     let details: Vec<Option<TexelDetail>> = match &detail {

@@ -97,7 +97,7 @@ mod tests {
         let one_sided = Material { diffuse_transmittance: tau, ..material([0.2; 3], [0.0; 3]) };
         let mut m = manifest(1, vec![sheet, one_sided, material([0.5; 3], [0.0; 3])]);
         m.effects.diffuse_transmission = true;
-        let atlas = crate::atlas::bake_sized(&mesh, vec![16], 2);
+        let atlas = crate::atlas::bake_sized(&mesh, vec![16], &vec![2; mesh.triangles.len()]);
         let tiles = crate::tiling::identity(&mesh);
         let (table, one_sided) = table(&atlas, &tiles, &mesh, &m, &mesh.twins()).unwrap();
         assert_eq!(one_sided, 1);
