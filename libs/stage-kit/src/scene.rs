@@ -12,13 +12,14 @@ use radiometry::texture::{Maps, TexelGrid, Texels};
 use schemas::mesh::{Camera, GoniometricLight, Mesh};
 use schemas::surface::{Surface, Texture, TextureKind, NONE};
 
+/// The corners of triangle `t` of `mesh`, in f64.
+pub fn triangle_corners(mesh: &Mesh, t: usize) -> [DVec3; 3] {
+    mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)))
+}
+
 /// The geometry of every triangle of `mesh`, in f64.
 pub fn mesh_triangles(mesh: &Mesh) -> Vec<TriangleGeometry> {
-    let p = |i: u32| {
-        let v = mesh.positions[i as usize];
-        DVec3::new(v[0].into(), v[1].into(), v[2].into())
-    };
-    mesh.triangles.iter().map(|t| TriangleGeometry::new(t.vertices.map(p))).collect()
+    (0..mesh.triangles.len()).map(|t| TriangleGeometry::new(triangle_corners(mesh, t))).collect()
 }
 
 /// The pinhole camera of `camera` rendering a `width` x `height` image;

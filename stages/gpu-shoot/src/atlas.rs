@@ -20,6 +20,7 @@ use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use schemas::lightmap::Region;
 use schemas::mesh::{Manifest, Mesh};
+use stage_kit::scene::triangle_corners;
 
 /// One covered texel, as the GPU reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -281,8 +282,8 @@ pub fn bake_sized(mesh: &Mesh, sizes: Vec<u32>, levels: &[u32]) -> Atlas {
     let mut triangles = Vec::with_capacity(mesh.triangles.len());
     let mut all_texels = Vec::new();
     let mut groups = Vec::new();
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let geometry = TriangleGeometry::new(tri.vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from))));
+    for t in 0..mesh.triangles.len() {
+        let geometry = TriangleGeometry::new(triangle_corners(mesh, t));
         let region = regions[t];
         let n = region.size;
         let g = 1u32 << levels[t];

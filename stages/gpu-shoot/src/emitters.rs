@@ -21,6 +21,7 @@
 
 use glam::DVec3;
 use schemas::mesh::{Manifest, Mesh};
+use stage_kit::scene::triangle_corners;
 
 /// Groups an emitting object shoots from at least, where its texels allow
 /// and it is [`clear`] (module docs).
@@ -67,7 +68,7 @@ pub fn shoot_levels(mesh: &Mesh, manifest: &Manifest, sizes: &[u32], level: u32)
 /// from it) is at least `distance` from it. Measures at most
 /// [`MOST_PAIRS`] pairs (after a bounding-box test), else says no.
 pub fn clear(mesh: &Mesh, own: &[usize], distance: f64) -> bool {
-    let corners = |t: usize| mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)));
+    let corners = |t: usize| triangle_corners(mesh, t);
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for &e in own {
         for p in corners(e) {

@@ -22,7 +22,7 @@ use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use schemas::mesh::Mesh;
-use stage_kit::scene::mesh_triangles;
+use stage_kit::scene::{mesh_triangles, triangle_corners};
 use std::collections::HashMap;
 
 /// The input mesh's rays and geometry, built once per solve: the
@@ -103,7 +103,7 @@ impl Burial {
                 continue;
             }
             let region = atlas.regions[t];
-            let geometry = TriangleGeometry::new(mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from))));
+            let geometry = TriangleGeometry::new(triangle_corners(mesh, t));
             let root = tiles[t].root;
             for g in &mut atlas.groups[range.group_first as usize..(range.group_first + range.group_count) as usize] {
                 let texels = g.first as usize..(g.first + g.count) as usize;

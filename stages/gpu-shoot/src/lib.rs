@@ -61,6 +61,7 @@ use schemas::surface::Surface;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use tiling::Tile;
+use stage_kit::scene::triangle_corners;
 
 /// How visibility from a shooting sample is found.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -406,7 +407,7 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
         .collect();
     let emission: Vec<[f32; 4]> = atlas.texels.iter().map(|x| f4(material(x.triangle as usize).emission)).collect();
     let half_edges = |t: usize| {
-        let p = mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)));
+        let p = triangle_corners(mesh, t);
         let n = 2.0 * atlas.regions[t].size as f64;
         [f4(((p[1] - p[0]) / n).to_array()), f4(((p[2] - p[0]) / n).to_array())]
     };

@@ -46,6 +46,7 @@ use radiometry::geometry::frame_with_normal;
 use schemas::mesh::{Manifest, Mesh};
 use std::f64::consts::PI;
 use std::time::Instant;
+use stage_kit::scene::triangle_corners;
 
 /// Two triangles lie in one window's plane when their unit normals differ
 /// by less than this and their planes' offsets by less than this times
@@ -136,17 +137,13 @@ impl Window {
     }
 }
 
-fn corners(mesh: &Mesh, t: u32) -> [DVec3; 3] {
-    mesh.triangles[t as usize].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)))
-}
-
 /// Groups the lit specular triangles `lit` into windows: per plane (the
 /// triangle's front plane, within `COPLANAR`), a mirror of those with
 /// `rho_s > 0` and a pane of those with `tau_s > 0`.
 pub fn windows(mesh: &Mesh, specular: &Specular, lit: &[u32], diagonal: f64) -> Vec<Window> {
     let mut out: Vec<Window> = Vec::new();
     for &t in lit {
-        let p = corners(mesh, t);
+        let p = triangle_corners(mesh, t as usize);
         let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { continue };
         let (rho, tau) = specular.coefficients[t as usize];
         for (kind, c, sign) in [(Kind::Mirror, rho, 1.0), (Kind::Pane, tau, -1.0)] {
@@ -202,7 +199,7 @@ pub fn virtual_sample(s: &GpuSample, window: &Window) -> GpuSample {
 /// `k = 1 / tan(alpha / 2)`, the smallest field of view that holds every
 /// corner.
 pub fn view(mesh: &Mesh, window: &Window, eye: DVec3) -> GpuView {
-    let points: Vec<DVec3> = window.triangles.iter().flat_map(|&(t, _)| corners(mesh, t)).map(|p| p - eye).collect();
+    let points: Vec<DVec3> = window.triangles.iter().flat_map(|&(t, _)| triangle_corners(mesh, t as usize)).map(|p| p - eye).collect();
     let centroid = points.iter().sum::<DVec3>() / points.len() as f64;
     let mut axis = centroid.normalize_or(window.plane.normal);
     if points.iter().any(|p| p.dot(axis) < 0.1 * p.length()) {

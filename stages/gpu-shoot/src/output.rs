@@ -6,7 +6,6 @@
 use crate::atlas::{texel_point, Atlas};
 use crate::tiling::{from_root, to_root, Tile};
 use crate::{Params, Solved};
-use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::header::{Header, Provenance, Schema};
@@ -17,6 +16,7 @@ use schemas::solution::{Element, Solution, NONE};
 use stage_kit::run::Outputs;
 use std::collections::HashMap;
 use std::path::Path;
+use stage_kit::scene::triangle_corners;
 
 /// A run's artifacts, each stamped with the run's provenance: the
 /// solution, the lightmap atlas and the convergence record.
@@ -170,7 +170,7 @@ pub fn lightmap_of(a: &Atlas, radiosity: &[[f32; 3]], residual: &[[f32; 3]], mes
     // (the point of the triangle's plane its centre maps to).
     for (t, r) in a.regions.iter().enumerate() {
         let tri = &mesh.triangles[t];
-        let g = TriangleGeometry::new(tri.vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from))));
+        let g = TriangleGeometry::new(triangle_corners(mesh, t));
         let n = r.size as f64;
         for j in 0..r.size + 2 {
             for i in 0..r.size + 2 {

@@ -7,6 +7,7 @@
 use crate::atlas::Atlas;
 use glam::DVec3;
 use radiometry::form_factor::point_to_polygon;
+use stage_kit::scene::triangle_corners;
 
 /// Residual power of triangle `t`: `sum_k dB_k A_k` over its covered
 /// texels, W, RGB.
@@ -160,7 +161,7 @@ pub struct AreaSample<'a> {
 pub fn patch_of(atlas: &Atlas, mesh: &schemas::mesh::Mesh, k: usize) -> (usize, [DVec3; 4]) {
     let texel = atlas.texels[k];
     let t = texel.triangle as usize;
-    let p = mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)));
+    let p = triangle_corners(mesh, t);
     let region = atlas.regions[t];
     let n = 2.0 * region.size as f64;
     texel_patch(DVec3::from(texel.position.map(f64::from)), (p[1] - p[0]) / n, (p[2] - p[0]) / n, texel.on_hypotenuse(region))

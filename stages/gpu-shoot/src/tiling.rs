@@ -13,6 +13,7 @@ use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Mesh, Triangle};
 use schemas::surface::Surface;
 use std::collections::HashMap;
+use stage_kit::scene::triangle_corners;
 
 /// One tile: a triangle of the refinement of input triangle `root`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,7 +46,7 @@ pub fn from_root(corners: &Corners, x: [f64; 2]) -> [f64; 2] {
 
 /// The point at barycentric `uv` of input triangle `t`, m.
 fn point(mesh: &Mesh, t: usize, uv: [f64; 2]) -> DVec3 {
-    let p = mesh.triangles[t].vertices.map(|v| DVec3::from(mesh.positions[v as usize].map(f64::from)));
+    let p = triangle_corners(mesh, t);
     p[0] + uv[0] * (p[1] - p[0]) + uv[1] * (p[2] - p[0])
 }
 
