@@ -102,7 +102,8 @@ fn checked(p: [f64; 3], eye: [f64; 3]) -> bool {
 /// pixels, the brightest shadowed pixel over the brightest lit one, and
 /// the counts.
 fn errors(image: &HdrImage, manifest: &Manifest) -> (f64, f64, usize, usize) {
-    let eye = manifest.camera.eye;
+    // The camera's eye in the world frame, as the points are.
+    let eye: [f64; 3] = std::array::from_fn(|a| manifest.camera.eye[a] + manifest.world_from_mesh_translation[a]);
     let (mut worst, mut brightest_shadowed, mut brightest_lit, mut lit, mut shadowed) = (0.0f64, 0.0f64, 0.0f64, 0, 0);
     for y in 0..SIZE {
         for x in 0..SIZE {
