@@ -101,8 +101,9 @@ impl Burial {
     /// its end by the short block, the tall block +0.83% in all; now
     /// -0.21%, and every surface within 0.50% (the ceiling -0.50%, the
     /// rest within 0.27%, where they were within 0.19%: the strip had
-    /// been making up a deficit of about 0.25% that is still to be
-    /// found). That hull, cut to [`HIDDEN_CORNERS`] corners by dropping its
+    /// been making up a deficit of about 0.25%, which the per-face test of
+    /// the cube box in `tests/tests/gpu_kernels.rs` shows on the walls
+    /// nearest the cube). That hull, cut to [`HIDDEN_CORNERS`] corners by dropping its
     /// smallest ones, is the buried part where one convex solid buries it
     /// (a block standing on a floor); where an exposed texel's point lies
     /// inside it (two solids, a concave one) the group keeps no hidden
@@ -124,7 +125,6 @@ impl Burial {
                 if hidden.is_empty() || open.is_empty() {
                     continue;
                 }
-                let at: HashMap<(u32, u32), usize> = texels.map(|k| (atlas.texels[k].indices(region), k)).collect();
                 let point = |k: usize| {
                     let (i, j) = atlas.texels[k].indices(region);
                     texel_point(region, i, j)
@@ -133,13 +133,16 @@ impl Burial {
                 let nf = f64::from(region.size);
                 for &k in &hidden {
                     let (i, j) = atlas.texels[k].indices(region);
-                    // The exposed texel of the triangle at an offset from it, in
-                    // the group or beyond its edge (none: no texel, or buried).
-                    let exposed = |di: i64, dj: i64| triangle.get(&((i as i64 + di) as u32, (j as i64 + dj) as u32)).copied().filter(|&e| !buried[e]);
-                    let in_group = |di: i64, dj: i64| at.contains_key(&((i as i64 + di) as u32, (j as i64 + dj) as u32));
+                    // The triangle's texel at an offset from this one, if any;
+                    // whether it is in the group; the exposed one (none: no
+                    // texel, or buried); and the point of this texel's square
+                    // towards it (a side's midpoint or a corner).
+                    let beside = |di: i64, dj: i64| triangle.get(&((i as i64 + di) as u32, (j as i64 + dj) as u32)).copied();
+                    let in_group = |di: i64, dj: i64| beside(di, dj).is_some_and(|e| texels.contains(&e));
+                    let exposed = |di: i64, dj: i64| beside(di, dj).filter(|&e| !buried[e]);
+                    let towards = |di: i64, dj: i64| [(i as f64 + 0.5 + di as f64 / 2.0) / nf, (j as f64 + 0.5 + dj as f64 / 2.0) / nf];
                     for (side, (di, dj)) in [(1i64, 0i64), (0, 1), (-1, 0), (0, -1)].into_iter().enumerate() {
-                        // The point of this texel's edge towards the neighbour.
-                        let edge = [(i as f64 + 0.5 + di as f64 / 2.0) / nf, (j as f64 + 0.5 + dj as f64 / 2.0) / nf];
+                        let edge = towards(di, dj);
                         let Some(e) = exposed(di, dj) else {
                             // Buried or no texel beyond the group's edge: the
                             // buried part reaches that edge.
@@ -167,7 +170,7 @@ impl Burial {
                         points.push(inside);
                     }
                     for (di, dj) in [(1i64, 1i64), (1, -1), (-1, 1), (-1, -1)] {
-                        let corner = [(i as f64 + 0.5 + di as f64 / 2.0) / nf, (j as f64 + 0.5 + dj as f64 / 2.0) / nf];
+                        let corner = towards(di, dj);
                         let open_near = exposed(di, 0).is_some() || exposed(0, dj).is_some() || exposed(di, dj).is_some();
                         if !in_group(di, 0) && !in_group(0, dj) && !open_near && corner[0] + corner[1] <= 1.0 {
                             points.push(corner);
