@@ -9,7 +9,7 @@
 pub mod fuzz;
 pub mod stages;
 
-use schemas::mesh::{Manifest, Mesh};
+use schemas::mesh::{Camera, Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::{Element, Solution};
 use std::path::{Path, PathBuf};
@@ -156,34 +156,40 @@ pub fn solve_prepared(dir: &Path, solve_args: &[&str], leaf_size: Option<u32>) -
     solution
 }
 
-/// The world points a pinhole camera sees on the plane z = 0 through an
-/// `n x n` grid of points inside pixel `(x, y)` of a `width` x `height`
-/// image (pixel `(0, 0)` top left; the manifest's camera, mesh frame, with
-/// `origin` the world position of the mesh frame's origin): the camera
-/// model written out here from the manifest's fields, not the renderer's.
-pub fn pixel_points_on_ground(manifest: &Manifest, width: u32, height: u32, x: u32, y: u32, n: u32) -> Vec<[f64; 3]> {
-    let c = &manifest.camera;
+/// The direction (not of unit length) of the manifest's `camera` ray
+/// through the point `(px, py)` of a `width` x `height` image, in pixels
+/// from its top left corner: the pinhole written out here from the
+/// camera's fields, not the renderer's.
+pub fn camera_ray(camera: &Camera, width: u32, height: u32, px: f64, py: f64) -> [f64; 3] {
     let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let cross = |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
     let unit = |a: [f64; 3]| {
         let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
         a.map(|v| v / l)
     };
-    let forward = unit(sub(c.target, c.eye));
-    let right = unit(cross(forward, c.up));
+    let forward = unit(sub(camera.target, camera.eye));
+    let right = unit(cross(forward, camera.up));
     let up = cross(right, forward);
-    let half_h = (0.5 * c.vertical_fov_deg.to_radians()).tan();
+    let half_h = (0.5 * camera.vertical_fov_deg.to_radians()).tan();
     let half_w = half_h * f64::from(width) / f64::from(height);
+    let sx = (2.0 * px / f64::from(width) - 1.0) * half_w;
+    let sy = (1.0 - 2.0 * py / f64::from(height)) * half_h;
+    std::array::from_fn(|a| forward[a] + sx * right[a] + sy * up[a])
+}
+
+/// The world points a pinhole camera sees on the plane z = 0 through an
+/// `n x n` grid of points inside pixel `(x, y)` of a `width` x `height`
+/// image (pixel `(0, 0)` top left; the manifest's camera, mesh frame, with
+/// `origin` the world position of the mesh frame's origin; [`camera_ray`]).
+pub fn pixel_points_on_ground(manifest: &Manifest, width: u32, height: u32, x: u32, y: u32, n: u32) -> Vec<[f64; 3]> {
     let origin = manifest.world_from_mesh_translation;
-    let eye: [f64; 3] = std::array::from_fn(|a| c.eye[a] + origin[a]);
+    let eye: [f64; 3] = std::array::from_fn(|a| manifest.camera.eye[a] + origin[a]);
     let mut points = Vec::new();
     for j in 0..n {
         for i in 0..n {
             let px = f64::from(x) + (f64::from(i) + 0.5) / f64::from(n);
             let py = f64::from(y) + (f64::from(j) + 0.5) / f64::from(n);
-            let sx = (2.0 * px / f64::from(width) - 1.0) * half_w;
-            let sy = (1.0 - 2.0 * py / f64::from(height)) * half_h;
-            let d: [f64; 3] = std::array::from_fn(|a| forward[a] + sx * right[a] + sy * up[a]);
+            let d = camera_ray(&manifest.camera, width, height, px, py);
             let t = -eye[2] / d[2];
             points.push(std::array::from_fn(|a| eye[a] + t * d[a]));
         }

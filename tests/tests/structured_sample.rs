@@ -4,7 +4,7 @@
 //! (`closed_form::lambert_polygon`) and, for B's one-bounce light (002 Eq.
 //! 4), a Gauss-Legendre quadrature over A of A's exact radiosity.
 
-use end_to_end::{refused, run_ok, s, scratch};
+use end_to_end::{camera_ray, refused, run_ok, s, scratch};
 use schemas::image::{HdrImage, SINGLE_SURFACE};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
@@ -152,23 +152,11 @@ impl OneBounce {
 }
 
 /// The mesh-frame point where the camera ray through the centre of pixel
-/// `(px, py)` meets the plane `z`, from the manifest's camera (a pinhole
-/// written here apart from radiometry's).
+/// `(px, py)` meets the plane `z` ([`end_to_end::camera_ray`], a pinhole
+/// written apart from radiometry's).
 fn camera_hit(run: &Run, px: usize, py: usize, z: f64) -> Option<[f64; 3]> {
     let c = &run.manifest.camera;
-    let (w, h) = (run.image.width as f64, run.image.height as f64);
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross = |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-    let unit = |a: [f64; 3]| {
-        let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-        a.map(|x| x / l)
-    };
-    let forward = unit(sub(c.target, c.eye));
-    let right = unit(cross(forward, c.up));
-    let up = cross(right, forward);
-    let t = (0.5 * c.vertical_fov_deg.to_radians()).tan();
-    let (sx, sy) = ((2.0 * (px as f64 + 0.5) / w - 1.0) * t * w / h, (1.0 - 2.0 * (py as f64 + 0.5) / h) * t);
-    let d: [f64; 3] = [0, 1, 2].map(|k| forward[k] + right[k] * sx + up[k] * sy);
+    let d = camera_ray(c, run.image.width as u32, run.image.height as u32, px as f64 + 0.5, py as f64 + 0.5);
     let along = (z - c.eye[2]) / d[2];
     (along > 0.0).then(|| [0, 1, 2].map(|k| c.eye[k] + along * d[k]))
 }
