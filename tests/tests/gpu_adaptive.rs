@@ -164,9 +164,13 @@ fn a_sharp_shadow_on_a_coarse_floor_is_refined_along_its_edge() {
 /// light and then the surfaces shooting, each split copying its radiosity
 /// and residual down), every surface's reflected power (radiosity times
 /// area over its texels) with the subdivision (one level, 2000 texels) is
-/// within 3% of a solve at 32000 texels without it (measured 2.2%), no
-/// farther than the 2000-texel solve without it (measured 5.7%), and the
-/// shots converge as far.
+/// within 2% of a solve at 32000 texels without it (measured 1.39%, the
+/// ceiling), no more than half a point farther than the 2000-texel solve
+/// without it (measured 1.16%, the short block), and the shots converge
+/// as far. Which of the two is nearer moves with the texel grid at the
+/// blocks' bases (1.22% and 1.26% before texels took their exposed part of
+/// the floor, [`gpu_shoot::exposure`]); the subdivision's gain is in the
+/// shadows' edges (the test above), not in the surfaces' power.
 #[test]
 fn the_cornell_box_keeps_its_surfaces_power_under_subdivision() {
     let (mesh, m) = mesh_prep::prepare_builtin("cornell-box", "test").unwrap();
@@ -188,5 +192,5 @@ fn the_cornell_box_keeps_its_surfaces_power_under_subdivision() {
     let worst = |p: &[f64]| p.iter().zip(&fine).map(|(a, b)| (a / b - 1.0).abs()).fold(0.0, f64::max);
     eprintln!("Cornell box: {added} tiles added; worst object power against 32000 texels: {:.4} subdivided, {:.4} not", worst(&refined), worst(&plain));
     assert!(added > 0);
-    assert!(worst(&refined) < 0.03 && worst(&refined) <= worst(&plain), "{refined:?} and {plain:?} vs {fine:?}");
+    assert!(worst(&refined) < 0.02 && worst(&refined) <= worst(&plain) + 0.005, "{refined:?} and {plain:?} vs {fine:?}");
 }

@@ -376,12 +376,13 @@ fn build(c: &Context, tiles: &[Tile], init: Option<Init>) -> Built {
         for (texel, _) in atlas.texels.iter().zip(&buried).filter(|(_, b)| **b) {
             has_buried[texel.triangle as usize] = true;
         }
-        let coverage: Vec<f64> = (0..atlas.texels.len()).map(|k| if buried[k] { 0.0 } else { detail_of(k).map_or(1.0, |x| x.coverage) }).collect();
-        for (texel, &b) in atlas.texels.iter_mut().zip(&buried) {
-            texel.buried = b;
+        let coverage: Vec<f64> = (0..atlas.texels.len()).map(|k| detail_of(k).map_or(1.0, |x| x.coverage)).collect();
+        let (exposed, rays) = c.burial.hide(&mut atlas, mesh, tiles, &buried);
+        burial_rays += rays;
+        for (texel, &e) in atlas.texels.iter_mut().zip(&exposed) {
+            texel.buried = e == 0.0;
         }
-        burial_rays += c.burial.hide(&mut atlas, mesh, tiles, &buried);
-        atlas.cover(&coverage, &|t| has_buried[t] || masks.is_some_and(|d| d.mask(mesh, t).is_some()));
+        atlas.cover(&exposed, &coverage, &|t| has_buried[t] || masks.is_some_and(|d| d.mask(mesh, t).is_some()));
     }
     let material = |t: usize| &manifest.materials[mesh.triangles[t].material as usize];
     let texels: Vec<GpuTexel> = atlas
