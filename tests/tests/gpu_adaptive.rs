@@ -164,13 +164,14 @@ fn a_sharp_shadow_on_a_coarse_floor_is_refined_along_its_edge() {
 /// light and then the surfaces shooting, each split copying its radiosity
 /// and residual down), every surface's reflected power (radiosity times
 /// area over its texels) with the subdivision (one level, 2000 texels) is
-/// within 2% of a solve at 32000 texels without it (measured 1.39%, the
-/// ceiling), no more than half a point farther than the 2000-texel solve
-/// without it (measured 1.16%, the short block), and the shots converge
-/// as far. Which of the two is nearer moves with the texel grid at the
-/// blocks' bases (1.22% and 1.26% before texels took their exposed part of
-/// the floor, [`gpu_shoot::exposure`]); the subdivision's gain is in the
-/// shadows' edges (the test above), not in the surfaces' power.
+/// within 2% of a solve at 32000 texels without it (measured 1.53%), no
+/// more than half a point farther than the 2000-texel solve without it
+/// (measured 1.20%), and the shots converge as far. Which of the two is
+/// nearer moves with the texel grid at the blocks' bases (1.22% and 1.26%
+/// before texels took their exposed part of the floor and the tiles'
+/// edges were tested for burial, [`gpu_shoot::exposure`]); the
+/// subdivision's gain is in the shadows' edges (the test above), not in
+/// the surfaces' power.
 #[test]
 fn the_cornell_box_keeps_its_surfaces_power_under_subdivision() {
     let (mesh, m) = mesh_prep::prepare_builtin("cornell-box", "test").unwrap();

@@ -87,26 +87,30 @@ pub fn closed_box(s: f64, light: f64) -> Mesh {
 }
 
 /// A unit box `[0, 1]^3` with inward faces and a cube of `side` standing on
-/// its floor with its lowest corner at `(corner, 0, corner)`: the floor
-/// (material 1, object 0; triangles 0-1), the walls x = 0, x = 1, z = 0,
-/// z = 1 and the ceiling (material 0, object 0; triangles 2-11), then the
-/// cube's top and its faces x = corner, x = corner + side, z = corner,
-/// z = corner + side (material 0, object 1; triangles 12-21).
-pub fn cube_in_box(corner: f64, side: f64) -> Mesh {
+/// its floor, its lowest corner at `(corner, 0, corner)` before it turns by
+/// `angle` radians about the vertical through its centre (a turn
+/// about +y, right-handed): the floor (material 1, object 0; triangles 0-1), the
+/// walls x = 0, x = 1, z = 0, z = 1 and the ceiling (material 0, object 0;
+/// triangles 2-11), then the cube's top and its faces towards -x, +x, -z,
+/// +z before turning (material 0, object 1; triangles 12-21).
+pub fn cube_in_box(corner: f64, side: f64, angle: f64) -> Mesh {
     let (o, x, y, z) = (DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z);
+    let centre = DVec3::new(corner + side / 2.0, 0.0, corner + side / 2.0);
+    let turn = |v: DVec3| DVec3::new(v.x * angle.cos() + v.z * angle.sin(), v.y, v.z * angle.cos() - v.x * angle.sin());
+    let at = |p: DVec3| centre + turn(p - centre);
     let lo = DVec3::new(corner, 0.0, corner);
-    let (cx, cy, cz) = (x * side, y * side, z * side);
+    let (cx, cy, cz) = (turn(x * side), y * side, turn(z * side));
     quads(&[
         (o, z, x, 1, 0), // floor y = 0, normal +y
         (o, y, z, 0, 0), // walls facing in
         (x, z, y, 0, 0),
         (o, x, y, 0, 0),
         (z, y, x, 0, 0),
-        (y, x, z, 0, 0),         // ceiling y = 1, normal -y
-        (lo + cy, cz, cx, 0, 1), // the cube's top, normal +y
-        (lo, cz, cy, 0, 1),      // normal -x
-        (lo + cx, cy, cz, 0, 1), // normal +x
-        (lo, cy, cx, 0, 1),      // normal -z
-        (lo + cz, cx, cy, 0, 1), // normal +z
+        (y, x, z, 0, 0),              // ceiling y = 1, normal -y
+        (at(lo) + cy, cz, cx, 0, 1),  // the cube's top, normal +y
+        (at(lo), cz, cy, 0, 1),       // normal -x before turning
+        (at(lo) + cx, cy, cz, 0, 1),  // normal +x
+        (at(lo), cy, cx, 0, 1),       // normal -z
+        (at(lo) + cz, cx, cy, 0, 1),  // normal +z
     ])
 }

@@ -90,8 +90,12 @@ impl Burial {
     /// 4-neighbour, found by bisecting the segment between their points
     /// ([`EDGE_STEPS`] times, keeping the buried end), and of the group's
     /// own edge where the buried region reaches it: the midpoint of a
-    /// buried texel's side whose neighbour beyond the group is buried or
-    /// absent (or lies past the contact, which is then in the next group),
+    /// buried texel's side whose neighbour beyond the group is buried (or
+    /// lies past the contact, which is then in the next group) or absent
+    /// where that side is itself buried (the triangle's edge; across it may
+    /// lie exposed floor of another triangle, and then the contact is
+    /// bisected towards it: taken as buried, the floor's diagonal under a
+    /// turned cube left 7 of its lowest texels up to 2% dark),
     /// the contact on that edge, bisected between that midpoint and the
     /// exposed neighbour's (the row through the texels' points left half a
     /// texel of it out: a cube on an emitting floor had 0.1% more exposed
@@ -164,36 +168,34 @@ impl Burial {
                     let in_group = |di: i64, dj: i64| beside(di, dj).is_some_and(|e| texels.contains(&e));
                     let exposed = |di: i64, dj: i64| beside(di, dj).filter(|&e| !buried[e]);
                     let towards = |di: i64, dj: i64| [(i as f64 + 0.5 + di as f64 / 2.0) / nf, (j as f64 + 0.5 + dj as f64 / 2.0) / nf];
-                    // The buried end of the last of EDGE_STEPS halvings of
-                    // the segment from a buried point to an exposed one (the
-                    // hull must stay inside the buried region: an exposed
-                    // texel's point within it takes the group's hidden part
-                    // away); `key` and `stride` key each step's grazing rays.
-                    let mut bisect = |mut inside: [f64; 2], mut outside: [f64; 2], key: u64, stride: u64| {
-                        for step in 0..EDGE_STEPS as u64 {
-                            let mid = [(inside[0] + outside[0]) / 2.0, (inside[1] + outside[1]) / 2.0];
-                            let (is_buried, cast) = self.point(geometry.point(mid), root, k as u64, key + stride * step);
-                            rays += cast;
-                            if is_buried {
-                                inside = mid;
-                            } else {
-                                outside = mid;
-                            }
-                        }
-                        inside
+                    // Whether a point is buried; `key` keys its grazing rays.
+                    let mut test = |uv: [f64; 2], key: u64| {
+                        let (is_buried, cast) = self.point(geometry.point(uv), root, k as u64, key);
+                        rays += cast;
+                        is_buried
                     };
                     for (side, (di, dj)) in [(1i64, 0i64), (0, 1), (-1, 0), (0, -1)].into_iter().enumerate() {
                         let edge = towards(di, dj);
                         let Some(e) = exposed(di, dj) else {
-                            // Buried or no texel beyond the group's edge: the
-                            // buried part reaches that edge.
+                            // A buried texel beyond the group's edge: the buried
+                            // part reaches that edge (the two texels' points lie
+                            // in it, and so does the middle between them). No
+                            // texel beyond it: the triangle ends there, and its
+                            // neighbour across may be exposed (a floor's other
+                            // triangle), so the edge is tested, and the contact
+                            // bisected towards it if it is not buried.
                             if !in_group(di, dj) && edge[0] + edge[1] <= 1.0 {
-                                points.push(edge);
+                                if beside(di, dj).is_some() || test(edge, 41 + side as u64) {
+                                    points.push(edge);
+                                } else {
+                                    reaches_open = true;
+                                    points.push(bisect(point(k), edge, &mut test, 45 + side as u64, 4));
+                                }
                             }
                             continue;
                         };
                         reaches_open = true;
-                        let mut contact = bisect(point(k), point(e), 1 + side as u64, 4);
+                        let mut contact = bisect(point(k), point(e), &mut test, 1 + side as u64, 4);
                         // A contact past the group's edge lies in the next group:
                         // this group's buried part reaches its edge.
                         if !in_group(di, dj) && (contact[0] - edge[0]) * di as f64 + (contact[1] - edge[1]) * dj as f64 > 0.0 {
@@ -206,15 +208,17 @@ impl Burial {
                         // leaves half a texel of the edge out.
                         for (which, (pi, pj)) in [(dj, di), (-dj, -di)].into_iter().enumerate() {
                             let (near, far) = (towards(pi, pj), towards(pi + 2 * di, pj + 2 * dj));
-                            if in_group(di, dj) && !in_group(pi, pj) && exposed(pi, pj).is_none() && near[0] + near[1] <= 1.0 && far[0] + far[1] <= 1.0 {
-                                points.push(bisect(near, far, 21 + (2 * side + which) as u64, 8));
+                            let key = 21 + (2 * side + which) as u64;
+                            if in_group(di, dj) && !in_group(pi, pj) && exposed(pi, pj).is_none() && near[0] + near[1] <= 1.0 && far[0] + far[1] <= 1.0 && (beside(pi, pj).is_some() || test(near, key + 40)) {
+                                points.push(bisect(near, far, &mut test, key, 8));
                             }
                         }
                     }
-                    for (di, dj) in [(1i64, 1i64), (1, -1), (-1, 1), (-1, -1)] {
+                    for (c, (di, dj)) in [(1i64, 1i64), (1, -1), (-1, 1), (-1, -1)].into_iter().enumerate() {
                         let corner = towards(di, dj);
                         let open_near = exposed(di, 0).is_some() || exposed(0, dj).is_some() || exposed(di, dj).is_some();
-                        if !in_group(di, 0) && !in_group(0, dj) && !open_near && corner[0] + corner[1] <= 1.0 {
+                        let all_there = beside(di, 0).is_some() && beside(0, dj).is_some() && beside(di, dj).is_some();
+                        if !in_group(di, 0) && !in_group(0, dj) && !open_near && corner[0] + corner[1] <= 1.0 && (all_there || test(corner, 71 + c as u64)) {
                             points.push(corner);
                         }
                     }
@@ -250,6 +254,24 @@ impl Burial {
     }
 }
 
+/// The buried end of the last of [`EDGE_STEPS`] halvings of the segment
+/// from the buried point `inside` to the exposed `outside`, by `test`
+/// (whether a point is buried, and the key of its grazing rays: `key`,
+/// then `stride` more each step). The hull of [`Burial::hide`] must stay
+/// inside the buried region: an exposed texel's point within it takes the
+/// group's hidden part away.
+fn bisect(mut inside: [f64; 2], mut outside: [f64; 2], test: &mut impl FnMut([f64; 2], u64) -> bool, key: u64, stride: u64) -> [f64; 2] {
+    for step in 0..EDGE_STEPS as u64 {
+        let mid = [(inside[0] + outside[0]) / 2.0, (inside[1] + outside[1]) / 2.0];
+        if test(mid, key + stride * step) {
+            inside = mid;
+        } else {
+            outside = mid;
+        }
+    }
+    inside
+}
+
 /// Exposed fraction of a texel's square under which it counts as buried
 /// ([`Burial::hide`]): a sliver this thin carries nothing measurable, and
 /// its point would sit on the contact.
@@ -282,7 +304,7 @@ mod tests {
     #[test]
     fn the_floors_texels_expose_the_floor_less_the_blocks_footprint() {
         let (corner, side) = (0.4, 0.3);
-        let mesh = cube_in_box(corner, side);
+        let mesh = cube_in_box(corner, side, 0.0);
         let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
         let mut atlas = bake(&mesh, &m, 24000.0, 2, 512, 3);
         assert_eq!(atlas.regions[0].size, 61);
