@@ -352,11 +352,15 @@ fn a_small_lamp_over_a_large_floor_is_shot_with_overshooting_on() {
 /// edge gained 0.71% (the strip under the cube shot too,
 /// [`gpu_shoot::exposure::Burial::hide`]).
 ///
-/// Three placements: the cube's corner at `(0.3, 0.3)`; at `(0.4, 0.4)`,
+/// Four placements: the cube's corner at `(0.3, 0.3)`; at `(0.4, 0.4)`,
 /// where the footprint's edges lie 7 mm inside groups (of 8 texels of
 /// 1/61 m) whose every texel's point is under the cube; and at `(0.33,
 /// 0.33)` turned by 30 degrees, its contact lines across the texel rows
-/// (the Cornell box's blocks are turned too). At `0.4` those groups
+/// (the Cornell box's blocks are turned too); and at `(0, 0.35)`, flush
+/// against the wall x = 0, where the wall's front and the cube's face
+/// coincide ([`radiometry::burial::COINCIDENT`]: without it the floor
+/// under the cube was not buried, and the room received 0.936 of the
+/// power, every face 6% to 9% short). At `0.4` those groups
 /// had no exposed texel and shot nothing, and the cube's lowest texels in
 /// front of them, which see mostly that strip, were 22% dark; at `0.3`
 /// two groups round the cube's corners, whose exposed texels form an L,
@@ -381,8 +385,8 @@ fn a_small_lamp_over_a_large_floor_is_shot_with_overshooting_on() {
 #[test]
 fn a_block_on_an_emitting_floor_swallows_none_of_its_shots() {
     let Some((device, queue)) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire) else { return };
-    for (corner, angle) in [(0.3, 0.0), (0.4, 0.0), (0.33, 30f64.to_radians())] {
-        let (lo, side) = (DVec3::new(corner, 0.0, corner), 0.3);
+    for (corner, angle) in [([0.3, 0.3], 0.0), ([0.4, 0.4], 0.0), ([0.33, 0.33], 30f64.to_radians()), ([0.0, 0.35], 0.0)] {
+        let (lo, side) = (DVec3::new(corner[0], 0.0, corner[1]), 0.3);
         let mesh = test_support::meshes::cube_in_box(corner, side, angle);
         let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
         let params = Params { texels: 24000.0, max_shots: 2, convergence_target: 1.0, overshoot: false, ..Params::default() };
@@ -392,9 +396,9 @@ fn a_block_on_an_emitting_floor_swallows_none_of_its_shots() {
         let received: f64 = solved.atlas.texels.iter().enumerate().filter(|(_, t)| !floor(t.triangle)).map(|(k, t)| solved.radiosity[k][0] as f64 * t.area as f64).sum();
         let ratio = received / solved.emitted_power[0];
         let buried = solved.atlas.texels.iter().filter(|t| floor(t.triangle) && t.area == 0.0).count();
-        eprintln!("cube at {corner} on an emitting floor: received / shot = {ratio:.5}, {buried} floor texels buried");
+        eprintln!("cube at {corner:?} on an emitting floor: received / shot = {ratio:.5}, {buried} floor texels buried");
         assert!(buried > 0, "the floor under the cube is buried");
-        assert!((ratio - 1.0).abs() < 0.005, "cube at {corner}: received / shot = {ratio}");
+        assert!((ratio - 1.0).abs() < 0.005, "cube at {corner:?}: received / shot = {ratio}");
         // Per texel of the cube's side faces: rho E F(p -> the floor), the
         // floor clipped to the face's hemisphere (Lambert's formula; the part
         // under the cube lies behind every face, so nothing in front is hidden).
@@ -405,13 +409,18 @@ fn a_block_on_an_emitting_floor_swallows_none_of_its_shots() {
             let n = DVec3::from(mesh.triangles[t.triangle as usize].normal.map(f64::from));
             let p = DVec3::from(t.position.map(f64::from));
             let exact = 10.0 * radiometry::form_factor::point_to_polygon(p, n, &floor_quad);
+            if exact <= 0.0 {
+                // A face flush against a wall sees no floor.
+                assert_eq!(solved.radiosity[k][0], 0.0, "cube at {corner:?}: a texel facing the wall at {p}");
+                continue;
+            }
             let err = solved.radiosity[k][0] as f64 / exact - 1.0;
             if err.abs() > worst.0.abs() {
                 worst = (err, p.y);
             }
         }
-        eprintln!("cube at {corner}: its faces per texel against Lambert: worst {:+.2}% at height {:.4} m", 100.0 * worst.0, worst.1);
-        assert!(worst.0.abs() < 0.01, "cube at {corner}: a texel {:+.2}% off Lambert's formula at height {:.4} m", 100.0 * worst.0, worst.1);
+        eprintln!("cube at {corner:?}: its faces per texel against Lambert: worst {:+.2}% at height {:.4} m", 100.0 * worst.0, worst.1);
+        assert!(worst.0.abs() < 0.01, "cube at {corner:?}: a texel {:+.2}% off Lambert's formula at height {:.4} m", 100.0 * worst.0, worst.1);
         // Per face (triangles 2-21 in pairs), its share of the power shot
         // against the Monte Carlo reference.
         let reference = cube_box_shares(lo, side, angle, 16_000_000);
@@ -428,8 +437,8 @@ fn a_block_on_an_emitting_floor_swallows_none_of_its_shots() {
                 worst_face = (err, f);
             }
         }
-        eprintln!("cube at {corner}: box per face against Monte Carlo: worst {:+.2}% (face {})", 100.0 * worst_face.0, worst_face.1);
-        assert!(worst_face.0.abs() < 0.01, "cube at {corner}: face {} receives {:+.2}% of its share", worst_face.1, 100.0 * worst_face.0);
+        eprintln!("cube at {corner:?}: box per face against Monte Carlo: worst {:+.2}% (face {})", 100.0 * worst_face.0, worst_face.1);
+        assert!(worst_face.0.abs() < 0.01, "cube at {corner:?}: face {} receives {:+.2}% of its share", worst_face.1, 100.0 * worst_face.0);
     }
 }
 

@@ -8,7 +8,10 @@
 //! closed solid every ray does, and a ray that leaves the scene or meets a
 //! front face shows the point open to the room. A two-sided surface has no
 //! back face for rays (they see its twin's front, [`crate::rays`]), so
-//! nothing is buried under a sheet, only inside solids.
+//! nothing is buried under a sheet, only inside solids. A solid may close
+//! against another surface: a block flush against a wall has its face
+//! where the wall's front is, and a grazing ray meets both at one distance
+//! ([`COINCIDENT`]); the back face decides.
 
 use crate::rays::SceneRays;
 use crate::sampling::Stream;
@@ -31,6 +34,11 @@ pub const EXPOSURE_RAYS: usize = 1 + GRAZING_RAYS;
 /// at once).
 pub const GRAZING_RAYS: usize = 16;
 
+/// Relative distance within which a grazing ray's front face and a back
+/// face behind it count as one place ([`buried`]): past the f32 rounding
+/// of two coplanar triangles' hits.
+pub const COINCIDENT: f32 = 1e-5;
+
 /// Cosine to the normal of the grazing rays (about 6 degrees above the
 /// surface).
 pub const GRAZING_COS: f64 = 0.1;
@@ -45,6 +53,8 @@ pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3,
     let v = normal.cross(u);
     let turn = 2.0 * PI * stream.next_f64();
     let sin_grazing = (1.0 - GRAZING_COS * GRAZING_COS).sqrt();
+    // Second queries of the coincidence rule, counted as rays.
+    let mut extra = 0;
     for k in 0..EXPOSURE_RAYS {
         let direction = if k == 0 {
             normal
@@ -53,12 +63,22 @@ pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3,
             normal * GRAZING_COS + u * (sin_grazing * phi.cos()) + v * (sin_grazing * phi.sin())
         };
         let hit = scene.closest_hit(point, direction, t_min, f32::INFINITY, [triangle, u32::MAX]);
-        let back_face = hit.is_some_and(|hit| normal_of(hit.triangle).dot(direction) > 0.0);
+        let back = |t: u32| normal_of(t).dot(direction) > 0.0;
+        let front = hit.is_some_and(|hit| !back(hit.triangle));
+        extra += u64::from(front && k > 0);
+        let back_face = hit.is_some_and(|hit| {
+            // A front face with a back face in the same place (a block
+            // pushed flush against a wall: the wall's front and the block's
+            // face coincide) closes the solid: a grazing ray from the floor
+            // under the block meets the two at one distance, whichever the
+            // traversal returns first.
+            back(hit.triangle) || (k > 0 && scene.closest_hit(point, direction, t_min, hit.t * (1.0 + COINCIDENT) + t_min, [triangle, hit.triangle]).is_some_and(|other| back(other.triangle)))
+        });
         if !back_face {
-            return (false, k as u64 + 1);
+            return (false, k as u64 + 1 + extra);
         }
     }
-    (true, EXPOSURE_RAYS as u64)
+    (true, EXPOSURE_RAYS as u64 + extra)
 }
 
 #[cfg(test)]
@@ -93,5 +113,26 @@ mod tests {
         let sheet_normals = [dvec3(0.0, 0.0, -1.0), DVec3::Z];
         let under = buried(&sheet, &|t| sheet_normals[t as usize], dvec3(0.7, 0.3, 0.0), DVec3::Z, 1, 1e-6, &mut Stream::new(1, 2, 3));
         assert!(!under.0, "a sheet facing down is a front face seen from below");
+        // The cube pushed flush against a wall x = 0 facing +x: the wall's
+        // front and the cube's face x = 0 coincide, and every floor point
+        // under the cube stays buried, whichever of the two the grazing
+        // rays towards the wall meet first (without the coincidence rule a
+        // cube on an emitting floor against the wall of gpu-shoot's test
+        // box left its floor unburied, and the room lost 6.4% of the power).
+        let mut walled = triangles.clone();
+        let wall = [dvec3(0.0, -big, 0.0), dvec3(0.0, big, 0.0), dvec3(0.0, big, big), dvec3(0.0, -big, big)];
+        walled.push([wall[0], wall[1], wall[2]]);
+        walled.push([wall[0], wall[2], wall[3]]);
+        let walled_normals: Vec<DVec3> = walled.iter().map(|t| (t[1] - t[0]).cross(t[2] - t[0]).normalize()).collect();
+        assert!(walled_normals[walled.len() - 1].x > 0.99, "the wall faces +x");
+        let walled_scene = SceneRays::new(&walled);
+        let mut stream = Stream::new(4, 5, 6);
+        for x in [0.5, 0.05, 0.01] {
+            for y in [0.5, 0.03] {
+                let (is_buried, _) = buried(&walled_scene, &|t| walled_normals[t as usize], dvec3(x, y, 0.0), DVec3::Z, floor, 1e-6, &mut stream);
+                assert!(is_buried, "under the cube against the wall at ({x}, {y})");
+            }
+        }
+        assert!(!buried(&walled_scene, &|t| walled_normals[t as usize], dvec3(0.05, 1.05, 0.0), DVec3::Z, floor, 1e-6, &mut stream).0, "beside it, by the wall");
     }
 }

@@ -87,18 +87,18 @@ pub fn closed_box(s: f64, light: f64) -> Mesh {
 }
 
 /// A unit box `[0, 1]^3` with inward faces and a cube of `side` standing on
-/// its floor, its lowest corner at `(corner, 0, corner)` before it turns by
+/// its floor, its lowest corner at `(corner[0], 0, corner[1])` before it turns by
 /// `angle` radians about the vertical through its centre (a turn
 /// about +y, right-handed): the floor (material 1, object 0; triangles 0-1), the
 /// walls x = 0, x = 1, z = 0, z = 1 and the ceiling (material 0, object 0;
 /// triangles 2-11), then the cube's top and its faces towards -x, +x, -z,
 /// +z before turning (material 0, object 1; triangles 12-21).
-pub fn cube_in_box(corner: f64, side: f64, angle: f64) -> Mesh {
+pub fn cube_in_box(corner: [f64; 2], side: f64, angle: f64) -> Mesh {
     let (o, x, y, z) = (DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z);
-    let centre = DVec3::new(corner + side / 2.0, 0.0, corner + side / 2.0);
+    let lo = DVec3::new(corner[0], 0.0, corner[1]);
+    let centre = lo + DVec3::new(side / 2.0, 0.0, side / 2.0);
     let turn = |v: DVec3| DVec3::new(v.x * angle.cos() + v.z * angle.sin(), v.y, v.z * angle.cos() - v.x * angle.sin());
     let at = |p: DVec3| centre + turn(p - centre);
-    let lo = DVec3::new(corner, 0.0, corner);
     let (cx, cy, cz) = (turn(x * side), y * side, turn(z * side));
     quads(&[
         (o, z, x, 1, 0), // floor y = 0, normal +y

@@ -304,7 +304,7 @@ mod tests {
     #[test]
     fn the_floors_texels_expose_the_floor_less_the_blocks_footprint() {
         let (corner, side) = (0.4, 0.3);
-        let mesh = cube_in_box(corner, side, 0.0);
+        let mesh = cube_in_box([corner; 2], side, 0.0);
         let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
         let mut atlas = bake(&mesh, &m, 24000.0, 2, 512, 3);
         assert_eq!(atlas.regions[0].size, 61);
