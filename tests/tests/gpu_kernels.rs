@@ -385,11 +385,11 @@ fn a_small_lamp_over_a_large_floor_is_shot_with_overshooting_on() {
 #[test]
 fn a_block_on_an_emitting_floor_swallows_none_of_its_shots() {
     let Some((device, queue)) = device_or_skip(gpu::quiet_device_select_layer, gpu::acquire) else { return };
+    let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
+    let params = Params { texels: 24000.0, max_shots: 2, convergence_target: 1.0, overshoot: false, ..Params::default() };
     for (corner, angle) in [([0.3, 0.3], 0.0), ([0.4, 0.4], 0.0), ([0.33, 0.33], 30f64.to_radians()), ([0.0, 0.35], 0.0)] {
         let (lo, side) = (DVec3::new(corner[0], 0.0, corner[1]), 0.3);
         let mesh = test_support::meshes::cube_in_box(corner, side, angle);
-        let m = manifest(2, vec![material([1.0; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
-        let params = Params { texels: 24000.0, max_shots: 2, convergence_target: 1.0, overshoot: false, ..Params::default() };
         let solved = solve(&device, &queue, &mesh, &m, None, &[], &params, &mut |_| {}).unwrap();
         let floor = |t: u32| t < 2;
         assert!(solved.shots.iter().all(|s| s.shooter == "triangle 0" || s.shooter == "triangle 1"), "{:?}", solved.shots);
@@ -458,7 +458,7 @@ fn cube_box_shares(lo: DVec3, side: f64, angle: f64, samples: usize) -> [f64; 10
     let hi = lo + DVec3::splat(side);
     // The cube's own frame: the room turned back about the cube's axis.
     let centre = DVec3::new(lo.x + side / 2.0, 0.0, lo.z + side / 2.0);
-    let back = |v: DVec3| DVec3::new(v.x * angle.cos() - v.z * angle.sin(), v.y, v.z * angle.cos() + v.x * angle.sin());
+    let back = |v: DVec3| glam::DMat3::from_rotation_y(-angle) * v;
     let mut hits = [0usize; 10];
     let mut cast = 0;
     while cast < samples {

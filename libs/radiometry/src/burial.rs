@@ -62,18 +62,21 @@ pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3,
             let phi = turn + 2.0 * PI * k as f64 / GRAZING_RAYS as f64;
             normal * GRAZING_COS + u * (sin_grazing * phi.cos()) + v * (sin_grazing * phi.sin())
         };
-        let hit = scene.closest_hit(point, direction, t_min, f32::INFINITY, [triangle, u32::MAX]);
         let back = |t: u32| normal_of(t).dot(direction) > 0.0;
-        let front = hit.is_some_and(|hit| !back(hit.triangle));
-        extra += u64::from(front && k > 0);
-        let back_face = hit.is_some_and(|hit| {
+        let back_face = match scene.closest_hit(point, direction, t_min, f32::INFINITY, [triangle, u32::MAX]) {
+            None => false,
+            Some(hit) if back(hit.triangle) => true,
             // A front face with a back face in the same place (a block
             // pushed flush against a wall: the wall's front and the block's
             // face coincide) closes the solid: a grazing ray from the floor
             // under the block meets the two at one distance, whichever the
             // traversal returns first.
-            back(hit.triangle) || (k > 0 && scene.closest_hit(point, direction, t_min, hit.t * (1.0 + COINCIDENT) + t_min, [triangle, hit.triangle]).is_some_and(|other| back(other.triangle)))
-        });
+            Some(hit) if k > 0 => {
+                extra += 1;
+                scene.closest_hit(point, direction, t_min, hit.t * (1.0 + COINCIDENT) + t_min, [triangle, hit.triangle]).is_some_and(|other| back(other.triangle))
+            }
+            Some(_) => false,
+        };
         if !back_face {
             return (false, k as u64 + 1 + extra);
         }

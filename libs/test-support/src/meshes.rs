@@ -3,7 +3,7 @@
 //! gpu-shoot's tests and benchmark, used by any test that solves in
 //! memory).
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use schemas::header::{Provenance, Schema};
 use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
 
@@ -97,7 +97,7 @@ pub fn cube_in_box(corner: [f64; 2], side: f64, angle: f64) -> Mesh {
     let (o, x, y, z) = (DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z);
     let lo = DVec3::new(corner[0], 0.0, corner[1]);
     let centre = lo + DVec3::new(side / 2.0, 0.0, side / 2.0);
-    let turn = |v: DVec3| DVec3::new(v.x * angle.cos() + v.z * angle.sin(), v.y, v.z * angle.cos() - v.x * angle.sin());
+    let turn = |v: DVec3| DMat3::from_rotation_y(angle) * v;
     let at = |p: DVec3| centre + turn(p - centre);
     let (cx, cy, cz) = (turn(x * side), y * side, turn(z * side));
     quads(&[

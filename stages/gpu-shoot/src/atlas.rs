@@ -439,8 +439,8 @@ impl Atlas {
                     // at (0.3, 0.3): two such groups shot nothing, and the
                     // walls nearest the cube got 0.8% to 1.2% too little).
                     let point = |x: &Texel| DVec3::from(x.position.map(f64::from));
-                    let nearest = self.texels[range].iter().filter(|x| x.area > 0.0).map(point).min_by(|a, b| a.distance_squared(centroid).total_cmp(&b.distance_squared(centroid)));
-                    g.centroid = if g.in_hidden(centroid) { nearest.unwrap_or(centroid) } else { centroid }.as_vec3().to_array();
+                    let nearest = || self.texels[range].iter().filter(|x| x.area > 0.0).map(point).min_by(|a, b| a.distance_squared(centroid).total_cmp(&b.distance_squared(centroid)));
+                    g.centroid = if g.in_hidden(centroid) { nearest().unwrap_or(centroid) } else { centroid }.as_vec3().to_array();
                 }
                 g.area = area as f32;
                 g.opaque = if open > 0.0 { (area / open) as f32 } else { 0.0 };
