@@ -17,7 +17,7 @@
 //! buried part, so that the power a group is charged is the power its
 //! polygon less the buried part delivers.
 
-use crate::atlas::{area_centroid, clip_convex, convex_hull, texel_point, texel_square, turn, Atlas, HIDDEN_CORNERS};
+use crate::atlas::{area_centroid, clip_convex, convex_hull, texel_point, texel_square, turn, Atlas, Texel, HIDDEN_CORNERS};
 use crate::tiling::Tile;
 use glam::DVec3;
 use radiometry::burial::buried;
@@ -26,7 +26,9 @@ use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 use schemas::mesh::Mesh;
 use stage_kit::scene::{mesh_triangles, triangle_corners};
+use schemas::lightmap::Region;
 use std::collections::HashMap;
+use std::ops::Range;
 
 /// The input mesh's rays and geometry, built once per solve: the
 /// adaptive subdivision rebuilds the atlas over new tiles of the same
@@ -138,119 +140,173 @@ impl Burial {
         let mut rays = 0;
         let mut exposed_fraction: Vec<f64> = buried.iter().map(|&b| if b { 0.0 } else { 1.0 }).collect();
         for (t, range) in atlas.triangles.iter().enumerate() {
-            if !buried[range.first as usize..(range.first + range.count) as usize].contains(&true) {
+            let texels = range.first as usize..(range.first + range.count) as usize;
+            if !buried[texels.clone()].contains(&true) {
                 continue;
             }
             let region = atlas.regions[t];
-            let geometry = TriangleGeometry::new(triangle_corners(mesh, t));
-            let root = tiles[t].root;
-            let triangle: HashMap<(u32, u32), usize> = (range.first as usize..(range.first + range.count) as usize).map(|k| (atlas.texels[k].indices(region), k)).collect();
+            let indices = atlas.texels[texels.clone()].iter().map(|texel| texel.indices(region)).collect();
+            let grid = TexelGrid::new(region, TriangleGeometry::new(triangle_corners(mesh, t)), tiles[t].root, range.first as usize, indices, buried);
             for g in &mut atlas.groups[range.group_first as usize..(range.group_first + range.group_count) as usize] {
-                let texels = g.first as usize..(g.first + g.count) as usize;
-                let (hidden, open): (Vec<usize>, Vec<usize>) = texels.clone().partition(|&k| buried[k]);
-                if hidden.is_empty() {
-                    continue;
-                }
-                let point = |k: usize| {
-                    let (i, j) = atlas.texels[k].indices(region);
-                    texel_point(region, i, j)
-                };
-                let mut points: Vec<[f64; 2]> = hidden.iter().map(|&k| point(k)).collect();
-                let nf = f64::from(region.size);
-                let mut reaches_open = !open.is_empty();
-                for &k in &hidden {
-                    let (i, j) = atlas.texels[k].indices(region);
-                    // The triangle's texel at an offset from this one, if any;
-                    // whether it is in the group; the exposed one (none: no
-                    // texel, or buried); and the point of this texel's square
-                    // towards it (a side's midpoint or a corner).
-                    let beside = |di: i64, dj: i64| triangle.get(&((i as i64 + di) as u32, (j as i64 + dj) as u32)).copied();
-                    let in_group = |di: i64, dj: i64| beside(di, dj).is_some_and(|e| texels.contains(&e));
-                    let exposed = |di: i64, dj: i64| beside(di, dj).filter(|&e| !buried[e]);
-                    let towards = |di: i64, dj: i64| [(i as f64 + 0.5 + di as f64 / 2.0) / nf, (j as f64 + 0.5 + dj as f64 / 2.0) / nf];
-                    // Whether a point is buried; `key` keys its grazing rays.
-                    let mut test = |uv: [f64; 2], key: u64| {
-                        let (is_buried, cast) = self.point(geometry.point(uv), root, k as u64, key);
-                        rays += cast;
-                        is_buried
-                    };
-                    for (side, (di, dj)) in [(1i64, 0i64), (0, 1), (-1, 0), (0, -1)].into_iter().enumerate() {
-                        let edge = towards(di, dj);
-                        let Some(e) = exposed(di, dj) else {
-                            // A buried texel beyond the group's edge: the buried
-                            // part reaches that edge (the two texels' points lie
-                            // in it, and so does the middle between them). No
-                            // texel beyond it: the triangle ends there, and its
-                            // neighbour across may be exposed (a floor's other
-                            // triangle), so the edge is tested, and the contact
-                            // bisected towards it if it is not buried.
-                            if !in_group(di, dj) && edge[0] + edge[1] <= 1.0 {
-                                if beside(di, dj).is_some() || test(edge, 41 + side as u64) {
-                                    points.push(edge);
-                                } else {
-                                    reaches_open = true;
-                                    points.push(bisect(point(k), edge, &mut test, 45 + side as u64, 4));
-                                }
-                            }
-                            continue;
-                        };
-                        reaches_open = true;
-                        let mut contact = bisect(point(k), point(e), &mut test, 1 + side as u64, 4);
-                        // A contact past the group's edge lies in the next group:
-                        // this group's buried part reaches its edge.
-                        if !in_group(di, dj) && (contact[0] - edge[0]) * di as f64 + (contact[1] - edge[1]) * dj as f64 > 0.0 {
-                            contact = edge;
-                        }
-                        points.push(contact);
-                        // Where the buried part reaches the group's edge beside
-                        // this texel, the contact on that edge, between the two
-                        // texels' sides on it: the row through their points
-                        // leaves half a texel of the edge out.
-                        for (which, (pi, pj)) in [(dj, di), (-dj, -di)].into_iter().enumerate() {
-                            let (near, far) = (towards(pi, pj), towards(pi + 2 * di, pj + 2 * dj));
-                            let key = 21 + (2 * side + which) as u64;
-                            if in_group(di, dj) && !in_group(pi, pj) && exposed(pi, pj).is_none() && near[0] + near[1] <= 1.0 && far[0] + far[1] <= 1.0 && (beside(pi, pj).is_some() || test(near, key + 40)) {
-                                points.push(bisect(near, far, &mut test, key, 8));
-                            }
-                        }
-                    }
-                    for (c, (di, dj)) in [(1i64, 1i64), (1, -1), (-1, 1), (-1, -1)].into_iter().enumerate() {
-                        let corner = towards(di, dj);
-                        let open_near = exposed(di, 0).is_some() || exposed(0, dj).is_some() || exposed(di, dj).is_some();
-                        let all_there = beside(di, 0).is_some() && beside(0, dj).is_some() && beside(di, dj).is_some();
-                        if !in_group(di, 0) && !in_group(0, dj) && !open_near && corner[0] + corner[1] <= 1.0 && (all_there || test(corner, 71 + c as u64)) {
-                            points.push(corner);
-                        }
-                    }
-                }
-                if !reaches_open {
-                    continue;
-                }
-                let part = convex_hull(points, HIDDEN_CORNERS);
-                let within = |p: [f64; 2]| (0..part.len()).all(|k| turn(part[k], part[(k + 1) % part.len()], p) > 0.0);
-                if part.len() < 3 || open.iter().any(|&k| within(point(k))) {
-                    continue;
-                }
+                let group = g.first as usize..(g.first + g.count) as usize;
+                let Some(part) = self.hidden_part(&grid, group.clone(), &mut rays) else { continue };
                 for (slot, uv) in g.hidden.iter_mut().zip(&part) {
-                    *slot = geometry.point(*uv).as_vec3().to_array();
+                    *slot = grid.geometry.point(*uv).as_vec3().to_array();
                 }
                 g.hidden_corners = part.len() as u32;
-                for k in texels {
-                    let (i, j) = atlas.texels[k].indices(region);
-                    let square = texel_square(region, i, j);
-                    let (whole, centre) = area_centroid(&square);
-                    let (under, under_centre) = area_centroid(&clip_convex(square, &part));
-                    let fraction = ((whole - under) / whole).clamp(0.0, 1.0);
-                    exposed_fraction[k] = if fraction > MIN_EXPOSED { fraction } else { 0.0 };
-                    if buried[k] && exposed_fraction[k] > 0.0 {
-                        // Its point moves to the centroid of its exposed part.
-                        let outside = [0, 1].map(|c| (whole * centre[c] - under * under_centre[c]) / (whole - under));
-                        atlas.texels[k].position = geometry.point(outside).as_vec3().to_array();
-                    }
-                }
+                grid.expose(&part, group, &mut atlas.texels, &mut exposed_fraction);
             }
         }
         (exposed_fraction, rays)
+    }
+
+    /// The buried part of the group of texels `group` of `grid`'s triangle
+    /// ([`Burial::hide`]), in barycentrics, counter-clockwise; none where
+    /// the group has no buried texel, its buried texels reach no exposed
+    /// one, or an exposed texel's point lies inside their hull (no convex
+    /// buried part). Counts the rays it casts into `rays`.
+    fn hidden_part(&self, grid: &TexelGrid, group: Range<usize>, rays: &mut u64) -> Option<Vec<[f64; 2]>> {
+        let (hidden, open): (Vec<usize>, Vec<usize>) = group.clone().partition(|&k| grid.buried[k]);
+        if hidden.is_empty() {
+            return None;
+        }
+        let mut points: Vec<[f64; 2]> = hidden.iter().map(|&k| grid.point(k)).collect();
+        let mut reaches_open = !open.is_empty();
+        for &k in &hidden {
+            reaches_open |= self.outline(grid, &group, k, &mut points, rays);
+        }
+        if !reaches_open {
+            return None;
+        }
+        let part = convex_hull(points, HIDDEN_CORNERS);
+        let within = |p: [f64; 2]| (0..part.len()).all(|k| turn(part[k], part[(k + 1) % part.len()], p) > 0.0);
+        (part.len() >= 3 && !open.iter().any(|&k| within(grid.point(k)))).then_some(part)
+    }
+
+    /// Adds to `points` where the buried region round buried texel `k`
+    /// of `group` ends ([`Burial::hide`]): the contacts with its exposed
+    /// 4-neighbours, and the group's edge where the buried region reaches
+    /// it. Returns whether it found exposed floor next to the texel.
+    fn outline(&self, grid: &TexelGrid, group: &Range<usize>, k: usize, points: &mut Vec<[f64; 2]>, rays: &mut u64) -> bool {
+        let mut reaches_open = false;
+        let (i, j) = grid.indices(k);
+        let nf = f64::from(grid.region.size);
+        // The triangle's texel at an offset from this one, if any;
+        // whether it is in the group; the exposed one (none: no
+        // texel, or buried); and the point of this texel's square
+        // towards it (a side's midpoint or a corner).
+        let beside = |di: i64, dj: i64| grid.at.get(&((i as i64 + di) as u32, (j as i64 + dj) as u32)).copied();
+        let in_group = |di: i64, dj: i64| beside(di, dj).is_some_and(|e| group.contains(&e));
+        let exposed = |di: i64, dj: i64| beside(di, dj).filter(|&e| !grid.buried[e]);
+        let towards = |di: i64, dj: i64| [(i as f64 + 0.5 + di as f64 / 2.0) / nf, (j as f64 + 0.5 + dj as f64 / 2.0) / nf];
+        // Whether a point is buried; `key` keys its grazing rays.
+        let mut test = |uv: [f64; 2], key: u64| {
+            let (is_buried, cast) = self.point(grid.geometry.point(uv), grid.root, k as u64, key);
+            *rays += cast;
+            is_buried
+        };
+        for (side, (di, dj)) in [(1i64, 0i64), (0, 1), (-1, 0), (0, -1)].into_iter().enumerate() {
+            let edge = towards(di, dj);
+            let Some(e) = exposed(di, dj) else {
+                // A buried texel beyond the group's edge: the buried
+                // part reaches that edge (the two texels' points lie
+                // in it, and so does the middle between them). No
+                // texel beyond it: the triangle ends there, and its
+                // neighbour across may be exposed (a floor's other
+                // triangle), so the edge is tested, and the contact
+                // bisected towards it if it is not buried.
+                if !in_group(di, dj) && edge[0] + edge[1] <= 1.0 {
+                    if beside(di, dj).is_some() || test(edge, 41 + side as u64) {
+                        points.push(edge);
+                    } else {
+                        reaches_open = true;
+                        points.push(bisect(grid.point(k), edge, &mut test, 45 + side as u64, 4));
+                    }
+                }
+                continue;
+            };
+            reaches_open = true;
+            let mut contact = bisect(grid.point(k), grid.point(e), &mut test, 1 + side as u64, 4);
+            // A contact past the group's edge lies in the next group:
+            // this group's buried part reaches its edge.
+            if !in_group(di, dj) && (contact[0] - edge[0]) * di as f64 + (contact[1] - edge[1]) * dj as f64 > 0.0 {
+                contact = edge;
+            }
+            points.push(contact);
+            // Where the buried part reaches the group's edge beside
+            // this texel, the contact on that edge, between the two
+            // texels' sides on it: the row through their points
+            // leaves half a texel of the edge out.
+            for (which, (pi, pj)) in [(dj, di), (-dj, -di)].into_iter().enumerate() {
+                let (near, far) = (towards(pi, pj), towards(pi + 2 * di, pj + 2 * dj));
+                let key = 21 + (2 * side + which) as u64;
+                if in_group(di, dj) && !in_group(pi, pj) && exposed(pi, pj).is_none() && near[0] + near[1] <= 1.0 && far[0] + far[1] <= 1.0 && (beside(pi, pj).is_some() || test(near, key + 40)) {
+                    points.push(bisect(near, far, &mut test, key, 8));
+                }
+            }
+        }
+        for (c, (di, dj)) in [(1i64, 1i64), (1, -1), (-1, 1), (-1, -1)].into_iter().enumerate() {
+            let corner = towards(di, dj);
+            let open_near = exposed(di, 0).is_some() || exposed(0, dj).is_some() || exposed(di, dj).is_some();
+            let all_there = beside(di, 0).is_some() && beside(0, dj).is_some() && beside(di, dj).is_some();
+            if !in_group(di, 0) && !in_group(0, dj) && !open_near && corner[0] + corner[1] <= 1.0 && (all_there || test(corner, 71 + c as u64)) {
+                points.push(corner);
+            }
+        }
+        reaches_open
+    }
+}
+
+/// One input triangle's texels, as [`Burial::hide`] reads them.
+struct TexelGrid<'a> {
+    region: Region,
+    geometry: TriangleGeometry,
+    /// The input triangle.
+    root: u32,
+    /// Its first texel in the atlas.
+    first: usize,
+    /// `(i, j)` in `region` of each of its texels, from `first` on.
+    indices: Vec<(u32, u32)>,
+    /// Its texel at `(i, j)`.
+    at: HashMap<(u32, u32), usize>,
+    /// Per texel of the atlas, whether its point is buried.
+    buried: &'a [bool],
+}
+
+impl<'a> TexelGrid<'a> {
+    fn new(region: Region, geometry: TriangleGeometry, root: u32, first: usize, indices: Vec<(u32, u32)>, buried: &'a [bool]) -> Self {
+        let at = indices.iter().enumerate().map(|(k, &ij)| (ij, first + k)).collect();
+        TexelGrid { region, geometry, root, first, indices, at, buried }
+    }
+
+    /// `(i, j)` of texel `k`.
+    fn indices(&self, k: usize) -> (u32, u32) {
+        self.indices[k - self.first]
+    }
+
+    /// Texel `k`'s point, in barycentrics.
+    fn point(&self, k: usize) -> [f64; 2] {
+        let (i, j) = self.indices(k);
+        texel_point(self.region, i, j)
+    }
+
+    /// Sets the exposed fraction of each texel of `group` to that of its
+    /// square (half square on the hypotenuse) outside the buried `part`,
+    /// 0 under [`MIN_EXPOSED`]; a buried one with an exposed part moves
+    /// its point to that part's centroid ([`Burial::hide`]).
+    fn expose(&self, part: &[[f64; 2]], group: Range<usize>, texels: &mut [Texel], exposed_fraction: &mut [f64]) {
+        for k in group {
+            let (i, j) = self.indices(k);
+            let square = texel_square(self.region, i, j);
+            let (whole, centre) = area_centroid(&square);
+            let (under, under_centre) = area_centroid(&clip_convex(square, part));
+            let fraction = ((whole - under) / whole).clamp(0.0, 1.0);
+            exposed_fraction[k] = if fraction > MIN_EXPOSED { fraction } else { 0.0 };
+            if self.buried[k] && exposed_fraction[k] > 0.0 {
+                let outside = [0, 1].map(|c| (whole * centre[c] - under * under_centre[c]) / (whole - under));
+                texels[k].position = self.geometry.point(outside).as_vec3().to_array();
+            }
+        }
     }
 }
 
