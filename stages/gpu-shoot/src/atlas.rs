@@ -143,23 +143,27 @@ pub fn convex_hull(mut points: Vec<[f64; 2]>, most: usize) -> Vec<[f64; 2]> {
 }
 
 /// The barycentric square `[u0, u1] x [v0, v1]` cut by the hypotenuse
-/// `u + v <= 1` (Sutherland-Hodgman against one line), counter-clockwise.
+/// `u + v <= 1`, counter-clockwise.
 pub fn block_polygon(u0: f64, u1: f64, v0: f64, v1: f64) -> Vec<[f64; 2]> {
-    let square = [[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
-    let inside = |p: [f64; 2]| 1.0 - p[0] - p[1];
-    let mut out = Vec::with_capacity(5);
-    for k in 0..4 {
-        let (a, b) = (square[k], square[(k + 1) % 4]);
-        let (da, db) = (inside(a), inside(b));
+    clip_line(&[[u0, v0], [u1, v0], [u1, v1], [u0, v1]], |p| 1.0 - p[0] - p[1])
+}
+
+/// The part of polygon `p` where `side` is not negative (Sutherland-Hodgman
+/// against one line): a corner on the line is kept and makes no crossing.
+fn clip_line(p: &[[f64; 2]], side: impl Fn([f64; 2]) -> f64) -> Vec<[f64; 2]> {
+    let mut kept = Vec::with_capacity(p.len() + 1);
+    for k in 0..p.len() {
+        let (a, b) = (p[k], p[(k + 1) % p.len()]);
+        let (da, db) = (side(a), side(b));
         if da >= 0.0 {
-            out.push(a);
+            kept.push(a);
         }
         if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
             let t = da / (da - db);
-            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            kept.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
         }
     }
-    out
+    kept
 }
 
 /// Per-triangle ranges into the texel and group lists.
@@ -274,24 +278,11 @@ pub fn area_centroid(p: &[[f64; 2]]) -> (f64, [f64; 2]) {
 }
 
 /// The part of the convex polygon `p` inside the convex polygon `by`
-/// (both counter-clockwise): Sutherland-Hodgman, one edge of `by` at a time.
+/// (both counter-clockwise): [`clip_line`] by one edge of `by` at a time.
 pub fn clip_convex(mut p: Vec<[f64; 2]>, by: &[[f64; 2]]) -> Vec<[f64; 2]> {
     for k in 0..by.len() {
         let (a, b) = (by[k], by[(k + 1) % by.len()]);
-        let side = |q: [f64; 2]| turn(a, b, q);
-        let mut kept = Vec::with_capacity(p.len() + 1);
-        for m in 0..p.len() {
-            let (q, r) = (p[m], p[(m + 1) % p.len()]);
-            let (sq, sr) = (side(q), side(r));
-            if sq >= 0.0 {
-                kept.push(q);
-            }
-            if (sq >= 0.0) != (sr >= 0.0) {
-                let t = sq / (sq - sr);
-                kept.push([q[0] + t * (r[0] - q[0]), q[1] + t * (r[1] - q[1])]);
-            }
-        }
-        p = kept;
+        p = clip_line(&p, |q| turn(a, b, q));
         if p.is_empty() {
             break;
         }
