@@ -458,7 +458,8 @@ fn cube_box_shares(lo: DVec3, side: f64, angle: f64, samples: usize) -> [f64; 10
     let hi = lo + DVec3::splat(side);
     // The cube's own frame: the room turned back about the cube's axis.
     let centre = DVec3::new(lo.x + side / 2.0, 0.0, lo.z + side / 2.0);
-    let back = |v: DVec3| glam::DMat3::from_rotation_y(-angle) * v;
+    let turn_back = glam::DMat3::from_rotation_y(-angle);
+    let back = |v: DVec3| turn_back * v;
     let mut hits = [0usize; 10];
     let mut cast = 0;
     while cast < samples {
