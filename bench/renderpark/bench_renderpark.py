@@ -1,0 +1,237 @@
+"""`make bench-renderpark`: hierarchical-solve against RenderPark's solve.
+
+Issue 10 set the solve a peer: RenderPark's hierarchical Galerkin
+radiosity with clustering (the rpkCpp port of RenderPark, one thread,
+Jacobi, 30 iterations), which on the built-in Cornell box puts every
+surface within 0.7% of a converged path-traced reference at its
+link-error threshold 3e-5 (27k links) and within 4% at 1e-4 (11.8k
+links). Its times in the issue came from another machine and day; this
+measures both programs on this machine, in one run:
+
+1. scene: the pipeline's Mitsuba export (export-mitsuba: PLY meshes,
+   diffuse reflectances and area emitters, linear Rec.709 RGB) converted
+   to MGF ([`mgf`]): the triangles exactly, each material one-sided, its
+   colour as the CIE chromaticity of the RGB value and its `rd` as the
+   value's luminance Y; an emitter's `ed` is 183.07 lm/W (rpkCpp's
+   WHITE_EFFICACY, which it divides `ed` by) times the luminance of its
+   exitance pi L. rpk then runs with Rec.709 primaries and a D65 white
+   (`-red ... -white ...`), so the RGB it solves in is the export's.
+   The link counts it prints check the configuration: 27,289 at 3e-5 and
+   11,820 at 1e-4 on the built-in Cornell box, the issue's 27k and 11.8k
+   (rpk's default primaries give 25,447 and 11,069).
+2. runs, interleaved so that a change of the machine's speed shows in
+   every series alike: per round, rpk at each threshold, then
+   hierarchical-solve at each EPS on one thread (RAYON_NUM_THREADS=1); the
+   first round is a warm-up and not counted. A time is a whole process's
+   wall clock (reading the scene, solving, and for hierarchical-solve
+   writing its solution); rpk writes no image (`-raytracing-method none`,
+   no save file) and its per-iteration debug print goes to a file.
+3. table: per series the median, fastest and slowest time and the link
+   count, and hierarchical-solve's median over rpk's median at each
+   threshold.
+
+The accuracy of either program is not measured here (bench-peer and the
+README's RenderPark table do that for hierarchical-solve; rpk's is the
+issue's). Standard library only.
+"""
+
+import argparse
+import math
+import os
+import re
+import statistics
+import struct
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+
+# rpkCpp's luminous efficacy of its "white" (lm/W): it reads an MGF `ed`
+# (lm/m^2) as ed / WHITE_EFFICACY W/m^2.
+WHITE_EFFICACY = 183.07
+
+# Linear Rec.709 RGB (D65) to CIE XYZ (IEC 61966-2-1).
+RGB_TO_XYZ = (
+    (0.4124564, 0.3575761, 0.1804375),
+    (0.2126729, 0.7151522, 0.0721750),
+    (0.0193339, 0.1191920, 0.9503041),
+)
+
+# rpk's primaries and white for the RGB above (its -red/-green/-blue/-white).
+REC709 = ["-red", "0.64", "0.33", "-green", "0.30", "0.60", "-blue", "0.15", "0.06", "-white", "0.3127", "0.3290"]
+
+
+class Refused(Exception):
+    """Input this converter cannot carry over to MGF (the message says which and why)."""
+
+
+def chromaticity(rgb):
+    """(x, y, Y) of a linear Rec.709 RGB value; the white point's (x, y) for black."""
+    x_, y_, z_ = (sum(m * c for m, c in zip(row, rgb)) for row in RGB_TO_XYZ)
+    s = x_ + y_ + z_
+    if s <= 0.0:
+        return 0.3127, 0.3290, 0.0
+    return x_ / s, y_ / s, y_
+
+
+def read_ply(path):
+    """Vertices and faces of a binary little-endian PLY with float x, y, z
+    and uchar/int face lists, as export-mitsuba writes them."""
+    data = open(path, "rb").read()
+    end = data.find(b"end_header\n")
+    if not data.startswith(b"ply\n") or end < 0:
+        raise Refused(f"{path}: not a PLY file")
+    header = data[:end].decode("ascii").split("\n")
+    if "format binary_little_endian 1.0" not in header:
+        raise Refused(f"{path}: only binary little-endian PLY is read")
+    counts, props, element = {}, {"vertex": [], "face": []}, None
+    for line in header:
+        w = line.split()
+        if w[:1] == ["element"]:
+            element = w[1]
+            if element not in props:
+                raise Refused(f"{path}: element '{element}' is not read")
+            counts[element] = int(w[2])
+        elif w[:1] == ["property"]:
+            props[element].append(w[1:])
+    if props["vertex"] != [["float", "x"], ["float", "y"], ["float", "z"]] or [p[:3] for p in props["face"]] != [["list", "uchar", "int"]]:
+        raise Refused(f"{path}: properties {props} are not float x, y, z and a uchar/int face list")
+    at = end + len(b"end_header\n")
+    vertices = [struct.unpack_from("<3f", data, at + 12 * i) for i in range(counts["vertex"])]
+    at += 12 * counts["vertex"]
+    faces = []
+    for _ in range(counts["face"]):
+        n = data[at]
+        faces.append(struct.unpack_from(f"<{n}i", data, at + 1))
+        at += 1 + 4 * n
+    if at != len(data):
+        raise Refused(f"{path}: {len(data) - at} bytes after the last face")
+    return vertices, faces
+
+
+def rgb_value(element, name, where):
+    node = element.find(f"rgb[@name='{name}']")
+    if node is None:
+        raise Refused(f"{where}: no rgb '{name}'")
+    return [float(v) for v in node.get("value").replace(",", " ").split()]
+
+
+def mgf(xml_path):
+    """The MGF text of an export-mitsuba scene (see the module's doc)."""
+    root = ET.parse(xml_path).getroot()
+    base = os.path.dirname(os.path.abspath(xml_path))
+    lines = [f"# {os.path.basename(xml_path)} as MGF for RenderPark (bench/renderpark/bench_renderpark.py)"]
+    n_vertices = 0
+    for shape in root.findall("shape"):
+        name = re.sub(r"[^A-Za-z0-9_]", "_", shape.get("id", f"shape{len(lines)}"))
+        where = f"{xml_path}: shape {name}"
+        bsdf = shape.find("bsdf")
+        if shape.get("type") != "ply" or bsdf is None or bsdf.get("type") != "diffuse":
+            raise Refused(f"{where}: only PLY shapes with a diffuse BSDF convert (RenderPark's Galerkin solve is diffuse)")
+        lines += [f"o {name}", f"m {name} =", "\tsides 1"]
+        x, y, luminance = chromaticity(rgb_value(bsdf, "reflectance", where))
+        lines += ["\tc", f"\t\tcxy {x:.9f} {y:.9f}", f"\trd {luminance:.9f}"]
+        emitter = shape.find("emitter")
+        if emitter is not None:
+            if emitter.get("type") != "area":
+                raise Refused(f"{where}: emitter '{emitter.get('type')}' is not an area emitter")
+            x, y, luminance = chromaticity([math.pi * c for c in rgb_value(emitter, "radiance", where)])
+            lines += ["\tc", f"\t\tcxy {x:.9f} {y:.9f}", f"\ted {WHITE_EFFICACY * luminance:.9f}"]
+        vertices, faces = read_ply(os.path.join(base, shape.find("string[@name='filename']").get("value")))
+        for v in vertices:
+            n_vertices += 1
+            lines += [f"v v{n_vertices} =", "\tp {!r} {!r} {!r}".format(*v)]
+        first = n_vertices - len(vertices) + 1
+        lines += ["f " + " ".join(f"v{first + i}" for i in face) for face in faces]
+        lines.append("o")
+    return "\n".join(lines) + "\n"
+
+
+def rpk_links(log):
+    """The link count rpk prints after its last iteration ("Nr. interactions")."""
+    found = re.findall(r"Nr\. interactions: (\d+)", log)
+    if not found:
+        raise RuntimeError("rpk printed no 'Nr. interactions'")
+    return int(found[-1])
+
+
+def report_links(path):
+    """The links a hierarchical-solve report counts."""
+    found = re.search(r'"links":\s*([0-9.]+)', open(path).read())
+    if not found:
+        raise RuntimeError(f"{path}: no 'links' figure")
+    return int(float(found.group(1)))
+
+
+def timed(command, log_path, env=None):
+    """Wall-clock seconds of one process, its output to `log_path`; stops the run if it fails."""
+    with open(log_path, "w") as log:
+        started = time.perf_counter()
+        status = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, env=env).returncode
+        seconds = time.perf_counter() - started
+    if status != 0:
+        sys.exit(f"bench-renderpark: {command[0]} exited {status} (its output: {log_path})")
+    return seconds
+
+
+def table(series, thresholds):
+    """Markdown rows: per series its median (fastest-slowest) time and
+    links, and for hierarchical-solve its median over each rpk threshold's."""
+    rpk = {t: statistics.median(series[("rpk", t)]["times"]) for t in thresholds}
+    head = "| program | setting | links | time, median (fastest-slowest) | runs | " + " | ".join(f"over rpk {t}" for t in thresholds) + " |"
+    rows = [head, "|" + "---|" * (5 + len(thresholds))]
+    for (program, setting), s in series.items():
+        median = statistics.median(s["times"])
+        ratios = " | ".join(f"{median / rpk[t]:.2f}" if program != "rpk" else "" for t in thresholds)
+        rows.append(f"| {program} | {setting} | {s['links']} | {median:.3f} s ({min(s['times']):.3f}-{max(s['times']):.3f}) | {len(s['times'])} | {ratios} |")
+    return "\n".join(rows)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--xml", required=True, help="the scene as export-mitsuba wrote it")
+    ap.add_argument("--rpk", required=True, help="the rpk executable (rpkCpp)")
+    ap.add_argument("--thresholds", default="3e-5,1e-4", help="rpk's -gr-link-error-threshold values")
+    ap.add_argument("--solve", required=True, help="hierarchical-solve's command line without --eps, --seed, -o, --report")
+    ap.add_argument("--eps", default="6e-4", help="hierarchical-solve's EPS values")
+    ap.add_argument("--seed", default="1")
+    ap.add_argument("--runs", type=int, default=9, help="counted rounds (one warm-up round more)")
+    ap.add_argument("--out", required=True)
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    try:
+        text = mgf(a.xml)
+    except (Refused, OSError, ET.ParseError) as e:
+        sys.exit(f"bench-renderpark: {e}")
+    scene = os.path.join(a.out, "scene.mgf")
+    open(scene, "w").write(text)
+    thresholds, epses = a.thresholds.split(","), a.eps.split(",")
+    series = {("rpk", t): {"times": [], "links": None} for t in thresholds}
+    series.update({("hierarchical-solve", e): {"times": [], "links": None} for e in epses})
+    one_thread = dict(os.environ, RAYON_NUM_THREADS="1")
+    for round_ in range(a.runs + 1):
+        for t in thresholds:
+            log = os.path.join(a.out, f"rpk-{t}.log")
+            seconds = timed([a.rpk, scene, "-force-onesided", *REC709, "-radiance-method", "Galerkin", "-raytracing-method", "none",
+                             "-gr-iteration-method", "Jacobi", "-gr-hierarchical", "-gr-clustering", "-iterations", "30",
+                             "-gr-link-error-threshold", t], log)
+            s = series[("rpk", t)]
+            s["links"] = rpk_links(open(log, errors="replace").read())
+            if round_ > 0:
+                s["times"].append(seconds)
+        for e in epses:
+            solution = os.path.join(a.out, f"solution-{e}.exr")
+            seconds = timed(a.solve.split() + ["--eps", e, "--seed", a.seed, "-o", solution, "--report", solution + ".report.ron"],
+                            os.path.join(a.out, f"solve-{e}.log"), one_thread)
+            s = series[("hierarchical-solve", e)]
+            s["links"] = report_links(solution + ".report.ron")
+            if round_ > 0:
+                s["times"].append(seconds)
+        print(f"bench-renderpark: round {round_}/{a.runs}{' (warm-up)' if round_ == 0 else ''}", file=sys.stderr)
+    result = table(series, thresholds)
+    open(os.path.join(a.out, "table.md"), "w").write(result + "\n")
+    print(result)
+
+
+if __name__ == "__main__":
+    main()
