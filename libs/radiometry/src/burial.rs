@@ -43,6 +43,18 @@ pub const COINCIDENT: f32 = 1e-5;
 /// surface).
 pub const GRAZING_COS: f64 = 0.1;
 
+/// The triangle whose back face the ray from `point` along its unit
+/// front `normal` meets first, if it does (rays start at `t_min`, and skip
+/// `triangle`, the point's own): the first test of [`buried`], which
+/// finds a point open to the room wherever this is `None`. Where a solid
+/// stands on a surface it is the solid's roof over the point, the same
+/// for the points of one element under one solid: a caller that has
+/// proven some of them buried by [`buried`] may take the others under the
+/// same roof for buried too, for one ray each.
+pub fn roof(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32) -> Option<u32> {
+    scene.closest_hit(point, normal, t_min, f32::INFINITY, [triangle, u32::MAX]).map(|hit| hit.triangle).filter(|&t| normal_of(t).dot(normal) > 0.0)
+}
+
 /// Whether `point` on mesh triangle `triangle` (unit front normal
 /// `normal`) is buried, and the rays cast; `normal_of(t)` is triangle
 /// `t`'s unit front normal; rays start at `t_min` (past the rounding of
@@ -137,5 +149,18 @@ mod tests {
             }
         }
         assert!(!buried(&walled_scene, &|t| walled_normals[t as usize], dvec3(0.05, 1.05, 0.0), DVec3::Z, floor, 1e-6, &mut stream).0, "beside it, by the wall");
+        // The roof over a floor point: the cube's top (triangles 2 and 3,
+        // seen from inside) under it, none beside it or in the open, and a
+        // sheet facing up over a point (its back seen from below) is a roof
+        // though nothing buries the point: a roof alone proves nothing.
+        let roof_at = |p: DVec3| roof(&scene, &normal_of, p, DVec3::Z, floor, 1e-6);
+        assert!(matches!(roof_at(dvec3(0.5, 0.2, 0.0)), Some(2 | 3)), "{:?}", roof_at(dvec3(0.5, 0.2, 0.0)));
+        assert_eq!(roof_at(dvec3(1.03, 0.5, 0.0)), None, "beside the cube");
+        assert_eq!(roof_at(dvec3(-2.0, 2.0, 0.0)), None, "in the open");
+        let up_normals = [DVec3::Z, DVec3::Z];
+        let up_sheet = SceneRays::new(&[[dvec3(0.0, 0.0, 1.0), dvec3(1.0, 0.0, 1.0), dvec3(1.0, 1.0, 1.0)], [dvec3(-big, -big, 0.0), dvec3(big, -big, 0.0), dvec3(big, big, 0.0)]]);
+        let point = dvec3(0.7, 0.3, 0.0);
+        assert_eq!(roof(&up_sheet, &|t| up_normals[t as usize], point, DVec3::Z, 1, 1e-6), Some(0));
+        assert!(!buried(&up_sheet, &|t| up_normals[t as usize], point, DVec3::Z, 1, 1e-6, &mut Stream::new(1, 2, 3)).0, "under a sheet facing up");
     }
 }
