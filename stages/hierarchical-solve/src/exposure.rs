@@ -67,8 +67,8 @@ fn t_min(element: &crate::elements::Element) -> f32 {
 
 /// Exposure of element `e` (module docs) and the rays cast:
 /// [`EXPOSURE_POINTS`] points, and [`STRADDLING_POINTS`] where those
-/// disagree, each of which lies under the roof of a solid that buries one
-/// of the first points taken for buried after one ray (`sampled`).
+/// disagree (one ray each where the first points tell their roof,
+/// `sampled`).
 fn of_element(h: &Hierarchy, scene: &SceneRays, e: u32, seed: u64) -> (f64, u64) {
     let mut stream = Stream::new(seed ^ 0xe790_5ed0, key(Node::Element(e)), 0xb0);
     let first = sampled(h, scene, e, EXPOSURE_POINTS, None, &mut stream);
