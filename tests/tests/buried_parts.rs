@@ -138,9 +138,10 @@ fn summary(eps: &str) -> (f64, f64, f64, usize) {
 /// noise of 64 leaves' mean at that L2) and +0.10%, 2.03% at 1.5e-5.
 /// Since the last solve opens such leaves too where a shadow edge crosses
 /// them (hierarchical-solve's `shadowed`): -1.00%, 7.17% at 4e-4 and
-/// -0.39%, 1.81% at 1.5e-5; since a straddling leaf's points under a
-/// roof already proven buried take one ray (hierarchical-solve's
-/// `exposure`): -0.52%, 6.86% and -0.18%, 1.55%. What is left on a single straddling leaf is
+/// -0.39%, 1.81% at 1.5e-5; since a leaf's points under a roof already
+/// proven buried take one ray (hierarchical-solve's `exposure`, other
+/// points of the same strata): -0.87%, 6.84% and -0.40%, 1.58%. What is
+/// left on a single straddling leaf is
 /// the noise of its links' visibility rays, of which the buried part
 /// stops some.
 #[test]

@@ -67,13 +67,12 @@ fn t_min(element: &crate::elements::Element) -> f32 {
 
 /// Exposure of element `e` (module docs) and the rays cast:
 /// [`EXPOSURE_POINTS`] points, and [`STRADDLING_POINTS`] where those
-/// disagree (one ray each where the first points tell their roof,
-/// `sampled`).
+/// disagree, one ray each where a roof is known (`sampled`).
 fn of_element(h: &Hierarchy, scene: &SceneRays, e: u32, seed: u64) -> (f64, u64) {
     let mut stream = Stream::new(seed ^ 0xe790_5ed0, key(Node::Element(e)), 0xb0);
-    let first = sampled(h, scene, e, EXPOSURE_POINTS, None, &mut stream);
+    let first = sampled(h, scene, e, EXPOSURE_POINTS, &[], &mut stream);
     if first.exposure > 0.0 && first.exposure < 1.0 {
-        let more = sampled(h, scene, e, STRADDLING_POINTS, Some(&first.roofs), &mut stream);
+        let more = sampled(h, scene, e, STRADDLING_POINTS, &first.roofs, &mut stream);
         return (more.exposure, first.rays + more.rays);
     }
     (first.exposure, first.rays)
@@ -85,28 +84,30 @@ struct Sampled {
     exposure: f64,
     /// Rays cast.
     rays: u64,
-    /// The roofs ([`radiometry::burial::roof`]) over its points proven
-    /// buried, where asked for (no `roofs` given).
+    /// The roofs ([`radiometry::burial::roof`]) over its points that
+    /// [`radiometry::burial::buried`] proved buried.
     roofs: Vec<u32>,
 }
 
 /// The exposed fraction of `n` stratified points of element `e` (those
-/// that exist; 1 where none does) and the rays cast. Given `roofs` (those
-/// over points of `e` that [`radiometry::burial::buried`] proved buried),
-/// a point whose ray along the normal meets one of them first is taken
-/// for buried after that one ray, and one whose ray meets no back face
-/// for open (as `buried` decides it); only the rest cast all of `buried`'s
-/// rays. Without them, the roofs over the points proven buried are
-/// returned. A straddling element's 256 points cost its buried ones 17
-/// rays each before: on the built-in Cornell box at `EPS` 1e-3 exposure
-/// was a sixth of the solve (283k rays, 213k of them for the elements
-/// along the blocks' bases at 6e-4).
-fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: Option<&[u32]>, stream: &mut Stream) -> Sampled {
+/// that exist; 1 where none does), the rays cast, and the roofs proven.
+/// Each point first casts its ray along the normal
+/// ([`radiometry::burial::roof`]): one that meets no back face is open,
+/// as [`radiometry::burial::buried`] decides it, and one that meets first
+/// a roof already proven (given in `roofs`, or found earlier in this
+/// call) is buried; only the rest cast all of `buried`'s rays, and a roof
+/// over a point they prove buried is proven. A roof alone proves nothing
+/// (under a sheet facing up a ray meets its back too), but under a solid
+/// the points of one element share a few roofs. Each buried point cast
+/// 17 rays before: on the built-in Cornell box at `EPS` 1e-3 exposure was
+/// a sixth of the solve (283k rays), most of it along the blocks' bases
+/// and under them.
+fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: &[u32], stream: &mut Stream) -> Sampled {
     let element = &h.elements[e as usize];
     let normal = h.normal(e);
     let normal_of = |t: u32| h.triangles[t as usize].normal;
     let t_min = t_min(element);
-    let (mut existing, mut exposed, mut rays, mut found) = (0usize, 0usize, 0u64, Vec::new());
+    let (mut existing, mut exposed, mut rays, mut proven) = (0usize, 0usize, 0u64, roofs.to_vec());
     let strata = Strata::of(n);
     for k in 0..n {
         let point = strata.point(&element.points, k, stream);
@@ -114,28 +115,22 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: Option<&[u
             continue;
         }
         existing += 1;
-        let is_buried = match roofs.map(|known| (known, radiometry::burial::roof(scene, &normal_of, point, normal, element.triangle, t_min))) {
-            Some((_, None)) => {
-                rays += 1;
-                false
-            }
-            Some((known, Some(roof))) if known.contains(&roof) => {
-                rays += 1;
-                true
-            }
-            _ => {
+        rays += 1;
+        let is_buried = match radiometry::burial::roof(scene, &normal_of, point, normal, element.triangle, t_min) {
+            None => false,
+            Some(roof) if proven.contains(&roof) => true,
+            Some(roof) => {
                 let (is_buried, cast) = radiometry::burial::buried(scene, &normal_of, point, normal, element.triangle, t_min, stream);
-                rays += cast + u64::from(roofs.is_some());
-                if is_buried && roofs.is_none() {
-                    found.extend(radiometry::burial::roof(scene, &normal_of, point, normal, element.triangle, t_min));
-                    rays += 1;
+                rays += cast;
+                if is_buried {
+                    proven.push(roof);
                 }
                 is_buried
             }
         };
         exposed += usize::from(!is_buried);
     }
-    Sampled { exposure: if existing == 0 { 1.0 } else { exposed as f64 / existing as f64 }, rays, roofs: found }
+    Sampled { exposure: if existing == 0 { 1.0 } else { exposed as f64 / existing as f64 }, rays, roofs: proven }
 }
 
 /// The exposure of an inner node: its children's `(area, exposure)`
