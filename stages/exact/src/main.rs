@@ -74,5 +74,5 @@ impl Stage for Args {
 }
 
 fn main() -> ExitCode {
-    stage_kit::stage::main::<Args>()
+    stage_kit::stage::main_parallel::<Args>()
 }

@@ -78,5 +78,5 @@ impl stage_kit::stage::Stage for Args {
 }
 
 fn main() -> ExitCode {
-    stage_kit::stage::main::<Args>()
+    stage_kit::stage::main_parallel::<Args>()
 }
