@@ -58,22 +58,36 @@ pub fn roof(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, n
 /// Whether `point` on mesh triangle `triangle` (unit front normal
 /// `normal`) is buried, and the rays cast; `normal_of(t)` is triangle
 /// `t`'s unit front normal; rays start at `t_min` (past the rounding of
-/// their f32 origin).
+/// their f32 origin). It is under a [`roof`] and [`walled_in`].
 pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, stream: &mut Stream) -> (bool, u64) {
+    let turn = 2.0 * PI * stream.next_f64();
+    if roof(scene, normal_of, point, normal, triangle, t_min).is_none() {
+        return (false, 1);
+    }
+    let (walled, cast) = grazing(scene, normal_of, point, normal, triangle, t_min, turn);
+    (walled, 1 + cast)
+}
+
+/// The rest of [`buried`] for a point whose [`roof`] is known to be
+/// there: whether each of its [`GRAZING_RAYS`] meets a back face first,
+/// under one random turn drawn from `stream`, and the rays cast. A caller
+/// that has cast the ray along the normal itself need not cast it again.
+pub fn walled_in(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, stream: &mut Stream) -> (bool, u64) {
+    let turn = 2.0 * PI * stream.next_f64();
+    grazing(scene, normal_of, point, normal, triangle, t_min, turn)
+}
+
+/// [`walled_in`] with its turn in azimuth, radians.
+fn grazing(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, turn: f64) -> (bool, u64) {
     let helper = if normal.x.abs() > 0.5 { DVec3::Y } else { DVec3::X };
     let u = normal.cross(helper).normalize();
     let v = normal.cross(u);
-    let turn = 2.0 * PI * stream.next_f64();
     let sin_grazing = (1.0 - GRAZING_COS * GRAZING_COS).sqrt();
     // Second queries of the coincidence rule, counted as rays.
     let mut extra = 0;
-    for k in 0..EXPOSURE_RAYS {
-        let direction = if k == 0 {
-            normal
-        } else {
-            let phi = turn + 2.0 * PI * k as f64 / GRAZING_RAYS as f64;
-            normal * GRAZING_COS + u * (sin_grazing * phi.cos()) + v * (sin_grazing * phi.sin())
-        };
+    for k in 1..EXPOSURE_RAYS {
+        let phi = turn + 2.0 * PI * k as f64 / GRAZING_RAYS as f64;
+        let direction = normal * GRAZING_COS + u * (sin_grazing * phi.cos()) + v * (sin_grazing * phi.sin());
         let back = |t: u32| normal_of(t).dot(direction) > 0.0;
         let back_face = match scene.closest_hit(point, direction, t_min, f32::INFINITY, [triangle, u32::MAX]) {
             None => false,
@@ -83,17 +97,16 @@ pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3,
             // face coincide) closes the solid: a grazing ray from the floor
             // under the block meets the two at one distance, whichever the
             // traversal returns first.
-            Some(hit) if k > 0 => {
+            Some(hit) => {
                 extra += 1;
                 scene.closest_hit(point, direction, t_min, hit.t * (1.0 + COINCIDENT) + t_min, [triangle, hit.triangle]).is_some_and(|other| back(other.triangle))
             }
-            Some(_) => false,
         };
         if !back_face {
-            return (false, k as u64 + 1 + extra);
+            return (false, k as u64 + extra);
         }
     }
-    (true, EXPOSURE_RAYS as u64 + extra)
+    (true, GRAZING_RAYS as u64 + extra)
 }
 
 #[cfg(test)]

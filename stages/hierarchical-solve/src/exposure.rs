@@ -95,8 +95,9 @@ struct Sampled {
 /// ([`radiometry::burial::roof`]): one that meets no back face is open,
 /// as [`radiometry::burial::buried`] decides it, and one that meets first
 /// a roof already proven (given in `roofs`, or found earlier in this
-/// call) is buried; only the rest cast all of `buried`'s rays, and a roof
-/// over a point they prove buried is proven. A roof alone proves nothing
+/// call) is buried; only the rest cast the grazing rays
+/// ([`radiometry::burial::walled_in`]), and a roof over a point they
+/// prove buried is proven. A roof alone proves nothing
 /// (under a sheet facing up a ray meets its back too), but under a solid
 /// the points of one element share a few roofs. Each buried point cast
 /// 17 rays before: on the built-in Cornell box at `EPS` 1e-3 exposure was
@@ -120,7 +121,7 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: &[u32], st
             None => false,
             Some(roof) if proven.contains(&roof) => true,
             Some(roof) => {
-                let (is_buried, cast) = radiometry::burial::buried(scene, &normal_of, point, normal, element.triangle, t_min, stream);
+                let (is_buried, cast) = radiometry::burial::walled_in(scene, &normal_of, point, normal, element.triangle, t_min, stream);
                 rays += cast;
                 if is_buried {
                     proven.push(roof);
