@@ -39,6 +39,7 @@ import argparse
 import math
 import os
 import re
+import shlex
 import statistics
 import struct
 import subprocess
@@ -221,7 +222,7 @@ def main():
                 s["times"].append(seconds)
         for e in epses:
             solution = os.path.join(a.out, f"solution-{e}.exr")
-            seconds = timed(a.solve.split() + ["--eps", e, "--seed", a.seed, "-o", solution, "--report", solution + ".report.ron"],
+            seconds = timed(shlex.split(a.solve) + ["--eps", e, "--seed", a.seed, "-o", solution, "--report", solution + ".report.ron"],
                             os.path.join(a.out, f"solve-{e}.log"), one_thread)
             s = series[("hierarchical-solve", e)]
             s["links"] = report_links(solution + ".report.ron")
