@@ -8,6 +8,7 @@ pub mod gather;
 pub mod mask;
 pub mod mirror;
 pub mod structured;
+pub mod surfaces;
 pub mod sweep;
 
 use std::path::PathBuf;
