@@ -63,8 +63,8 @@ $(BINS) &: FORCE
 	@cargo build --release --quiet $(addprefix -p ,$(STAGES)) --bins
 
 # The benchmark drivers (bench-solve, bench-scale, sweep, bench-gather's
-# summary, bench-structured).
-BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep bench-gather bench-structured bench-mask)
+# summary, bench-structured, bench-mask, bench-surfaces).
+BENCH_BINS := $(addprefix $(BIN)/,bench-solve bench-scale sweep bench-gather bench-structured bench-mask bench-surfaces)
 $(BENCH_BINS) &: FORCE
 	@cargo build --release --quiet -p bench --bins
 

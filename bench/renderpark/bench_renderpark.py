@@ -29,10 +29,18 @@ measures both programs on this machine, in one run:
 3. table: per series the median, fastest and slowest time and the link
    count, and hierarchical-solve's median over rpk's median at each
    threshold.
+4. surfaces: each program's solution, measured alike (`bench-surfaces`,
+   bench/src/surfaces.rs): each surface's mean radiosity over its area
+   open to the scene against a hierarchical-solve reference at a much
+   finer EPS (`--surfaces` names it). rpk runs once more per threshold,
+   untimed, saving its model (`-radiance-model-savefile`: every leaf
+   element's corners with the radiance of its linear basis there, which
+   the Makefile's build of rpk leaves unmapped); hierarchical-solve's are
+   its last timed solutions. It is the solve's accuracy, not an image's
+   (bench-peer measures hierarchical-solve's images against Mitsuba):
+   rpk's solution is not rendered here.
 
-The accuracy of either program is not measured here (bench-peer and the
-README's RenderPark table do that for hierarchical-solve; rpk's is the
-issue's). Standard library only.
+Standard library only.
 """
 
 import argparse
@@ -175,6 +183,13 @@ def timed(command, log_path, env=None):
     return seconds
 
 
+def rpk_command(rpk, scene, threshold):
+    """rpk's command line for the solve at `threshold` (see the module's doc)."""
+    return [rpk, scene, "-force-onesided", *REC709, "-radiance-method", "Galerkin", "-raytracing-method", "none",
+            "-gr-iteration-method", "Jacobi", "-gr-hierarchical", "-gr-clustering", "-iterations", "30",
+            "-gr-link-error-threshold", threshold]
+
+
 def table(series, thresholds):
     """Markdown rows: per series its median (fastest-slowest) time and
     links, and for hierarchical-solve its median over each rpk threshold's."""
@@ -197,6 +212,7 @@ def main():
     ap.add_argument("--eps", default="6e-4", help="hierarchical-solve's EPS values")
     ap.add_argument("--seed", default="1")
     ap.add_argument("--runs", type=int, default=9, help="counted rounds (one warm-up round more)")
+    ap.add_argument("--surfaces", required=True, help="bench-surfaces' command line without -o and the series (its mesh, manifest and reference)")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
@@ -213,9 +229,7 @@ def main():
     for round_ in range(a.runs + 1):
         for t in thresholds:
             log = os.path.join(a.out, f"rpk-{t}.log")
-            seconds = timed([a.rpk, scene, "-force-onesided", *REC709, "-radiance-method", "Galerkin", "-raytracing-method", "none",
-                             "-gr-iteration-method", "Jacobi", "-gr-hierarchical", "-gr-clustering", "-iterations", "30",
-                             "-gr-link-error-threshold", t], log)
+            seconds = timed(rpk_command(a.rpk, scene, t), log)
             s = series[("rpk", t)]
             s["links"] = rpk_links(open(log, errors="replace").read())
             if round_ > 0:
@@ -232,6 +246,16 @@ def main():
     result = table(series, thresholds)
     open(os.path.join(a.out, "table.md"), "w").write(result + "\n")
     print(result)
+    models = []
+    for t in thresholds:
+        model = os.path.join(a.out, f"rpk-{t}.wrl")
+        timed(rpk_command(a.rpk, scene, t) + ["-radiance-model-savefile", model], os.path.join(a.out, f"rpk-{t}-model.log"))
+        models.append(f"rpk {t}={model}")
+    solutions = [f"hierarchical-solve {e}={os.path.join(a.out, f'solution-{e}.exr')}" for e in epses]
+    surfaces = os.path.join(a.out, "surfaces.md")
+    status = subprocess.run(shlex.split(a.surfaces) + ["-o", surfaces, *models, *solutions]).returncode
+    if status != 0:
+        sys.exit(f"bench-renderpark: bench-surfaces exited {status}")
 
 
 if __name__ == "__main__":
