@@ -14,7 +14,9 @@
 # Debian. Writes $(RPK_OUT)/table.md (times: per program and setting the
 # median time and links, and hierarchical-solve's time over rpk's) and
 # $(RPK_OUT)/surfaces.md (each surface's mean radiosity against a solve at
-# EPS $(RPK_REF_EPS)), printed too. About a minute once rpk is built.
+# EPS $(RPK_REF_EPS)) and, where `make bench-peer`'s Mitsuba image exists
+# (RPK_IMAGE_REF), $(RPK_OUT)/images.md (every solution's preview against
+# it), printed too. About a minute once rpk is built.
 
 RPK_REPO ?= https://github.com/OscarChavarro/rpkCpp.git
 RPK_COMMIT ?= 37e5ff4eede5fd7444916eb06f0379db137fefc9
@@ -32,6 +34,8 @@ RPK_RUNS ?= 9
 # this EPS (within 0.01% of EPS 1e-5 on every surface of the built-in
 # Cornell box), solved once.
 RPK_REF_EPS ?= 2.5e-5
+# The path-traced image the previews are compared with, if it exists.
+RPK_IMAGE_REF ?= $(OUT)/peer/reference.exr
 RPK_OUT ?= $(OUT)/renderpark
 RPK_PACKAGES := cmake g++ freeglut3-dev libglu1-mesa-dev
 
@@ -64,8 +68,11 @@ $(RPK_OUT)/reference-$(RPK_REF_EPS).exr: $(BIN)/hierarchical-solve $(OUT)/params
 	$(BIN)/hierarchical-solve --params $(OUT)/params/hierarchical-solve.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR)) \
 	  --eps $(RPK_REF_EPS) --seed 1 -o $@ --report $@.report.ron
 
-bench-renderpark: $(BIN)/hierarchical-solve $(BIN)/bench-surfaces $(RPK_BIN) $(MITSUBA_XML) $(OUT)/params/hierarchical-solve.ron $(OUT)/params/clusters $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(CLUSTERS_EXR) $(RPK_OUT)/reference-$(RPK_REF_EPS).exr
+bench-renderpark: $(BINS) $(BIN)/bench-surfaces $(RPK_BIN) $(OUT)/params/grid-gather.ron $(MITSUBA_XML) $(OUT)/params/hierarchical-solve.ron $(OUT)/params/clusters $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(CLUSTERS_EXR) $(RPK_OUT)/reference-$(RPK_REF_EPS).exr
 	python3 bench/renderpark/bench_renderpark.py --xml $(MITSUBA_XML) --rpk $(RPK_BIN) \
 	  --thresholds $(RPK_THRESHOLDS) --eps $(RPK_EPS) --runs $(RPK_RUNS) --out $(RPK_OUT) \
 	  --surfaces '$(BIN)/bench-surfaces --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --reference $(RPK_OUT)/reference-$(RPK_REF_EPS).exr' \
+	  $(if $(wildcard $(RPK_IMAGE_REF)),--image-reference $(RPK_IMAGE_REF)) \
+	  --preview '$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr' \
+	  --compare '$(BIN)/compare --exclude-emitters --exclude-edges 2 --manifest $(OUT)/manifest.ron' \
 	  --solve '$(BIN)/hierarchical-solve --params $(OUT)/params/hierarchical-solve.ron --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr $(if $(CLUSTERS_EXR),--clusters $(CLUSTERS_EXR))'

@@ -32,13 +32,22 @@ measures both programs on this machine, in one run:
 4. surfaces: each program's solution, measured alike (`bench-surfaces`,
    bench/src/surfaces.rs): each surface's mean radiosity over its area
    open to the scene against a hierarchical-solve reference at a much
-   finer EPS (`--surfaces` names it). rpk runs once more per threshold,
+   finer EPS (`--surfaces` names it); then each input triangle's, where a
+   surface's mean may hide errors of opposite sign on its faces
+   (triangles.md; its last line printed). rpk runs once more per threshold,
    untimed, saving its model (`-radiance-model-savefile`: every leaf
    element's corners with the radiance of its linear basis there, which
    the Makefile's build of rpk leaves unmapped); hierarchical-solve's are
-   its last timed solutions. It is the solve's accuracy, not an image's
-   (bench-peer measures hierarchical-solve's images against Mitsuba):
-   rpk's solution is not rendered here.
+   its last timed solutions. It is the solve's accuracy.
+5. images, where a path-traced reference image is given (`make
+   bench-peer`'s Mitsuba image): every solution rendered by grid-gather's
+   preview and compared with it as bench-peer compares (relative RMSE and
+   each surface's mean; emitters and 2 px round edges left out). rpk's
+   models become solutions on the mesh (`bench-surfaces --solutions`:
+   each leaf two quadtree levels below its element, with the element's
+   linear radiance there), so both programs' solutions go through the
+   same display: the issue's own measure of rpk (every surface within
+   0.7%), taken here in the same run.
 
 Standard library only.
 """
@@ -190,6 +199,35 @@ def rpk_command(rpk, scene, threshold):
             "-gr-link-error-threshold", threshold]
 
 
+def file_label(label):
+    """The file name bench-surfaces gives a series' solution: its label
+    with characters other than letters, digits, '.' and '-' as '-'."""
+    return "".join(c if (c.isascii() and c.isalnum()) or c in ".-" else "-" for c in label)
+
+
+def compared(text):
+    """(relative RMSE, {surface: mean signed error}) of a compare report
+    (RON text; run with --exclude-emitters, it has no emitter's surface);
+    the errors are fractions."""
+    found = re.search(r'\n\s*"relative_rmse":\s*([0-9.eE+-]+)', text)
+    if not found:
+        raise RuntimeError("the compare report has no relative_rmse")
+    signed = re.findall(r'"object\[([^\]]+)\]\.mean_signed_error":\s*([0-9.eE+-]+)', text)
+    return float(found.group(1)), {k: float(v) for k, v in signed}
+
+
+def image_table(results):
+    """Markdown: per surface each series' mean signed error in the image,
+    then its relative RMSE and its worst surface."""
+    names = sorted({k for _, (_, errors) in results for k in errors})
+    rows = ["| surface | " + " | ".join(label for label, _ in results) + " |", "|---|" + "---|" * len(results)]
+    for n in names:
+        rows.append(f"| {n} | " + " | ".join(f"{100 * e[n]:+.2f}%" if n in e else "-" for _, (_, e) in results) + " |")
+    rows.append("| relative RMSE | " + " | ".join(f"{100 * r:.2f}%" for _, (r, _) in results) + " |")
+    rows.append("| worst surface | " + " | ".join(f"{100 * max(map(abs, e.values())):.2f}%" for _, (_, e) in results) + " |")
+    return "\n".join(rows)
+
+
 def table(series, thresholds):
     """Markdown rows: per series its median (fastest-slowest) time and
     links, and for hierarchical-solve its median over each rpk threshold's."""
@@ -213,6 +251,9 @@ def main():
     ap.add_argument("--seed", default="1")
     ap.add_argument("--runs", type=int, default=9, help="counted rounds (one warm-up round more)")
     ap.add_argument("--surfaces", required=True, help="bench-surfaces' command line without -o and the series (its mesh, manifest and reference)")
+    ap.add_argument("--image-reference", help="a path-traced image of the scene (bench-peer's); renders and compares every solution")
+    ap.add_argument("--preview", help="grid-gather's command line for the preview, without --solution, -o and --report")
+    ap.add_argument("--compare", help="compare's command line without the two images and -o")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
@@ -253,9 +294,27 @@ def main():
         models.append(f"rpk {t}={model}")
     solutions = [f"hierarchical-solve {e}={os.path.join(a.out, f'solution-{e}.exr')}" for e in epses]
     surfaces = os.path.join(a.out, "surfaces.md")
-    status = subprocess.run(shlex.split(a.surfaces) + ["-o", surfaces, *models, *solutions]).returncode
+    converted = os.path.join(a.out, "rpk-solutions")
+    status = subprocess.run(shlex.split(a.surfaces) + ["-o", surfaces, "--solutions", converted, *models, *solutions]).returncode
+    triangles = os.path.join(a.out, "triangles.md")
+    status = status or subprocess.run(shlex.split(a.surfaces) + ["--by", "triangle", "-o", triangles, *models, *solutions], stdout=subprocess.DEVNULL).returncode
     if status != 0:
         sys.exit(f"bench-renderpark: bench-surfaces exited {status}")
+    print(f"per input triangle ({triangles}): {open(triangles).read().strip().splitlines()[-1]}")
+    if not a.image_reference:
+        print("bench-renderpark: no reference image (make bench-peer makes one): the images are not compared", file=sys.stderr)
+        return
+    series = [(m.split("=", 1)[0], os.path.join(converted, file_label(m.split("=", 1)[0]) + ".exr")) for m in models]
+    series += [tuple(x.split("=", 1)) for x in solutions]
+    results = []
+    for label, solution in series:
+        image, report = os.path.join(a.out, f"preview-{file_label(label)}.exr"), os.path.join(a.out, f"compare-{file_label(label)}.ron")
+        timed(shlex.split(a.preview) + ["--solution", solution, "-o", image, "--report", image + ".report.ron"], image + ".log")
+        timed(shlex.split(a.compare) + [image, a.image_reference, "-o", report], report + ".log")
+        results.append((label, compared(open(report).read())))
+    images = image_table(results)
+    open(os.path.join(a.out, "images.md"), "w").write(images + "\n")
+    print(images)
 
 
 if __name__ == "__main__":

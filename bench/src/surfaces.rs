@@ -2,8 +2,9 @@
 //! a reference solve: `bench-surfaces`, with which `make bench-renderpark`
 //! measures both programs' accuracy alike.
 //!
-//! A surface is an object of the manifest (emitters left out). Its mean is
-//! the luminance of its radiosity averaged over its area open to the scene,
+//! A surface is an object of the manifest, or each of its input triangles
+//! ([`Unit`]; emitters left out). Its mean is the luminance of its
+//! radiosity averaged over its area open to the scene,
 //!
 //! ```text
 //! B_o = sum_k a_k Y(B_k) / sum_k a_k
@@ -21,8 +22,14 @@
 //! there: its radiosity over its open part as it would show. Both solvers
 //! are judged by the same measure against the same reference, a solve at
 //! a much finer `EPS` (the README's RenderPark section).
+//!
+//! A RenderPark model also converts into a solution on the mesh
+//! ([`Surfaces::solution_of_faces`]), which grid-gather's preview renders
+//! like any other: its images are then measured like hierarchical-solve's.
 
 use glam::DVec3;
+use radiometry::subdivision::{children, Corners, ROOT};
+use schemas::header::Header;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::{Element, Solution, NONE};
 use std::f64::consts::PI;
@@ -132,11 +139,22 @@ pub fn vrml_faces(text: &str) -> Result<Vec<Face>, String> {
     Ok(faces)
 }
 
+/// What a surface is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Unit {
+    /// An object of the manifest (the issue's surfaces: floor, blocks).
+    Object,
+    /// An input triangle of the mesh (a block's face is two): where an
+    /// object's mean hides errors of opposite sign on its faces.
+    Triangle,
+}
+
 /// The scene's surfaces and a reference solution on its mesh.
 pub struct Surfaces<'a> {
     mesh: &'a Mesh,
-    /// Object names, and whether each is measured (not an emitter).
-    objects: Vec<(String, bool)>,
+    unit: Unit,
+    /// Surface names, and whether each is measured (not an emitter).
+    surfaces: Vec<(String, bool)>,
     reference: &'a Solution,
     /// Largest distance of a point from a triangle's plane that still lies
     /// on it, m.
@@ -148,35 +166,39 @@ pub struct Surfaces<'a> {
 const INSIDE: f64 = 1e-5;
 
 impl<'a> Surfaces<'a> {
-    /// The surfaces of `mesh` and `manifest`, against `reference` (a
-    /// solution on that mesh).
-    pub fn new(mesh: &'a Mesh, manifest: &Manifest, reference: &'a Solution) -> Result<Self, String> {
+    /// The surfaces (`unit`) of `mesh` and `manifest`, against `reference`
+    /// (a solution on that mesh).
+    pub fn new(mesh: &'a Mesh, manifest: &Manifest, reference: &'a Solution, unit: Unit) -> Result<Self, String> {
         check_mesh(mesh, reference, "the reference")?;
         let emits = |t: &schemas::mesh::Triangle| luminance(manifest.materials[t.material as usize].emission) > 0.0;
-        let objects = manifest
-            .objects
-            .iter()
-            .enumerate()
-            .map(|(o, name)| (name.clone(), !mesh.triangles.iter().filter(|t| t.object as usize == o).all(emits)))
-            .collect();
+        let surfaces = match unit {
+            Unit::Object => manifest
+                .objects
+                .iter()
+                .enumerate()
+                .map(|(o, name)| (name.clone(), !mesh.triangles.iter().filter(|t| t.object as usize == o).all(emits)))
+                .collect(),
+            Unit::Triangle => mesh.triangles.iter().enumerate().map(|(i, t)| (format!("{} {i}", manifest.objects[t.object as usize]), !emits(t))).collect(),
+        };
         let (lo, hi) = mesh.positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(point(*p)), hi.max(point(*p))));
-        Ok(Surfaces { mesh, objects, reference, on_plane: 1e-5 * (hi - lo).length() })
+        Ok(Surfaces { mesh, unit, surfaces, reference, on_plane: 1e-5 * (hi - lo).length() })
     }
 
-    /// The measured objects' names.
+    /// The measured surfaces' names (an object's, or an object's and a
+    /// triangle's index).
     pub fn names(&self) -> Vec<&str> {
-        self.objects.iter().filter(|o| o.1).map(|o| o.0.as_str()).collect()
+        self.surfaces.iter().filter(|o| o.1).map(|o| o.0.as_str()).collect()
     }
 
-    /// Each measured object's mean ([`Self::names`]' order) in `solution`,
+    /// Each measured surface's mean ([`Self::names`]' order) in `solution`,
     /// a solution on the same mesh; `None` where it has no open area.
     pub fn of_solution(&self, solution: &Solution) -> Result<Vec<Option<f64>>, String> {
         check_mesh(self.mesh, solution, "a solution")?;
-        let pieces = solution.elements.iter().filter(|e| e.first_child == NONE).map(|e| (self.object_of(e.triangle), f64::from(e.area), e.radiosity.map(f64::from)));
+        let pieces = solution.elements.iter().filter(|e| e.first_child == NONE).map(|e| (self.surface_of(e.triangle), f64::from(e.area), e.radiosity.map(f64::from)));
         Ok(self.means(pieces))
     }
 
-    /// Each measured object's mean in the faces of a RenderPark model
+    /// Each measured surface's mean in the faces of a RenderPark model
     /// ([`Face::pieces`]). A piece that lies on no triangle of the mesh is
     /// an error.
     pub fn of_faces(&self, faces: &[Face]) -> Result<Vec<Option<f64>>, String> {
@@ -185,25 +207,101 @@ impl<'a> Surfaces<'a> {
             .flat_map(Face::pieces)
             .map(|(c, area, radiosity)| {
                 let (t, uv) = self.locate(c).ok_or(format!("a face's point ({:.6}, {:.6}, {:.6}) lies on no triangle of the mesh", c.x, c.y, c.z))?;
-                Ok((self.object_of(t), area * self.open_fraction(t, uv), radiosity))
+                Ok((self.surface_of(t), area * self.open_fraction(t, uv), radiosity))
             })
             .collect::<Result<Vec<_>, String>>()?;
         Ok(self.means(pieces.into_iter()))
     }
 
-    fn object_of(&self, triangle: u32) -> usize {
-        self.mesh.triangles[triangle as usize].object as usize
+    /// A RenderPark model as a solution on the mesh (no links, no
+    /// clusters): each input triangle subdivided as hierarchical-solve
+    /// subdivides it, down to [`BELOW_FACE`] levels below the model's
+    /// element (triangle of its fan) that holds the leaf, each leaf with
+    /// the radiosity of that element's linear basis at its centroid (its
+    /// mean there) and the reference's open fraction of its area
+    /// ([`Self::of_faces`]). The model's elements must be such
+    /// subdivisions too (RenderPark's quadtree of a triangle is): a leaf
+    /// that no element holds, or that still straddles two at
+    /// [`MOST_LEVELS`], is an error.
+    pub fn solution_of_faces(&self, faces: &[Face], header: Header) -> Result<Solution, String> {
+        let mut on: Vec<Vec<Piece>> = vec![Vec::new(); self.mesh.triangles.len()];
+        for f in faces {
+            for i in 1..f.corners.len() - 1 {
+                let k = [0, i, i + 1];
+                let centroid = k.iter().map(|&j| f.corners[j]).sum::<DVec3>() / 3.0;
+                let (t, _) = self.locate(centroid).ok_or(format!("a face centred at ({:.6}, {:.6}, {:.6}) lies on no triangle of the mesh", centroid.x, centroid.y, centroid.z))?;
+                let [p0, p1, p2] = self.corners(t);
+                let uv = k.map(|j| barycentric(p1 - p0, p2 - p0, f.corners[j] - p0));
+                on[t as usize].push(Piece { uv, radiosity: k.map(|j| f.radiance[j].map(|r| PI * r)) });
+            }
+        }
+        let triangles = self.mesh.triangles.len();
+        let mut elements: Vec<Element> = (0..triangles as u32).map(|t| Element::root(t, 0.0, [0.0; 3])).collect();
+        let mut corners: Vec<Corners> = vec![ROOT; triangles];
+        let mut e = 0;
+        while e < elements.len() {
+            let (t, level) = (elements[e].triangle, elements[e].level);
+            let c = corners[e];
+            let centroid = [(c[0][0] + c[1][0] + c[2][0]) / 3.0, (c[0][1] + c[1][1] + c[2][1]) / 3.0];
+            let holding = on[t as usize].iter().find(|p| p.holds(centroid));
+            let leaf = holding.filter(|p| c.iter().all(|&x| p.holds(x)) && uv_area_of(&c) * 4f64.powi(BELOW_FACE as i32) <= uv_area_of(&p.uv) * (1.0 + 1e-9));
+            if let Some(p) = leaf {
+                elements[e].radiosity = p.at(centroid).map(|x| x as f32);
+                elements[e].area = (f64::from(self.mesh.triangles[t as usize].area) * 2.0 * uv_area_of(&c) * self.open_fraction(t, centroid)) as f32;
+            } else if level >= MOST_LEVELS {
+                return Err(format!("triangle {t}: a leaf at ({:.6}, {:.6}) {} after {MOST_LEVELS} levels", centroid[0], centroid[1], if holding.is_some() { "still straddles two of the model's elements" } else { "lies in none of the model's elements" }));
+            } else {
+                elements[e].first_child = elements.len() as u32;
+                for child in children(&c) {
+                    elements.push(Element { triangle: t, parent: e as u32, first_child: NONE, level: level + 1, corners: child.map(|x| x.map(|v| v as f32)), area: 0.0, radiosity: [0.0; 3] });
+                    corners.push(child);
+                }
+            }
+            e += 1;
+        }
+        // Inner elements: their children's open area and its mean radiosity
+        // (children follow their parents, so one backward sweep finds an
+        // element's sums complete when it reaches it).
+        for e in (0..elements.len()).rev() {
+            let element = &mut elements[e];
+            if element.first_child != NONE {
+                let area = element.area;
+                element.radiosity = element.radiosity.map(|x| if area > 0.0 { x / area } else { 0.0 });
+            }
+            let (parent, area, b) = (element.parent, element.area, element.radiosity);
+            if parent != NONE {
+                let p = &mut elements[parent as usize];
+                for c in 0..3 {
+                    p.radiosity[c] += area * b[c];
+                }
+                p.area += area;
+            }
+        }
+        Ok(Solution { header, elements, clusters: Vec::new(), links: Vec::new() })
     }
 
-    /// Open-area-weighted mean luminance per measured object of `(object,
-    /// open area, radiosity)` pieces.
+    /// Triangle `t`'s corners.
+    fn corners(&self, t: u32) -> [DVec3; 3] {
+        self.mesh.triangles[t as usize].vertices.map(|v| point(self.mesh.positions[v as usize]))
+    }
+
+    /// The surface input triangle `triangle` belongs to.
+    fn surface_of(&self, triangle: u32) -> usize {
+        match self.unit {
+            Unit::Object => self.mesh.triangles[triangle as usize].object as usize,
+            Unit::Triangle => triangle as usize,
+        }
+    }
+
+    /// Open-area-weighted mean luminance per measured surface of
+    /// `(surface, open area, radiosity)` pieces.
     fn means(&self, pieces: impl Iterator<Item = (usize, f64, [f64; 3])>) -> Vec<Option<f64>> {
-        let mut sums = vec![(0.0, 0.0); self.objects.len()];
+        let mut sums = vec![(0.0, 0.0); self.surfaces.len()];
         for (o, a, b) in pieces {
             sums[o].0 += a * luminance(b);
             sums[o].1 += a;
         }
-        sums.iter().zip(&self.objects).filter(|(_, o)| o.1).map(|(&(s, a), _)| (a > 0.0).then(|| s / a)).collect()
+        sums.iter().zip(&self.surfaces).filter(|(_, o)| o.1).map(|(&(s, a), _)| (a > 0.0).then(|| s / a)).collect()
     }
 
     /// The triangle `p` lies on and its barycentric `(u, v)` there (`p =
@@ -211,8 +309,8 @@ impl<'a> Surfaces<'a> {
     /// that hold it.
     fn locate(&self, p: DVec3) -> Option<(u32, [f64; 2])> {
         let mut best: Option<(f64, u32, [f64; 2])> = None;
-        for (t, tri) in self.mesh.triangles.iter().enumerate() {
-            let [p0, p1, p2] = tri.vertices.map(|v| point(self.mesh.positions[v as usize]));
+        for t in 0..self.mesh.triangles.len() {
+            let [p0, p1, p2] = self.corners(t as u32);
             let (e1, e2) = (p1 - p0, p2 - p0);
             let n = e1.cross(e2);
             let distance = (p - p0).dot(n).abs() / n.length();
@@ -236,13 +334,53 @@ impl<'a> Surfaces<'a> {
             let children = &elements[e.first_child as usize..e.first_child as usize + 4];
             e = children.iter().max_by(|a, b| inside_by(a, uv).total_cmp(&inside_by(b, uv))).expect("four children");
         }
-        let geometric = f64::from(self.mesh.triangles[t as usize].area) * 2.0 * uv_area(e);
+        let geometric = f64::from(self.mesh.triangles[t as usize].area) * 2.0 * uv_area_of(&corners_of(e));
         if geometric > 0.0 {
             (f64::from(e.area) / geometric).clamp(0.0, 1.0)
         } else {
             1.0
         }
     }
+}
+
+/// Levels below a RenderPark element that [`Surfaces::solution_of_faces`]
+/// subdivides to: 16 leaves carry its linear basis, each its mean over it.
+pub const BELOW_FACE: u32 = 2;
+
+/// Most levels [`Surfaces::solution_of_faces`] subdivides an input
+/// triangle to.
+pub const MOST_LEVELS: u32 = 16;
+
+/// A triangle of a RenderPark element on an input triangle: its corners'
+/// `(u, v)` there and radiosity.
+#[derive(Clone, Debug)]
+struct Piece {
+    uv: Corners,
+    radiosity: [[f64; 3]; 3],
+}
+
+/// How far outside a RenderPark element, in its own barycentric terms, a
+/// corner of a leaf may lie and be taken as in it: its corners carry the
+/// VRML's six digits; a leaf that straddles two elements has a corner
+/// outside one by a good fraction of it.
+const IN_PIECE: f64 = 1e-3;
+
+impl Piece {
+    /// Whether it holds `uv` (within [`IN_PIECE`]).
+    fn holds(&self, uv: [f64; 2]) -> bool {
+        local(&self.uv, uv).iter().all(|&l| l >= -IN_PIECE)
+    }
+
+    /// Its linear radiosity at `uv`.
+    fn at(&self, uv: [f64; 2]) -> [f64; 3] {
+        let l = local(&self.uv, uv);
+        std::array::from_fn(|c| (0..3).map(|k| l[k] * self.radiosity[k][c]).sum())
+    }
+}
+
+/// The area of a triangle of `(u, v)` corners.
+fn uv_area_of(c: &Corners) -> f64 {
+    0.5 * ((c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1])).abs()
 }
 
 /// A mesh position as f64.
@@ -258,18 +396,23 @@ fn barycentric(e1: DVec3, e2: DVec3, d: DVec3) -> [f64; 2] {
     [(c * x - b * y) / det, (a * y - b * x) / det]
 }
 
-/// The least of `uv`'s barycentric coordinates in element `e` (its corners
-/// `(u, v)`): at least 0 where `e` holds it.
-fn inside_by(e: &Element, uv: [f64; 2]) -> f64 {
-    let c = e.corners.map(|c| DVec3::new(c[0].into(), c[1].into(), 0.0));
+/// The barycentric coordinates of `uv` in the triangle of `(u, v)`
+/// corners `c`.
+fn local(c: &Corners, uv: [f64; 2]) -> [f64; 3] {
+    let c = c.map(|c| DVec3::new(c[0], c[1], 0.0));
     let [s, t] = barycentric(c[1] - c[0], c[2] - c[0], DVec3::new(uv[0], uv[1], 0.0) - c[0]);
-    s.min(t).min(1.0 - s - t)
+    [1.0 - s - t, s, t]
 }
 
-/// The area of element `e` in `(u, v)` (the whole triangle's is 1/2).
-fn uv_area(e: &Element) -> f64 {
-    let c = e.corners.map(|c| [f64::from(c[0]), f64::from(c[1])]);
-    0.5 * ((c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1])).abs()
+/// Element `e`'s `(u, v)` corners.
+fn corners_of(e: &Element) -> Corners {
+    e.corners.map(|c| [f64::from(c[0]), f64::from(c[1])])
+}
+
+/// The least of `uv`'s barycentric coordinates in element `e`: at least 0
+/// where `e` holds it.
+fn inside_by(e: &Element, uv: [f64; 2]) -> f64 {
+    local(&corners_of(e), uv).into_iter().fold(f64::INFINITY, f64::min)
 }
 
 /// That `solution` (`which`) lies on `mesh`: one root element per triangle.
@@ -390,8 +533,9 @@ mod tests {
     fn surfaces_are_open_area_means_against_the_reference() {
         let (mesh, manifest) = scene();
         let reference = reference([9.0, 1.0, 2.0, 3.0]);
-        let surfaces = Surfaces::new(&mesh, &manifest, &reference).expect("the reference lies on the mesh");
+        let surfaces = Surfaces::new(&mesh, &manifest, &reference, Unit::Object).expect("the reference lies on the mesh");
         assert_eq!(surfaces.names(), ["object_0"]);
+        assert_eq!(Surfaces::new(&mesh, &manifest, &reference, Unit::Triangle).unwrap().names(), ["object_0 0"]);
         let means = surfaces.of_solution(&reference).unwrap();
         assert!((means[0].unwrap() - 2.0).abs() < 1e-6, "{means:?}");
         let floor = vec![dvec3(0.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0)];
@@ -400,6 +544,41 @@ mod tests {
         assert!((means[0].unwrap() - PI * 7.0 / 9.0).abs() < 1e-9, "{means:?}");
         let off = Face { corners: face.corners.iter().map(|p| *p + dvec3(0.0, 0.0, 0.5)).collect(), ..face };
         assert!(surfaces.of_faces(&[off]).unwrap_err().contains("lies on no triangle"));
+    }
+
+    /// A model converted into a solution: each triangle subdivided
+    /// [`BELOW_FACE`] levels below the model's element (16 leaves for a
+    /// face over the whole triangle), each leaf with the element's linear
+    /// radiosity at its centroid and the reference's open part of its
+    /// area, the inner elements their leaves' open area and mean: the
+    /// floor's root the mean of `pi (u + v)` over its open part, `pi` 7/9.
+    /// An element that is not a quadtree cell of its triangle is refused.
+    #[test]
+    fn a_model_converts_into_a_solution_on_the_mesh() {
+        let (mesh, manifest) = scene();
+        let reference = reference([9.0, 1.0, 2.0, 3.0]);
+        let surfaces = Surfaces::new(&mesh, &manifest, &reference, Unit::Object).unwrap();
+        let floor = Face { corners: vec![dvec3(0.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0)], radiance: vec![[0.0; 3], [1.0; 3], [1.0; 3]] };
+        let lamp = Face { corners: vec![dvec3(0.0, 0.0, 1.0), dvec3(0.0, 1.0, 1.0), dvec3(1.0, 0.0, 1.0)], radiance: vec![[2.0; 3]; 3] };
+        let header = Solution::header(Provenance::in_memory("bench-surfaces test"));
+        let solution = surfaces.solution_of_faces(&[floor.clone(), lamp.clone()], header.clone()).expect("quadtree cells");
+        let leaves: Vec<&Element> = solution.elements.iter().filter(|e| e.first_child == NONE && e.triangle == 0).collect();
+        assert_eq!(leaves.len(), 16);
+        assert!(leaves.iter().all(|e| e.level == 2));
+        for e in &leaves {
+            let c = corners_of(e);
+            let (u, v) = ((c[0][0] + c[1][0] + c[2][0]) / 3.0, (c[0][1] + c[1][1] + c[2][1]) / 3.0);
+            assert!((f64::from(e.radiosity[0]) - PI * (u + v)).abs() < 1e-6, "{e:?}");
+            let open = if 1.0 - u - v > 0.5 { 0.0 } else { 0.5 / 16.0 };
+            assert!((f64::from(e.area) - open).abs() < 1e-7, "{e:?}");
+        }
+        let root = &solution.elements[0];
+        assert!((f64::from(root.area) - 0.375).abs() < 1e-7 && (f64::from(root.radiosity[0]) - PI * 7.0 / 9.0).abs() < 1e-5, "{root:?}");
+        assert!((f64::from(solution.elements[1].radiosity[1]) - 2.0 * PI).abs() < 1e-5);
+        let halves = [[dvec3(0.0, 0.0, 0.0), dvec3(0.7, 0.0, 0.0), dvec3(0.0, 1.0, 0.0)], [dvec3(0.7, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0)]];
+        let mut split: Vec<Face> = halves.iter().map(|c| Face { corners: c.to_vec(), radiance: vec![[1.0; 3]; 3] }).collect();
+        split.push(lamp);
+        assert!(surfaces.solution_of_faces(&split, header).unwrap_err().contains("straddles"));
     }
 
     /// The table: the reference's mean, each series' signed error, the

@@ -5,9 +5,10 @@
 //!
 //! Reproduce: `make bench-renderpark` (figures in README, RenderPark).
 
-use bench::surfaces::{table, vrml_faces, Surfaces};
+use bench::surfaces::{table, vrml_faces, Surfaces, Unit};
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
+use schemas::header::{Input, Provenance, Schema};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
@@ -30,9 +31,15 @@ struct Args {
     /// The reference: a hierarchical-solve solution of the scene at a fine EPS.
     #[arg(long, value_name = "SOLUTION.exr")]
     reference: PathBuf,
+    /// What a surface is: an object of the manifest, or an input triangle (a block's face is two).
+    #[arg(long, value_enum, default_value_t = Unit::Object)]
+    by: Unit,
     /// Output: the table (also printed on stdout).
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
+    /// Also write each RenderPark model as a solution on the mesh, DIR/LABEL.exr (LABEL's characters other than letters, digits, '.' and '-' as '-'), for grid-gather's preview to render.
+    #[arg(long, value_name = "DIR")]
+    solutions: Option<PathBuf>,
     /// The series, LABEL=FILE: a solution (EXR) of the same mesh, or a RenderPark model (.wrl) whose colours are radiance.
     #[arg(required = true, value_name = "LABEL=FILE")]
     series: Vec<String>,
@@ -40,18 +47,35 @@ struct Args {
 
 fn run(args: Args) -> Result<ExitCode> {
     check_writable(&args.output)?;
-    let (mesh, _) = Mesh::read(&args.mesh)?;
+    if let Some(dir) = &args.solutions {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    }
+    let (mesh, mesh_input) = Mesh::read(&args.mesh)?;
     let manifest: Manifest = read_ron(&args.manifest)?.value;
-    let (reference, _) = Solution::read(&args.reference)?;
+    let (reference, reference_input) = Solution::read(&args.reference)?;
     let invalid = |path: &Path, message: String| Error::invalid(path, None, message);
-    let surfaces = Surfaces::new(&mesh, &manifest, &reference).map_err(|m| invalid(&args.reference, m))?;
+    let surfaces = Surfaces::new(&mesh, &manifest, &reference, args.by).map_err(|m| invalid(&args.reference, m))?;
     let mut series = Vec::new();
     for s in &args.series {
         let (label, file) = s.split_once('=').ok_or_else(|| bad_parameter(format!("series '{s}' is not LABEL=FILE")))?;
         let path = Path::new(file);
         let means = if path.extension().is_some_and(|e| e == "wrl") {
-            let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-            vrml_faces(&text).and_then(|faces| surfaces.of_faces(&faces))
+            let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+            let faces = vrml_faces(&String::from_utf8_lossy(&bytes)).map_err(|m| invalid(path, m))?;
+            if let Some(dir) = &args.solutions {
+                let name: String = label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '-' }).collect();
+                let inputs = vec![mesh_input.clone(), reference_input.clone(), Input::new(path, &bytes, None)];
+                let provenance = Provenance {
+                    stage: "bench-surfaces".into(),
+                    stage_version: env!("CARGO_PKG_VERSION").into(),
+                    command_line: std::env::args().collect(),
+                    parameters: ron::value::RawValue::from_rust(&()).expect("unit serializes"),
+                    inputs,
+                };
+                let solution = surfaces.solution_of_faces(&faces, Solution::header(provenance)).map_err(|m| invalid(path, m))?;
+                solution.write(&dir.join(format!("{name}.exr")))?;
+            }
+            surfaces.of_faces(&faces)
         } else {
             surfaces.of_solution(&Solution::read(path)?.0)
         };
