@@ -271,8 +271,8 @@ impl<'a> Surfaces<'a> {
             let (parent, area, b) = (element.parent, element.area, element.radiosity);
             if parent != NONE {
                 let p = &mut elements[parent as usize];
-                for c in 0..3 {
-                    p.radiosity[c] += area * b[c];
+                for (sum, x) in p.radiosity.iter_mut().zip(b) {
+                    *sum += area * x;
                 }
                 p.area += area;
             }
