@@ -303,9 +303,11 @@ pub fn link(h: &Hierarchy, receiver: Node, sender: Node, linking: Linking) -> Op
     match (receiver, sender) {
         (Node::Element(r), Node::Element(s)) => element_link(h, r, s, linking.quadrature),
         (Node::Element(r), Node::Cluster(_)) if h.triangles_below(sender).len() <= EXACT_CLUSTER_SENDER => {
-            let factors: Vec<Link> = h.triangles_below(sender).iter().filter_map(|&t| element_link(h, r, t, linking.quadrature)).collect();
-            let form_factor: f64 = factors.iter().map(|l| l.form_factor).sum();
-            let spread = factors.iter().map(|l| l.spread).sum();
+            let (form_factor, spread) = h
+                .triangles_below(sender)
+                .iter()
+                .filter_map(|&t| element_link(h, r, t, linking.quadrature))
+                .fold((0.0, 0.0), |(f, s), l| (f + l.form_factor, s + l.spread));
             (form_factor > 0.0).then_some(Link { receiver, sender, form_factor, spread, visibility: None, occluder_distance: f32::INFINITY, clear: false })
         }
         _ => {
