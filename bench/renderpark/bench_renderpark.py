@@ -42,7 +42,9 @@ measures both programs on this machine, in one run:
 5. images, where a path-traced reference image is given (`make
    bench-peer`'s Mitsuba image): every solution rendered by grid-gather's
    preview and compared with it as bench-peer compares (relative RMSE and
-   each surface's mean; emitters and 2 px round edges left out). rpk's
+   each surface's mean; emitters and 2 px round edges left out; a
+   false-colour map of the relative difference beside each,
+   preview-LABEL.diff.png). rpk's
    models become solutions on the mesh (`bench-surfaces --solutions`:
    each leaf two quadtree levels below its element, with the element's
    linear radiance there), so both programs' solutions go through the
@@ -310,7 +312,7 @@ def main():
     for label, solution in series:
         image, report = os.path.join(a.out, f"preview-{file_label(label)}.exr"), os.path.join(a.out, f"compare-{file_label(label)}.ron")
         timed(shlex.split(a.preview) + ["--solution", solution, "-o", image, "--report", image + ".report.ron"], image + ".log")
-        timed(shlex.split(a.compare) + [image, a.image_reference, "-o", report], report + ".log")
+        timed(shlex.split(a.compare) + [image, a.image_reference, "-o", report, "--diff", image.replace(".exr", ".diff.png")], report + ".log")
         results.append((label, compared(open(report).read())))
     images = image_table(results)
     open(os.path.join(a.out, "images.md"), "w").write(images + "\n")
