@@ -230,6 +230,60 @@ def image_table(results):
     return "\n".join(rows)
 
 
+def worst_surfaces(markdown):
+    """{label: worst surface error, %} from bench-surfaces' table."""
+    lines = markdown.strip().splitlines()
+    labels = [c.strip() for c in lines[0].strip("|").split("|")][2:]
+    worst = [c.strip().rstrip("%") for c in lines[-1].strip("|").split("|")][2:]
+    return {label: float(w) for label, w in zip(labels, worst)}
+
+
+def nice(v, below):
+    """The nearest 1, 2 or 5 times a power of ten at or below `v` (or at
+    or above it): an axis end."""
+    steps = [m * 10.0 ** k for k in range(math.floor(math.log10(v)) - 1, math.floor(math.log10(v)) + 2) for m in (1, 2, 5)]
+    return max(t for t in steps if t <= v * (1 + 1e-9)) if below else min(t for t in steps if t >= v * (1 - 1e-9))
+
+
+def plot_svg(title, curves):
+    """An SVG plot of error (%) against time (s), both on log scales:
+    `curves` a list of (label, colour, dashed, [(seconds, error), ...])."""
+    width, height, left, right, top, bottom = 820, 440, 70, 320, 40, 50
+    points = [p for _, _, _, ps in curves for p in ps]
+    (x0, x1), (y0, y1) = [(nice(min(v), below=True), nice(max(v), below=False)) for v in zip(*points)]
+    px = lambda x: left + (width - left - right) * math.log(x / x0) / math.log(x1 / x0)
+    py = lambda y: height - bottom - (height - top - bottom) * math.log(y / y0) / math.log(y1 / y0)
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="12">',
+           f'<rect width="{width}" height="{height}" fill="white"/>',
+           f'<text x="{left}" y="22" font-size="14">{title}</text>']
+    for lo, hi, at, axis in [(x0, x1, px, "x"), (y0, y1, py, "y")]:
+        v = 10 ** math.floor(math.log10(lo))
+        while v <= hi * 1.0001:
+            for m in (1, 2, 5):
+                t = v * m
+                if lo * 0.9999 <= t <= hi * 1.0001:
+                    c = at(t)
+                    line = (c, top, c, height - bottom) if axis == "x" else (left, c, width - right, c)
+                    out.append('<line x1="%.1f" y1="%.1f" x2="%.1f" y2="%.1f" stroke="#ddd"/>' % line)
+                    label = f"{t:g}"
+                    out.append(f'<text x="{c:.1f}" y="{height - bottom + 16}" text-anchor="middle">{label}</text>' if axis == "x"
+                               else f'<text x="{left - 6}" y="{c + 4:.1f}" text-anchor="end">{label}</text>')
+            v *= 10
+    out += [f'<rect x="{left}" y="{top}" width="{width - left - right}" height="{height - top - bottom}" fill="none" stroke="black"/>',
+            f'<text x="{(left + width - right) / 2}" y="{height - 12}" text-anchor="middle">time, s (one thread)</text>',
+            f'<text transform="translate(16 {(top + height - bottom) / 2}) rotate(-90)" text-anchor="middle">error, %</text>']
+    for k, (label, colour, dashed, ps) in enumerate(curves):
+        ps = sorted(ps)
+        dash = ' stroke-dasharray="6 4"' if dashed else ""
+        path = " ".join(f"{px(x):.1f},{py(y):.1f}" for x, y in ps)
+        out.append(f'<polyline points="{path}" fill="none" stroke="{colour}" stroke-width="2"{dash}/>')
+        out += [f'<circle cx="{px(x):.1f}" cy="{py(y):.1f}" r="3.5" fill="{colour}"/>' for x, y in ps]
+        ly = top + 16 + 20 * k
+        out.append(f'<line x1="{width - right + 12}" y1="{ly - 4}" x2="{width - right + 40}" y2="{ly - 4}" stroke="{colour}" stroke-width="2"{dash}/>')
+        out.append(f'<text x="{width - right + 46}" y="{ly}">{label}</text>')
+    return "\n".join(out + ["</svg>"]) + "\n"
+
+
 def table(series, thresholds):
     """Markdown rows: per series its median (fastest-slowest) time and
     links, and for hierarchical-solve its median over each rpk threshold's."""
@@ -306,10 +360,10 @@ def main():
     if not a.image_reference:
         print("bench-renderpark: no reference image (make bench-peer makes one): the images are not compared", file=sys.stderr)
         return
-    series = [(m.split("=", 1)[0], os.path.join(converted, file_label(m.split("=", 1)[0]) + ".exr")) for m in models]
-    series += [tuple(x.split("=", 1)) for x in solutions]
+    rendered = [(m.split("=", 1)[0], os.path.join(converted, file_label(m.split("=", 1)[0]) + ".exr")) for m in models]
+    rendered += [tuple(x.split("=", 1)) for x in solutions]
     results = []
-    for label, solution in series:
+    for label, solution in rendered:
         image, report = os.path.join(a.out, f"preview-{file_label(label)}.exr"), os.path.join(a.out, f"compare-{file_label(label)}.ron")
         timed(shlex.split(a.preview) + ["--solution", solution, "-o", image, "--report", image + ".report.ron"], image + ".log")
         timed(shlex.split(a.compare) + [image, a.image_reference, "-o", report, "--diff", image.replace(".exr", ".diff.png")], report + ".log")
@@ -317,6 +371,16 @@ def main():
     images = image_table(results)
     open(os.path.join(a.out, "images.md"), "w").write(images + "\n")
     print(images)
+    medians = {f"{program} {setting}": statistics.median(v["times"]) for (program, setting), v in series.items()}
+    worst = worst_surfaces(open(surfaces).read())
+    curves = []
+    for program, colour in [("rpk", "#d95f02"), ("hierarchical-solve", "#1b6ac9")]:
+        mine = [(label, r) for label, r in results if label.startswith(program + " ")]
+        curves.append((f"{program}: image, relative RMSE", colour, False, [(medians[label], 100 * r[0]) for label, r in mine]))
+        curves.append((f"{program}: solution, worst surface", colour, True, [(medians[label], worst[label]) for label, _ in mine]))
+    plot = os.path.join(a.out, "renderpark.svg")
+    open(plot, "w").write(plot_svg("Cornell box: error against time, RenderPark and hierarchical-solve", curves))
+    print(f"bench-renderpark: {plot}", file=sys.stderr)
 
 
 if __name__ == "__main__":

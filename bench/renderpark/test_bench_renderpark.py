@@ -3,6 +3,7 @@ needed): `python3 -m unittest bench/renderpark/test_bench_renderpark.py`.
 Not part of `make test`."""
 
 import math
+import re
 import os
 import struct
 import sys
@@ -78,3 +79,37 @@ class Conversion(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class Accuracy(unittest.TestCase):
+    """Reading bench-surfaces' and compare's output, and the plot."""
+
+    def test_file_label_matches_bench_surfaces(self):
+        self.assertEqual(br.file_label("rpk 3e-5"), "rpk-3e-5")
+        self.assertEqual(br.file_label("hierarchical-solve 6.5e-4"), "hierarchical-solve-6.5e-4")
+
+    def test_worst_surfaces_and_compare_reports(self):
+        md = "| surface | reference | rpk 3e-5 | ours 1e-3 |\n|---|---|---|---|\n| floor | 0.3 | -1.51% | +0.32% |\n| worst surface | | 1.51% | 0.35% |\n"
+        self.assertEqual(br.worst_surfaces(md), {"rpk 3e-5": 1.51, "ours 1e-3": 0.35})
+        ron = 'Report(\n  figures: {\n    "relative_rmse": 0.0163,\n    "object[floor].mean_signed_error": -0.0059,\n    "object[tall_block].mean_signed_error": 0.0073,\n  },\n)'
+        rmse, errors = br.compared(ron)
+        self.assertAlmostEqual(rmse, 0.0163)
+        self.assertEqual(errors, {"floor": -0.0059, "tall_block": 0.0073})
+        table = br.image_table([("rpk 3e-5", (rmse, errors))])
+        self.assertIn("| tall_block | +0.73% |", table)
+        self.assertIn("| worst surface | 0.73% |", table)
+
+    def test_axis_ends_are_one_two_five(self):
+        self.assertEqual([br.nice(v, True) for v in (0.071, 0.1, 0.37, 4.67)], [0.05, 0.1, 0.2, 2.0])
+        self.assertEqual([br.nice(v, False) for v in (0.071, 0.1, 0.37, 4.67)], [0.1, 0.1, 0.5, 5.0])
+
+    def test_plot_places_points_on_log_scales(self):
+        svg = br.plot_svg("t", [("a", "red", False, [(0.1, 1.0), (1.0, 10.0)]), ("b", "blue", True, [(0.3, 3.0)])])
+        self.assertTrue(svg.startswith("<svg") and svg.rstrip().endswith("</svg>"))
+        self.assertEqual(svg.count("<polyline"), 2)
+        self.assertEqual(svg.count("<circle"), 3)
+        self.assertIn('stroke-dasharray="6 4"', svg)
+        # Axes 0.1-1 s and 1-10 %: the first point at the plot's lower
+        # left corner, the second at its upper right.
+        first = re.search(r'<circle cx="([0-9.]+)" cy="([0-9.]+)"', svg)
+        self.assertEqual((float(first.group(1)), float(first.group(2))), (70.0, 390.0))
