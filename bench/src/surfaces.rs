@@ -99,7 +99,7 @@ fn list_after(text: &str, key: &str, from: usize) -> Result<(Vec<f64>, usize), S
 /// The faces of the indexed face sets of a VRML 2 model as RenderPark's
 /// Galerkin radiosity writes it (`-radiance-model-savefile`): `point`,
 /// then `color` per vertex (`colorPerVertex TRUE`), then `coordIndex`,
-/// faces ended by -1. The colours must be radiance, not display values:
+/// faces ended by -1 (the last one perhaps not). The colours must be radiance, not display values:
 /// `make bench-renderpark` builds rpk with its tone mapping taken out of
 /// that writer (pipelines/renderpark.mk).
 pub fn vrml_faces(text: &str) -> Result<Vec<Face>, String> {
@@ -116,12 +116,10 @@ pub fn vrml_faces(text: &str) -> Result<Vec<Face>, String> {
             let k = i as usize;
             (i >= 0.0 && i.fract() == 0.0 && 3 * k < points.len()).then_some(k).ok_or(format!("coordIndex {i} is not a point of the set ({})", points.len() / 3))
         };
-        let mut corners = Vec::new();
-        for &i in &indices {
-            if i != -1.0 {
-                corners.push(vertex(i)?);
-                continue;
-            }
+        // Faces end at -1, the last one also at the list's end (VRML 2
+        // lets it go without).
+        for face in indices.split(|&i| i == -1.0).filter(|f| !f.is_empty()) {
+            let corners = face.iter().map(|&i| vertex(i)).collect::<Result<Vec<_>, _>>()?;
             if corners.len() < 3 {
                 return Err(format!("a face of {} corners", corners.len()));
             }
@@ -129,7 +127,6 @@ pub fn vrml_faces(text: &str) -> Result<Vec<Face>, String> {
                 corners: corners.iter().map(|&k| DVec3::new(points[3 * k], points[3 * k + 1], points[3 * k + 2])).collect(),
                 radiance: corners.iter().map(|&k| [colours[3 * k], colours[3 * k + 1], colours[3 * k + 2]]).collect(),
             });
-            corners.clear();
         }
         from = end;
     }
@@ -516,6 +513,8 @@ mod tests {
         let points = "0 0 0, 1 0 0, 0 1 0, 1 1 0";
         let faces = vrml_faces(&vrml(points, "0.1 0.2 0.3, 1 1 1, 2 2 2, 3 3 3", "0 1 2 -1 1 3 2 -1")).expect("two faces");
         assert_eq!(faces.len(), 2);
+        assert_eq!(vrml_faces(&vrml(points, "0.1 0.2 0.3, 1 1 1, 2 2 2, 3 3 3", "0 1 2 -1 1 3 2")).expect("the last face unended"), faces);
+        assert!(vrml_faces(&vrml(points, "0.1 0.2 0.3, 1 1 1, 2 2 2, 3 3 3", "0 1 2 -1 1 3")).unwrap_err().contains("a face of 2 corners"));
         assert_eq!(faces[1].corners, vec![dvec3(1.0, 0.0, 0.0), dvec3(1.0, 1.0, 0.0), dvec3(0.0, 1.0, 0.0)]);
         assert_eq!(faces[0].radiance[0], [0.1, 0.2, 0.3]);
         assert!(vrml_faces(&vrml(points, "1 1 1", "0 1 2 -1")).unwrap_err().contains("not one RGB colour per point"));
