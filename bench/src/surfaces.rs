@@ -28,16 +28,14 @@
 //! like any other: its images are then measured like hierarchical-solve's.
 
 use glam::DVec3;
+use radiometry::color::luminance;
+use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::header::Header;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::{Element, Solution, NONE};
+use stage_kit::scene::mesh_triangles;
 use std::f64::consts::PI;
-
-/// Rec. 709 luminance of linear RGB.
-pub fn luminance(c: [f64; 3]) -> f64 {
-    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
-}
 
 /// A polygon of a RenderPark VRML model with its corners' RGB radiance.
 #[derive(Clone, Debug, PartialEq)]
@@ -149,6 +147,8 @@ pub enum Unit {
 /// The scene's surfaces and a reference solution on its mesh.
 pub struct Surfaces<'a> {
     mesh: &'a Mesh,
+    /// Each mesh triangle's geometry, f64.
+    geometry: Vec<TriangleGeometry>,
     unit: Unit,
     /// Surface names, and whether each is measured (not an emitter).
     surfaces: Vec<(String, bool)>,
@@ -177,8 +177,9 @@ impl<'a> Surfaces<'a> {
                 .collect(),
             Unit::Triangle => mesh.triangles.iter().enumerate().map(|(i, t)| (format!("{} {i}", manifest.objects[t.object as usize]), !emits(t))).collect(),
         };
-        let (lo, hi) = mesh.positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(point(*p)), hi.max(point(*p))));
-        Ok(Surfaces { mesh, unit, surfaces, reference, on_plane: 1e-5 * (hi - lo).length() })
+        let geometry = mesh_triangles(mesh);
+        let (lo, hi) = geometry.iter().flat_map(|g| g.corners).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        Ok(Surfaces { mesh, geometry, unit, surfaces, reference, on_plane: 1e-5 * (hi - lo).length() })
     }
 
     /// The measured surfaces' names (an object's, or an object's and a
@@ -227,8 +228,7 @@ impl<'a> Surfaces<'a> {
                 let k = [0, i, i + 1];
                 let centroid = k.iter().map(|&j| f.corners[j]).sum::<DVec3>() / 3.0;
                 let (t, _) = self.locate(centroid).ok_or(format!("a face centred at ({:.6}, {:.6}, {:.6}) lies on no triangle of the mesh", centroid.x, centroid.y, centroid.z))?;
-                let [p0, p1, p2] = self.corners(t);
-                let uv = k.map(|j| barycentric(p1 - p0, p2 - p0, f.corners[j] - p0));
+                let uv = uv_triangle(&k.map(|j| self.geometry[t as usize].uv_of(f.corners[j])));
                 on[t as usize].push(Piece { uv, radiosity: k.map(|j| f.radiance[j].map(|r| PI * r)) });
             }
         }
@@ -241,10 +241,11 @@ impl<'a> Surfaces<'a> {
             let c = corners[e];
             let centroid = [(c[0][0] + c[1][0] + c[2][0]) / 3.0, (c[0][1] + c[1][1] + c[2][1]) / 3.0];
             let holding = on[t as usize].iter().find(|p| p.holds(centroid));
-            let leaf = holding.filter(|p| c.iter().all(|&x| p.holds(x)) && uv_area_of(&c) * 4f64.powi(BELOW_FACE as i32) <= uv_area_of(&p.uv) * (1.0 + 1e-9));
+            let cell = uv_triangle(&c);
+            let leaf = holding.filter(|p| c.iter().all(|&x| p.holds(x)) && cell.area * 4f64.powi(BELOW_FACE as i32) <= p.uv.area * (1.0 + 1e-9));
             if let Some(p) = leaf {
                 elements[e].radiosity = p.at(centroid).map(|x| x as f32);
-                elements[e].area = (f64::from(self.mesh.triangles[t as usize].area) * 2.0 * uv_area_of(&c) * self.open_fraction(t, centroid)) as f32;
+                elements[e].area = (self.geometry[t as usize].area * 2.0 * cell.area * self.open_fraction(t, centroid)) as f32;
             } else if level >= MOST_LEVELS {
                 return Err(format!("triangle {t}: a leaf at ({:.6}, {:.6}) {} after {MOST_LEVELS} levels", centroid[0], centroid[1], if holding.is_some() { "still straddles two of the model's elements" } else { "lies in none of the model's elements" }));
             } else {
@@ -277,11 +278,6 @@ impl<'a> Surfaces<'a> {
         Ok(Solution { header, elements, clusters: Vec::new(), links: Vec::new() })
     }
 
-    /// Triangle `t`'s corners.
-    fn corners(&self, t: u32) -> [DVec3; 3] {
-        self.mesh.triangles[t as usize].vertices.map(|v| point(self.mesh.positions[v as usize]))
-    }
-
     /// The surface input triangle `triangle` belongs to.
     fn surface_of(&self, triangle: u32) -> usize {
         match self.unit {
@@ -306,15 +302,12 @@ impl<'a> Surfaces<'a> {
     /// that hold it.
     fn locate(&self, p: DVec3) -> Option<(u32, [f64; 2])> {
         let mut best: Option<(f64, u32, [f64; 2])> = None;
-        for t in 0..self.mesh.triangles.len() {
-            let [p0, p1, p2] = self.corners(t as u32);
-            let (e1, e2) = (p1 - p0, p2 - p0);
-            let n = e1.cross(e2);
-            let distance = (p - p0).dot(n).abs() / n.length();
+        for (t, g) in self.geometry.iter().enumerate().filter(|(_, g)| g.area > 0.0) {
+            let distance = (p - g.corners[0]).dot(g.normal).abs();
             if distance > self.on_plane || best.is_some_and(|b| b.0 <= distance) {
                 continue;
             }
-            let uv = barycentric(e1, e2, p - p0);
+            let uv = g.uv_of(p);
             if uv[0] >= -INSIDE && uv[1] >= -INSIDE && uv[0] + uv[1] <= 1.0 + INSIDE {
                 best = Some((distance, t as u32, uv));
             }
@@ -331,7 +324,7 @@ impl<'a> Surfaces<'a> {
             let children = &elements[e.first_child as usize..e.first_child as usize + 4];
             e = children.iter().max_by(|a, b| inside_by(a, uv).total_cmp(&inside_by(b, uv))).expect("four children");
         }
-        let geometric = f64::from(self.mesh.triangles[t as usize].area) * 2.0 * uv_area_of(&corners_of(e));
+        let geometric = self.geometry[t as usize].area * 2.0 * uv_triangle(&corners_of(e)).area;
         if geometric > 0.0 {
             (f64::from(e.area) / geometric).clamp(0.0, 1.0)
         } else {
@@ -349,10 +342,10 @@ pub const BELOW_FACE: u32 = 2;
 pub const MOST_LEVELS: u32 = 16;
 
 /// A triangle of a RenderPark element on an input triangle: its corners'
-/// `(u, v)` there and radiosity.
+/// `(u, v)` there ([`uv_triangle`]) and radiosity.
 #[derive(Clone, Debug)]
 struct Piece {
-    uv: Corners,
+    uv: TriangleGeometry,
     radiosity: [[f64; 3]; 3],
 }
 
@@ -375,29 +368,15 @@ impl Piece {
     }
 }
 
-/// The area of a triangle of `(u, v)` corners.
-fn uv_area_of(c: &Corners) -> f64 {
-    0.5 * ((c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1])).abs()
+/// The triangle of `(u, v)` corners `c` in the plane `z = 0`: its area is
+/// its `(u, v)` area.
+fn uv_triangle(c: &Corners) -> TriangleGeometry {
+    TriangleGeometry::new(c.map(|c| DVec3::new(c[0], c[1], 0.0)))
 }
 
-/// A mesh position as f64.
-fn point(p: [f32; 3]) -> DVec3 {
-    DVec3::new(p[0].into(), p[1].into(), p[2].into())
-}
-
-/// `(u, v)` with `d = u e1 + v e2`, `d` in the plane of `e1` and `e2`.
-fn barycentric(e1: DVec3, e2: DVec3, d: DVec3) -> [f64; 2] {
-    let (a, b, c) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-    let (x, y) = (d.dot(e1), d.dot(e2));
-    let det = a * c - b * b;
-    [(c * x - b * y) / det, (a * y - b * x) / det]
-}
-
-/// The barycentric coordinates of `uv` in the triangle of `(u, v)`
-/// corners `c`.
-fn local(c: &Corners, uv: [f64; 2]) -> [f64; 3] {
-    let c = c.map(|c| DVec3::new(c[0], c[1], 0.0));
-    let [s, t] = barycentric(c[1] - c[0], c[2] - c[0], DVec3::new(uv[0], uv[1], 0.0) - c[0]);
+/// The barycentric coordinates of `uv` in `triangle` (a [`uv_triangle`]).
+fn local(triangle: &TriangleGeometry, uv: [f64; 2]) -> [f64; 3] {
+    let [s, t] = triangle.uv_of(DVec3::new(uv[0], uv[1], 0.0));
     [1.0 - s - t, s, t]
 }
 
@@ -409,7 +388,7 @@ fn corners_of(e: &Element) -> Corners {
 /// The least of `uv`'s barycentric coordinates in element `e`: at least 0
 /// where `e` holds it.
 fn inside_by(e: &Element, uv: [f64; 2]) -> f64 {
-    local(&corners_of(e), uv).into_iter().fold(f64::INFINITY, f64::min)
+    local(&uv_triangle(&corners_of(e)), uv).into_iter().fold(f64::INFINITY, f64::min)
 }
 
 /// That `solution` (`which`) lies on `mesh`: one root element per triangle.

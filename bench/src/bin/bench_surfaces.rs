@@ -8,13 +8,13 @@
 use bench::surfaces::{table, vrml_faces, Surfaces, Unit};
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
-use schemas::header::{Input, Provenance, Schema};
+use schemas::header::{Input, Schema};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::ron_io::read_ron;
 use schemas::solution::Solution;
 use schemas::{Error, Result};
 use stage_kit::cli::main_of;
-use stage_kit::run::{bad_parameter, check_writable};
+use stage_kit::run::{bad_parameter, check_writable, Run};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -50,9 +50,16 @@ fn run(args: Args) -> Result<ExitCode> {
     if let Some(dir) = &args.solutions {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     }
+    // The run records its inputs for the solutions it writes, refusing a
+    // reference made from another mesh-prep run than the mesh.
+    let mut run = Run::start("bench-surfaces", env!("CARGO_PKG_VERSION"));
     let (mesh, mesh_input) = Mesh::read(&args.mesh)?;
-    let manifest: Manifest = read_ron(&args.manifest)?.value;
+    run.input(mesh_input)?;
+    let manifest = read_ron::<Manifest>(&args.manifest)?;
+    run.input(manifest.input)?;
+    let manifest = manifest.value;
     let (reference, reference_input) = Solution::read(&args.reference)?;
+    run.input(reference_input)?;
     let invalid = |path: &Path, message: String| Error::invalid(path, None, message);
     let surfaces = Surfaces::new(&mesh, &manifest, &reference, args.by).map_err(|m| invalid(&args.reference, m))?;
     let mut series = Vec::new();
@@ -62,17 +69,10 @@ fn run(args: Args) -> Result<ExitCode> {
         let means = if path.extension().is_some_and(|e| e == "wrl") {
             let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
             let faces = vrml_faces(&String::from_utf8_lossy(&bytes)).map_err(|m| invalid(path, m))?;
+            run.input(Input::new(path, &bytes, None))?;
             if let Some(dir) = &args.solutions {
                 let name: String = label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '-' }).collect();
-                let inputs = vec![mesh_input.clone(), reference_input.clone(), Input::new(path, &bytes, None)];
-                let provenance = Provenance {
-                    stage: "bench-surfaces".into(),
-                    stage_version: env!("CARGO_PKG_VERSION").into(),
-                    command_line: std::env::args().collect(),
-                    parameters: ron::value::RawValue::from_rust(&()).expect("unit serializes"),
-                    inputs,
-                };
-                let solution = surfaces.solution_of_faces(&faces, Solution::header(provenance)).map_err(|m| invalid(path, m))?;
+                let solution = surfaces.solution_of_faces(&faces, Solution::header(run.provenance(&()))).map_err(|m| invalid(path, m))?;
                 solution.write(&dir.join(format!("{name}.exr")))?;
             }
             surfaces.of_faces(&faces)
