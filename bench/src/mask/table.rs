@@ -18,9 +18,9 @@ use crate::gather::GatherRun;
 use schemas::image::{HdrImage, SINGLE_SURFACE};
 use std::fmt::Write as _;
 
-/// Rec. 709 luminance of linear RGB.
+/// Rec. 709 luminance of an image's linear RGB pixel.
 fn luminance(rgb: [f32; 3]) -> f64 {
-    0.2126 * f64::from(rgb[0]) + 0.7152 * f64::from(rgb[1]) + 0.0722 * f64::from(rgb[2])
+    radiometry::color::luminance(rgb.map(f64::from))
 }
 
 /// One run's error against the reference.
