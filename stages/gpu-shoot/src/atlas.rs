@@ -96,11 +96,21 @@ impl Group {
     pub fn in_hidden(&self, p: DVec3) -> bool {
         let n = self.hidden_corners as usize;
         let corner = |k: usize| DVec3::from(self.hidden[k % n].map(f64::from));
-        n >= 3 && {
-            let normal = (corner(1) - corner(0)).cross(corner(2) - corner(0));
-            (0..n).all(|k| (corner(k + 1) - corner(k)).cross(p - corner(k)).dot(normal) > 0.0)
-        }
+        // Turns measured along the polygon's own normal, so its corners
+        // turn counter-clockwise about it.
+        let normal = if n >= 3 { (corner(1) - corner(0)).cross(corner(2) - corner(0)) } else { DVec3::ZERO };
+        strictly_inside(n, |k| (corner(k + 1) - corner(k)).cross(p - corner(k)).dot(normal))
     }
+}
+
+/// Whether a point lies strictly inside a convex polygon of `n` corners
+/// whose turns are counter-clockwise: `turn_at(k)`, the turn from its edge
+/// `k -> k + 1` to the point ([`turn`] in the plane), is positive for
+/// every edge. A polygon of fewer than 3 corners holds nothing. Used in
+/// barycentrics on a group's buried part ([`crate::exposure`]) and in 3D
+/// on the part as stored ([`Group::in_hidden`]).
+pub fn strictly_inside(n: usize, turn_at: impl Fn(usize) -> f64) -> bool {
+    n >= 3 && (0..n).all(|k| turn_at(k) > 0.0)
 }
 
 /// Most corners of a group's buried part ([`Group::hidden`]).
@@ -482,6 +492,32 @@ mod tests {
         points.push([0.5, 1.01]);
         assert_eq!(convex_hull(points.clone(), 8).len(), 5);
         assert_eq!(convex_hull(points, 4), square.to_vec());
+    }
+
+    /// The buried part's test in barycentrics and in 3D: a unit square,
+    /// counter-clockwise, holds its middle and a point just inside an edge,
+    /// not a point on an edge or outside; the same square placed on a
+    /// tilted plane (either winding as seen from its front) answers alike,
+    /// and a part of fewer than 3 corners holds nothing.
+    #[test]
+    fn a_point_is_inside_the_hidden_part_alike_in_the_plane_and_in_3d() {
+        let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let points = [([0.5, 0.5], true), ([0.999, 0.5], true), ([1.0, 0.5], false), ([0.5, -0.01], false), ([1.5, 1.5], false)];
+        let flat = |p: [f64; 2]| strictly_inside(4, |k| turn(square[k], square[(k + 1) % 4], p));
+        let (o, u, v) = (DVec3::new(1.0, 2.0, 3.0), DVec3::new(0.6, 0.0, 0.8), DVec3::new(0.0, 1.0, 0.0));
+        let at = |p: [f64; 2]| o + p[0] * u + p[1] * v;
+        for reversed in [false, true] {
+            let mut group = Group { first: 0, count: 0, centroid: [0.0; 3], area: 0.0, extent: 0.0, opaque: 1.0, polygon: [[0.0; 3]; 5], corners: 3, hidden: [[0.0; 3]; HIDDEN_CORNERS], hidden_corners: 4 };
+            for (k, c) in square.iter().enumerate() {
+                group.hidden[if reversed { 3 - k } else { k }] = at(*c).as_vec3().to_array();
+            }
+            for (p, inside) in points {
+                assert_eq!(flat(p), inside, "{p:?} in the plane");
+                assert_eq!(group.in_hidden(at(p)), inside, "{p:?} in 3D, reversed {reversed}");
+            }
+            group.hidden_corners = 2;
+            assert!(!group.in_hidden(at([0.5, 0.5])));
+        }
     }
 
     #[test]

@@ -17,7 +17,7 @@
 //! buried part, so that the power a group is charged is the power its
 //! polygon less the buried part delivers.
 
-use crate::atlas::{area_centroid, clip_convex, convex_hull, texel_point, texel_square, turn, Atlas, Texel, HIDDEN_CORNERS};
+use crate::atlas::{area_centroid, clip_convex, convex_hull, strictly_inside, texel_point, texel_square, turn, Atlas, Texel, HIDDEN_CORNERS};
 use crate::tiling::Tile;
 use glam::DVec3;
 use radiometry::burial::buried;
@@ -179,7 +179,7 @@ impl Burial {
             return None;
         }
         let part = convex_hull(points, HIDDEN_CORNERS);
-        let within = |p: [f64; 2]| (0..part.len()).all(|k| turn(part[k], part[(k + 1) % part.len()], p) > 0.0);
+        let within = |p: [f64; 2]| strictly_inside(part.len(), |k| turn(part[k], part[(k + 1) % part.len()], p));
         (part.len() >= 3 && !open.iter().any(|&k| within(grid.point(k)))).then_some(part)
     }
 
