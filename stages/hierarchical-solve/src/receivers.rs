@@ -86,7 +86,9 @@
 //! ```
 //!
 //! (`B_sent` what the link sends, [`crate::gather::SenderTerms`];
-//! `F_js` Lambert's factor from part `j`'s centroid to the sender, or to a
+//! `F_js` Lambert's factor from part `j`'s centroid to the sender (over
+//! all of `j` where `j` touches an element sender,
+//! [`Hierarchy::weight_between`]), or to a
 //! cluster sender's sampled points; times `j`'s own visibility of an
 //! element sender where the link is partly occluded), so
 //! `sum_j A_j E_j = A_r V F_rs B_sent`: the link's flux, shared by factor.
@@ -528,7 +530,8 @@ type PartViews = Vec<Vec<(usize, f64)>>;
 /// `(j, w_j)` for the parts `j` of an inner element `receiver` lit by
 /// `sender` (a link's ends, or a cluster link's sender and one of the
 /// cluster's triangles), `w_j = A_r F_js / sum_u A_u F_us` with `F_js` the
-/// factor from part `j`'s centroid to the sender (times their visibility,
+/// factor from part `j`'s centroid to the sender (over all of `j` where it
+/// touches an element sender, [`Hierarchy::weight_between`]; times their visibility,
 /// with `visibility`, given where the link is partly occluded and its
 /// sender is an element), and the rays cast. Where no part sees the
 /// sender, every part gets the same (`w_j = 1`). With `visibility` and an
@@ -554,7 +557,7 @@ fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<
     let sending = Part::new(h, sender, key(receiver));
     let mut rays = 0;
     let mut weigh = |j: u32| {
-        let factor = sending.factor(h, h.centroid(j), n);
+        let factor = match sending { Part::Element(e) => h.weight_between(j, e), _ => sending.factor(h, h.centroid(j), n) };
         // A cluster sender: every part sees the same one, so the link's
         // fraction would scale all weights alike; it is left out.
         let (seen, cast) = seen_factor(h, visibility, j, sender, factor, 1.0, part_rays(h, r, j, visibility));
