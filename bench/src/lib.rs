@@ -7,6 +7,7 @@
 pub mod gather;
 pub mod mask;
 pub mod mirror;
+pub mod residual;
 pub mod structured;
 pub mod surfaces;
 pub mod sweep;
@@ -33,6 +34,18 @@ pub struct PipelineArgs {
     /// Output directory.
     #[arg(short = 'o', long = "output", value_name = "DIR")]
     pub output: PathBuf,
+}
+
+/// The scene files a measuring binary reads (bench-surfaces,
+/// bench-residual): mesh-prep's mesh and manifest.
+#[derive(clap::Args, Debug)]
+pub struct SceneFiles {
+    /// The scene's mesh (mesh-prep).
+    #[arg(long)]
+    pub mesh: PathBuf,
+    /// The scene's manifest (mesh-prep): its materials and emitters, its surfaces' names.
+    #[arg(long)]
+    pub manifest: PathBuf,
 }
 
 /// The process's peak resident memory (VmHWM), MiB; `None` off Linux.

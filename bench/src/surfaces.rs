@@ -392,7 +392,9 @@ fn inside_by(e: &Element, uv: [f64; 2]) -> f64 {
 }
 
 /// That `solution` (`which`) lies on `mesh`: one root element per triangle.
-fn check_mesh(mesh: &Mesh, solution: &Solution, which: &str) -> Result<(), String> {
+/// Whether `solution` (named `which` in the error) is a solution of
+/// `mesh`: one root element per input triangle, no element of another.
+pub fn check_mesh(mesh: &Mesh, solution: &Solution, which: &str) -> Result<(), String> {
     let roots = solution.elements.iter().take_while(|e| e.parent == NONE).count();
     if roots != mesh.triangles.len() || solution.elements.iter().any(|e| e.triangle as usize >= mesh.triangles.len()) {
         return Err(format!("{which} has {roots} input triangles but the mesh {}: not its solution", mesh.triangles.len()));

@@ -5,6 +5,7 @@
 //!
 //! Reproduce: `make bench-renderpark` (figures in README, RenderPark).
 
+use bench::SceneFiles;
 use bench::surfaces::{table, vrml_faces, Surfaces, Unit};
 use clap::Parser;
 use schemas::atomic::write_bytes_atomically;
@@ -22,12 +23,8 @@ use std::process::ExitCode;
 #[derive(Parser, Debug)]
 #[command(name = "bench-surfaces", version)]
 struct Args {
-    /// The scene's mesh (mesh-prep).
-    #[arg(long)]
-    mesh: PathBuf,
-    /// The scene's manifest (mesh-prep): names the surfaces, marks the emitters.
-    #[arg(long)]
-    manifest: PathBuf,
+    #[command(flatten)]
+    scene: SceneFiles,
     /// The reference: a hierarchical-solve solution of the scene at a fine EPS.
     #[arg(long, value_name = "SOLUTION.exr")]
     reference: PathBuf,
@@ -53,9 +50,9 @@ fn run(args: Args) -> Result<ExitCode> {
     // The run records its inputs for the solutions it writes, refusing a
     // reference made from another mesh-prep run than the mesh.
     let mut run = Run::start("bench-surfaces", env!("CARGO_PKG_VERSION"));
-    let (mesh, mesh_input) = Mesh::read(&args.mesh)?;
+    let (mesh, mesh_input) = Mesh::read(&args.scene.mesh)?;
     run.input(mesh_input)?;
-    let manifest = read_ron::<Manifest>(&args.manifest)?;
+    let manifest = read_ron::<Manifest>(&args.scene.manifest)?;
     run.input(manifest.input)?;
     let manifest = manifest.value;
     let (reference, reference_input) = Solution::read(&args.reference)?;
