@@ -24,7 +24,7 @@
 //! the leaves they join send it. With a finer solve as the field, it is
 //! the leaf's error against one bounce of that solve.
 //!
-//! Per link ([`Gather::links`]): each ray's light is credited to the link
+//! Per link ([`Gather::link_fluxes`]): each ray's light is credited to the link
 //! that carries it, the one between an ancestor of the receiving leaf
 //! (itself included, then its input triangle's clusters) and an ancestor
 //! of the leaf the ray meets, against the link's own flux, `A_r V F B_sent`
