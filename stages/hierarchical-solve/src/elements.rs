@@ -11,7 +11,7 @@ use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon, triangle
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Manifest, Mesh};
-use schemas::solution::NONE;
+use schemas::solution::{Node, NONE};
 use schemas::surface::Surface;
 use std::f64::consts::PI;
 
@@ -205,11 +205,7 @@ impl Hierarchy {
     /// Whether the bounding boxes of elements `a` and `b` meet (to a
     /// millionth of the larger box's size).
     pub fn touching(&self, a: u32, b: u32) -> bool {
-        let bounds = |e: u32| {
-            let p = &self.elements[e as usize].points;
-            (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
-        };
-        let ((lo_a, hi_a), (lo_b, hi_b)) = (bounds(a), bounds(b));
+        let ((lo_a, hi_a), (lo_b, hi_b)) = (self.bounds(Node::Element(a)), self.bounds(Node::Element(b)));
         let tolerance = 1e-6 * (hi_a - lo_a).max(hi_b - lo_b).max_element();
         (lo_a - hi_b).max_element() <= tolerance && (lo_b - hi_a).max_element() <= tolerance
     }
