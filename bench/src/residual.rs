@@ -42,7 +42,7 @@ use radiometry::color::luminance;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{strata, Strata, Stream};
-use radiometry::subdivision::locate_child;
+use radiometry::subdivision::leaf_holding;
 use rayon::prelude::*;
 use schemas::cluster::Clusters;
 use schemas::mesh::{Manifest, Mesh};
@@ -175,17 +175,8 @@ impl<'a> Gather<'a> {
 
     /// The leaf of `solution` on triangle `t` holding point `p`.
     fn leaf_at(&self, solution: &Solution, t: u32, p: DVec3) -> usize {
-        let uv = self.geometry[t as usize].uv_of(p);
-        let mut local = [1.0 - uv[0] - uv[1], uv[0], uv[1]].map(|l| l.max(0.0));
-        let sum: f64 = local.iter().sum();
-        local = if sum > 0.0 { local.map(|l| l / sum) } else { [1.0 / 3.0; 3] };
-        let mut e = t as usize;
-        while solution.elements[e].first_child != NONE {
-            let (child, inside) = locate_child(local);
-            local = inside;
-            e = solution.elements[e].first_child as usize + child;
-        }
-        e
+        let first_child = |e: usize| Some(solution.elements[e].first_child).filter(|&c| c != NONE).map(|c| c as usize);
+        leaf_holding(t as usize, self.geometry[t as usize].uv_of(p), first_child).0
     }
 
     /// The field's radiosity at point `p` of triangle `t`.

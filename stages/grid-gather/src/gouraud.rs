@@ -58,7 +58,7 @@
 use glam::DVec3;
 use radiometry::bounds::Aabb;
 use radiometry::geometry::TriangleGeometry;
-use radiometry::subdivision::{children, locate_child, Corners, ROOT};
+use radiometry::subdivision::{children, leaf_holding, Corners, ROOT};
 use rayon::prelude::*;
 use schemas::solution::{Solution, NONE};
 use schemas::{Error, Result};
@@ -209,15 +209,7 @@ impl Gouraud {
     /// Coordinates slightly outside the triangle (ray-hit round-off) are
     /// clamped onto it.
     pub fn radiosity(&self, triangle: u32, uv: [f64; 2]) -> [f64; 3] {
-        let mut local = [1.0 - uv[0] - uv[1], uv[0], uv[1]].map(|l| l.max(0.0));
-        let sum: f64 = local.iter().sum();
-        local = if sum > 0.0 { local.map(|l| l / sum) } else { [1.0 / 3.0; 3] };
-        let mut element = triangle as usize;
-        while self.first_child[element] != NONE {
-            let (k, child_local) = locate_child(local);
-            local = child_local;
-            element = self.first_child[element] as usize + k;
-        }
+        let (element, local) = leaf_holding(triangle as usize, uv, |e| (self.first_child[e] != NONE).then(|| self.first_child[e] as usize));
         let corners = &self.corner_radiosity[self.leaf_of_element[element] as usize];
         std::array::from_fn(|channel| (0..3).map(|k| local[k] * corners[k][channel]).sum())
     }

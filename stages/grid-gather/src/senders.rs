@@ -142,9 +142,7 @@ impl<'a> Senders<'a> {
     /// arriving at the hit object").
     pub fn chain(&self, triangle: u32, uv: [f64; 2], links: &mut Vec<usize>) -> u32 {
         links.clear();
-        let mut local = [1.0 - uv[0] - uv[1], uv[0], uv[1]].map(|l| l.max(0.0));
-        let sum: f64 = local.iter().sum();
-        local = if sum > 0.0 { local.map(|l| l / sum) } else { [1.0 / 3.0; 3] };
+        let mut local = radiometry::subdivision::clamped_local(uv);
         let mut element = triangle;
         links.extend(self.links_of(Node::Element(element)));
         while self.solution.elements[element as usize].first_child != NONE {
