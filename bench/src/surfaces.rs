@@ -144,6 +144,25 @@ pub enum Unit {
     Triangle,
 }
 
+impl Unit {
+    /// The surface (its index) that input triangle `t` of `mesh` belongs to.
+    pub fn of(self, mesh: &Mesh, t: u32) -> usize {
+        match self {
+            Unit::Object => mesh.triangles[t as usize].object as usize,
+            Unit::Triangle => t as usize,
+        }
+    }
+
+    /// Every surface's name, by index: an object's, or an object's and a
+    /// triangle's index.
+    pub fn names(self, mesh: &Mesh, manifest: &Manifest) -> Vec<String> {
+        match self {
+            Unit::Object => manifest.objects.clone(),
+            Unit::Triangle => mesh.triangles.iter().enumerate().map(|(i, t)| format!("{} {i}", manifest.objects[t.object as usize])).collect(),
+        }
+    }
+}
+
 /// The scene's surfaces and a reference solution on its mesh.
 pub struct Surfaces<'a> {
     mesh: &'a Mesh,
@@ -168,15 +187,13 @@ impl<'a> Surfaces<'a> {
     pub fn new(mesh: &'a Mesh, manifest: &Manifest, reference: &'a Solution, unit: Unit) -> Result<Self, String> {
         check_mesh(mesh, reference, "the reference")?;
         let emits = |t: &schemas::mesh::Triangle| luminance(manifest.materials[t.material as usize].emission) > 0.0;
-        let surfaces = match unit {
-            Unit::Object => manifest
-                .objects
-                .iter()
-                .enumerate()
-                .map(|(o, name)| (name.clone(), !mesh.triangles.iter().filter(|t| t.object as usize == o).all(emits)))
-                .collect(),
-            Unit::Triangle => mesh.triangles.iter().enumerate().map(|(i, t)| (format!("{} {i}", manifest.objects[t.object as usize]), !emits(t))).collect(),
-        };
+        // A surface is measured unless all its triangles emit.
+        let names = unit.names(mesh, manifest);
+        let mut measured = vec![false; names.len()];
+        for (t, triangle) in mesh.triangles.iter().enumerate() {
+            measured[unit.of(mesh, t as u32)] |= !emits(triangle);
+        }
+        let surfaces = names.into_iter().zip(measured).collect();
         let geometry = mesh_triangles(mesh);
         let (lo, hi) = geometry.iter().flat_map(|g| g.corners).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
         Ok(Surfaces { mesh, geometry, unit, surfaces, reference, on_plane: 1e-5 * (hi - lo).length() })
@@ -280,10 +297,7 @@ impl<'a> Surfaces<'a> {
 
     /// The surface input triangle `triangle` belongs to.
     fn surface_of(&self, triangle: u32) -> usize {
-        match self.unit {
-            Unit::Object => self.mesh.triangles[triangle as usize].object as usize,
-            Unit::Triangle => triangle as usize,
-        }
+        self.unit.of(self.mesh, triangle)
     }
 
     /// Open-area-weighted mean luminance per measured surface of

@@ -79,14 +79,8 @@ fn run(args: Args) -> Result<ExitCode> {
         None => None,
     };
     let gather = Gather::new(&mesh, &manifest, field.as_ref().unwrap_or(&solution)).map_err(|m| invalid(&args.scene.manifest, m))?;
-    let surface_of = |t: u32| match args.by {
-        Unit::Object => mesh.triangles[t as usize].object as usize,
-        Unit::Triangle => t as usize,
-    };
-    let names: Vec<String> = match args.by {
-        Unit::Object => manifest.objects.clone(),
-        Unit::Triangle => (0..mesh.triangles.len()).map(|t| format!("{} {t}", manifest.objects[mesh.triangles[t].object as usize])).collect(),
-    };
+    let surface_of = |t: u32| args.by.of(&mesh, t);
+    let names = args.by.names(&mesh, &manifest);
     let only = match &args.surface {
         None => None,
         Some(name) => {
