@@ -47,9 +47,9 @@ pub fn point_to_polygon(point: DVec3, normal: DVec3, polygon: &[DVec3]) -> f64 {
         if c_len <= f64::MIN_POSITIVE {
             continue;
         }
-        // gamma via atan2 keeps full precision at small and near-pi angles,
-        // where acos of a dot product would not.
-        let gamma = c_len.atan2(a.dot(b));
+        // gamma from both sine and cosine keeps full precision at small and
+        // near-pi angles, where acos of a dot product would not.
+        let gamma = crate::angle::from_sin_cos(c_len, a.dot(b));
         sum += gamma * normal.dot(c) / c_len;
     }
     (sum.abs() / (2.0 * PI)).min(1.0)

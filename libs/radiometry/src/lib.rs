@@ -1,5 +1,7 @@
 //! # radiometry: the math several stages share
 //!
+//! - [`angle`]: the angle between two vectors from their cross and dot
+//!   products, the edge angle of Lambert's factor, without libm's `atan2`.
 //! - [`form_factor`]: Lambert's point-to-polygon factor (paper 002 Eq. 3)
 //!   and area-averaged element factors by Dunavant quadrature.
 //! - [`sampling`]: deterministic per-work-item random streams, stratified
@@ -22,6 +24,7 @@
 //! scene's artifacts (mesh, camera, lights, textures) into this crate's
 //! data.
 
+pub mod angle;
 pub mod bounds;
 pub mod burial;
 pub mod camera;
