@@ -36,11 +36,12 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// `tan(k pi/16)` for `k = 0..=4`: the centres of the four arcs.
-const CENTRES: [f64; 5] = [0.0, 0.198_912_367_379_658_006_9, 0.414_213_562_373_095_048_8, 0.668_178_637_919_298_920_0, 1.0];
+/// `tan(k pi/16)` for `k = 0..=4`, rounded to f64: the centres of the
+/// four arcs.
+const CENTRES: [f64; 5] = [0.0, 0.198_912_367_379_658, 0.414_213_562_373_095_03, 0.668_178_637_919_298_9, 1.0];
 
 /// `tan((2k + 1) pi/32)` for `k = 0..4`: the borders between the arcs.
-const BORDERS: [f64; 4] = [0.098_491_403_357_164_253_1, 0.303_346_683_607_342_391_7, 0.534_511_135_950_791_641_1, 0.820_678_790_828_660_330_9];
+const BORDERS: [f64; 4] = [0.098_491_403_357_164_25, 0.303_346_683_607_342_4, 0.534_511_135_950_791_7, 0.820_678_790_828_660_4];
 
 /// The angle `atan2(s, c)` in `[0, pi]` for `s >= 0` (module docs): the
 /// angle between two vectors whose cross product has length `s` and whose
