@@ -168,6 +168,12 @@ impl<'a> Gather<'a> {
         })
     }
 
+    /// The world centroid of element `e` of a solution of this mesh.
+    pub fn centroid(&self, e: &schemas::solution::Element) -> DVec3 {
+        let g = &self.geometry[e.triangle as usize];
+        e.corners.iter().map(|c| g.point([f64::from(c[0]), f64::from(c[1])])).sum::<DVec3>() / 3.0
+    }
+
     /// Whether triangle `t` emits.
     pub fn emits(&self, t: u32) -> bool {
         self.emits[t as usize]

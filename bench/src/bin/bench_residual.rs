@@ -59,10 +59,16 @@ struct Args {
     /// Output: the tables, Markdown (also printed on stdout).
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
+    /// Output: every gathered leaf as a CSV row (its element, surface, level, open area, centroid, and the luminance of the solution and of the gather), for plots and for sorting leaves by place.
+    #[arg(long, value_name = "LEAVES.csv")]
+    leaves: Option<PathBuf>,
 }
 
 fn run(args: Args) -> Result<ExitCode> {
     check_writable(&args.output)?;
+    if let Some(path) = &args.leaves {
+        check_writable(path)?;
+    }
     let (mesh, _) = Mesh::read(&args.scene.mesh)?;
     let manifest = read_ron::<Manifest>(&args.scene.manifest)?.value;
     let (solution, _) = Solution::read(&args.solution)?;
@@ -140,6 +146,16 @@ fn run(args: Args) -> Result<ExitCode> {
             let link = &solution.links[l];
             text += &format!("| {l} | {} | {} | {:.3} | {c:.4e} | {o:.4e} | {:+.2}% |\n", node(link.receiver), node(link.sender), link.visibility, 100.0 * (o / c - 1.0));
         }
+    }
+    if let Some(path) = &args.leaves {
+        let mut csv = String::from("element,surface,triangle,level,area_m2,x,y,z,solution,gathered\n");
+        for (leaf, g) in &gathered {
+            let e = &solution.elements[*leaf];
+            let c = gather.centroid(e);
+            let b = luminance(e.radiosity.map(f64::from));
+            csv += &format!("{leaf},{},{},{},{:e},{},{},{},{b:e},{:e}\n", names[surface_of(e.triangle)], e.triangle, e.level, e.area, c.x, c.y, c.z, luminance(g.radiosity));
+        }
+        write_bytes_atomically(path, csv.as_bytes())?;
     }
     write_bytes_atomically(&args.output, text.as_bytes())?;
     print!("{text}");
