@@ -93,8 +93,9 @@
 //! element sender where the link is partly occluded), so
 //! `sum_j A_j E_j = A_r V F_rs B_sent`: the link's flux, shared by factor.
 //! Below a part its light is shared by the factors of the elements there
-//! from their centroids, untraced ([`SPREAD_PARTS`] of them,
-//! `spread_below`), and pushed alike below those; where the link is partly
+//! (from their centroids, over them where they touch an element sender),
+//! untraced ([`SPREAD_PARTS`] of them, `spread_below`), and pushed alike
+//! below those; where the link is partly
 //! occluded, a part that a shadow edge crosses opens into its children
 //! first (`part_weights`, at most [`MAX_SHADOWED_PARTS`] parts), and the
 //! link's visible fraction becomes what its parts measured,
@@ -859,22 +860,6 @@ mod tests {
         }
     }
 
-    /// A lamp (`x, y` in [0.25, 0.75], 1 m up, facing down) over a unit
-    /// floor, and a black sheet 10 cm up over `x < 0.4`: the floor's
-    /// shadow edge, 5 cm wide, runs across the parts of the floor's
-    /// triangle 0 along `x = 0.4`. A partly occluded link from the lamp's
-    /// triangle into triangle 0, opened to level 3 (64 leaves), lights its
-    /// 16 parts (level 2) by their own visibility, and those the edge
-    /// crosses open into their children, so the light below them follows
-    /// the edge. Each leaf's share against its own visible factor (a 24 x
-    /// 24 midpoint grid over the leaf and 16 x 16 over the lamp, with the
-    /// segment test against the sheet written here): the relative L2 over
-    /// the leaves must be under half of what the best share constant over
-    /// each of the 16 parts (the mean of the reference over it) reaches,
-    /// as the parts alone gave. It is 0.066 against 0.200. The link, given
-    /// a visible fraction of 0.5, takes the one its parts measured: within
-    /// 1% of the leaves' visible factor over their unoccluded one (0.8447
-    /// against 0.8429).
     /// A floor triangle split three levels (64 leaves below its 16 parts)
     /// lit by the wall standing on its edge, through one unoccluded link
     /// into the floor's root. Each leaf's share of the link's light against
@@ -882,9 +867,8 @@ mod tests {
     /// Dunavant, 6 levels), relative to the leaves' mean factor: pushed
     /// alike below the parts, the leaves would get their part's mean, an
     /// L2 error of 18.6% (the crease's leaves far under their share);
-    /// shared by their own factors it is 1.2%, the worst leaf 3.2% (the
-    /// centroid factor's error for a leaf beside one that touches the
-    /// wall).
+    /// shared by their own factors it is 1.2%, the worst leaf 3.2% (what
+    /// the centroid factors of the leaves near the crease miss).
     #[test]
     fn the_light_of_a_part_is_shared_below_it_by_the_elements_own_factors() {
         use radiometry::form_factor::{triangle_to_polygon, Quadrature};
@@ -917,6 +901,22 @@ mod tests {
         assert!(worst < 0.05, "worst leaf {worst}; L2 {shared} against {pushed} pushed alike");
     }
 
+    /// A lamp (`x, y` in [0.25, 0.75], 1 m up, facing down) over a unit
+    /// floor, and a black sheet 10 cm up over `x < 0.4`: the floor's
+    /// shadow edge, 5 cm wide, runs across the parts of the floor's
+    /// triangle 0 along `x = 0.4`. A partly occluded link from the lamp's
+    /// triangle into triangle 0, opened to level 3 (64 leaves), lights its
+    /// 16 parts (level 2) by their own visibility, and those the edge
+    /// crosses open into their children, so the light below them follows
+    /// the edge. Each leaf's share against its own visible factor (a 24 x
+    /// 24 midpoint grid over the leaf and 16 x 16 over the lamp, with the
+    /// segment test against the sheet written here): the relative L2 over
+    /// the leaves must be under half of what the best share constant over
+    /// each of the 16 parts (the mean of the reference over it) reaches,
+    /// as the parts alone gave. It is 0.066 against 0.200. The link, given
+    /// a visible fraction of 0.5, takes the one its parts measured: within
+    /// 1% of the leaves' visible factor over their unoccluded one (0.8447
+    /// against 0.8429).
     #[test]
     fn a_partly_occluded_link_into_an_element_follows_the_shadow_edge_below_its_parts() {
         use glam::dvec3;
