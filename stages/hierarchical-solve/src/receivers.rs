@@ -873,13 +873,7 @@ mod tests {
     fn the_light_of_a_part_is_shared_below_it_by_the_elements_own_factors() {
         use radiometry::form_factor::{triangle_to_polygon, Quadrature};
         let FloorAndWall { mut h, .. } = FloorAndWall::new(2.0);
-        let mut level = vec![0u32];
-        for _ in 0..3 {
-            level = level.iter().flat_map(|&e| {
-                let first = h.subdivide(e);
-                first..first + 4
-            }).collect();
-        }
+        let level = crate::test_scenes::split_levels(&mut h, 0, 3);
         let (scene, occluders) = crate::test_scenes::traced(&h);
         let wall = 2;
         let link = Link { receiver: Node::Element(0), sender: Node::Element(wall), form_factor: 0.1, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: true };
@@ -928,13 +922,7 @@ mod tests {
         ]);
         let manifest = manifest(3, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [1.0; 3]), material([0.0; 3], [0.0; 3])]);
         let mut h = Hierarchy::new(&mesh, &manifest, None, None);
-        let mut level = vec![0u32];
-        for _ in 0..3 {
-            level = level.iter().flat_map(|&e| {
-                let first = h.subdivide(e);
-                first..first + 4
-            }).collect();
-        }
+        let level = crate::test_scenes::split_levels(&mut h, 0, 3);
         let (scene, occluders) = crate::test_scenes::traced(&h);
         let link = Link { receiver: Node::Element(0), sender: Node::Element(2), form_factor: 0.1, spread: 0.0, visibility: Some(0.5), occluder_distance: 0.5, clear: false };
         let mut links = [link];

@@ -96,3 +96,19 @@ pub fn traced(h: &Hierarchy) -> (SceneRays, Occluders) {
     let occluders = Occluders::new(&corners, &scene);
     (scene, occluders)
 }
+
+/// Splits element `e` of `h` `levels` times, 1:4 each time, and returns
+/// the elements of its last level (`4^levels` leaves).
+pub fn split_levels(h: &mut Hierarchy, e: u32, levels: u32) -> Vec<u32> {
+    let mut level = vec![e];
+    for _ in 0..levels {
+        level = level
+            .iter()
+            .flat_map(|&e| {
+                let first = h.subdivide(e);
+                first..first + 4
+            })
+            .collect();
+    }
+    level
+}
