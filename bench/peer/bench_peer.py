@@ -53,6 +53,9 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from pareto import pareto, time_to_error  # noqa: E402  (bench/pareto.py, shared with bench-renderpark)
+
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # radiometry::color::luminance (BT.709)
 NO_SURFACE = 4294967295.0
 SINGLE_SURFACE, EMITTER = 1, 2
@@ -249,30 +252,6 @@ def reference(renderer, args, mask, goal):
 
 
 # --- time to error ------------------------------------------------------------
-
-def pareto(points):
-    """(time, error) points, sorted by time, each better than every faster one."""
-    front, best = [], float("inf")
-    for t, e in sorted(points):
-        if e < best:
-            front.append((t, e))
-            best = e
-    return front
-
-
-def time_to_error(points, target):
-    """Smallest time at which the error reaches `target`, log-log between
-    the Pareto neighbours; None where never reached."""
-    front = pareto(points)
-    for i, (t, e) in enumerate(front):
-        if e <= target:
-            if i == 0 or e == target:
-                return t
-            t0, e0 = front[i - 1]
-            f = (math.log(target) - math.log(e0)) / (math.log(e) - math.log(e0))
-            return math.exp(math.log(t0) + f * (math.log(t) - math.log(t0)))
-    return None
-
 
 def read_sweep(path):
     """Series of the pipeline's sweep.csv: {"hierarchical/preview": [(total_s, error, label)]}."""

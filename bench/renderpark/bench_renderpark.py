@@ -66,6 +66,9 @@ import sys
 import time
 import xml.etree.ElementTree as ET
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from pareto import time_to_error  # noqa: E402  (bench/pareto.py, shared with bench-peer)
+
 # rpkCpp's luminous efficacy of its "white" (lm/W): it reads an MGF `ed`
 # (lm/m^2) as ed / WHITE_EFFICACY W/m^2.
 WHITE_EFFICACY = 183.07
@@ -230,6 +233,21 @@ def image_table(results):
     return "\n".join(rows)
 
 
+def equal_error(results, medians):
+    """Markdown: per rpk series, the time hierarchical-solve needs for rpk's
+    image relative RMSE (log-log between its Pareto neighbours,
+    `bench/pareto.py`) and its ratio to rpk's time; `results` as
+    `image_table` takes them, `medians` each label's median time."""
+    ours = [(medians[label], r) for label, (r, _) in results if label.startswith("hierarchical-solve ")]
+    rows = ["| rpk series | its image relative RMSE | its time | hierarchical-solve's time to it | ratio |", "|---|---|---|---|---|"]
+    for label, (r, _) in results:
+        if label.startswith("rpk "):
+            t = time_to_error(ours, r)
+            reached = f"{t:.3f} s | {t / medians[label]:.2f}" if t is not None else "not reached | -"
+            rows.append(f"| {label} | {100 * r:.2f}% | {medians[label]:.3f} s | {reached} |")
+    return "\n".join(rows)
+
+
 def worst_surfaces(markdown):
     """{label: worst surface error, %} from bench-surfaces' table."""
     lines = markdown.strip().splitlines()
@@ -368,10 +386,10 @@ def main():
         timed(shlex.split(a.preview) + ["--solution", solution, "-o", image, "--report", image + ".report.ron"], image + ".log")
         timed(shlex.split(a.compare) + [image, a.image_reference, "-o", report, "--diff", image.replace(".exr", ".diff.png")], report + ".log")
         results.append((label, compared(open(report).read())))
-    images = image_table(results)
+    medians = {f"{program} {setting}": statistics.median(v["times"]) for (program, setting), v in series.items()}
+    images = image_table(results) + "\n\nAt equal image error (medians of the timed rounds):\n\n" + equal_error(results, medians)
     open(os.path.join(a.out, "images.md"), "w").write(images + "\n")
     print(images)
-    medians = {f"{program} {setting}": statistics.median(v["times"]) for (program, setting), v in series.items()}
     worst = worst_surfaces(open(surfaces).read())
     curves = []
     for program, colour in [("rpk", "#d95f02"), ("hierarchical-solve", "#1b6ac9")]:

@@ -99,6 +99,19 @@ class Accuracy(unittest.TestCase):
         self.assertIn("| tall_block | +0.73% |", table)
         self.assertIn("| worst surface | 0.73% |", table)
 
+    def test_equal_error_interpolates_log_log_between_our_neighbours(self):
+        # rpk 3e-5 at 1.63% in 0.134 s; ours 1.91% at 0.209 s and 1.34% at
+        # 0.350 s (make bench-renderpark at 986a593): 1.63% at
+        # 0.209 (0.350 / 0.209)^(ln(1.91/1.63) / ln(1.91/1.34)) s.
+        results = [("rpk 3e-5", (0.0163, {})), ("rpk 1e-5", (0.0100, {})),
+                   ("hierarchical-solve 1e-3", (0.0191, {})), ("hierarchical-solve 6.5e-4", (0.0134, {}))]
+        medians = {"rpk 3e-5": 0.134, "rpk 1e-5": 0.257, "hierarchical-solve 1e-3": 0.209, "hierarchical-solve 6.5e-4": 0.350}
+        table = br.equal_error(results, medians)
+        t = 0.209 * (0.350 / 0.209) ** (math.log(1.91 / 1.63) / math.log(1.91 / 1.34))
+        self.assertIn(f"| rpk 3e-5 | 1.63% | 0.134 s | {t:.3f} s | {t / 0.134:.2f} |", table)
+        self.assertAlmostEqual(t / 0.134, 1.96, places=2)
+        self.assertIn("| rpk 1e-5 | 1.00% | 0.257 s | not reached | - |", table)
+
     def test_axis_ends_are_one_two_five(self):
         self.assertEqual([br.nice(v, True) for v in (0.071, 0.1, 0.37, 4.67)], [0.05, 0.1, 0.2, 2.0])
         self.assertEqual([br.nice(v, False) for v in (0.071, 0.1, 0.37, 4.67)], [0.1, 0.1, 0.5, 5.0])
