@@ -169,9 +169,24 @@ impl<'a> Gather<'a> {
     }
 
     /// The world centroid of element `e` of a solution of this mesh.
-    pub fn centroid(&self, e: &schemas::solution::Element) -> DVec3 {
+    fn centroid(&self, e: &schemas::solution::Element) -> DVec3 {
         let g = &self.geometry[e.triangle as usize];
         e.corners.iter().map(|c| g.point([f64::from(c[0]), f64::from(c[1])])).sum::<DVec3>() / 3.0
+    }
+
+    /// `gathered` (of `solution`'s leaves) as CSV, a row per leaf: its
+    /// element, surface (`surface` names a triangle's), input triangle,
+    /// level, open area (m²), world centroid, and the luminance of its
+    /// radiosity in the solution and in the gather (W/m²).
+    pub fn leaves_csv(&self, solution: &Solution, gathered: &[(usize, Gathered)], surface: &dyn Fn(u32) -> String) -> String {
+        let mut csv = String::from("element,surface,triangle,level,area_m2,x,y,z,solution,gathered\n");
+        for (leaf, g) in gathered {
+            let e = &solution.elements[*leaf];
+            let c = self.centroid(e);
+            let b = luminance(e.radiosity.map(f64::from));
+            csv += &format!("{leaf},{},{},{},{:e},{},{},{},{b:e},{:e}\n", surface(e.triangle), e.triangle, e.level, e.area, c.x, c.y, c.z, luminance(g.radiosity));
+        }
+        csv
     }
 
     /// Whether triangle `t` emits.
@@ -381,6 +396,29 @@ mod tests {
             let [(0, credited, own)] = fluxes[..] else { panic!("{fluxes:?}") };
             assert!((credited / (0.5 * f * 10.0) - 1.0).abs() < 5e-3 && (own / credited - ratio).abs() < 5e-3, "{credited} {own}");
         }
+    }
+
+    /// `--leaves`: a row per gathered leaf whose columns say what its
+    /// header says: the floor's element, surface, triangle, level, area,
+    /// centroid `(1/3, 1/3, 0)`, its radiosity in the solution (0) and
+    /// gathered (`rho F E`).
+    #[test]
+    fn the_leaves_table_has_a_row_per_gathered_leaf() {
+        let f = factor();
+        let (mesh, manifest, solution) = scene(f, 1.0);
+        let gather = Gather::new(&mesh, &manifest, &solution).expect("a plain scene");
+        let gathered = gather.leaves(&solution, &|_| true, Sampling { points: 16, rays: 16, emitter_points: 256 }, None);
+        let csv = gather.leaves_csv(&solution, &gathered, &|t| format!("surface {t}"));
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 2, "{csv}");
+        let row: Vec<&str> = lines[1].split(',').collect();
+        let header: Vec<&str> = lines[0].split(',').collect();
+        let column = |name: &str| row[header.iter().position(|&h| h == name).expect(name)];
+        assert_eq!((column("element"), column("surface"), column("triangle"), column("level")), ("0", "surface 0", "0", "0"));
+        let number = |name: &str| column(name).parse::<f64>().expect(name);
+        assert!((number("area_m2") - 0.5).abs() < 1e-6 && (number("x") - 1.0 / 3.0).abs() < 1e-6 && (number("y") - 1.0 / 3.0).abs() < 1e-6 && number("z").abs() < 1e-12, "{csv}");
+        assert_eq!(number("solution"), 0.0);
+        assert!((number("gathered") / (0.5 * f * 10.0) - 1.0).abs() < 0.02, "{csv}");
     }
 
     /// A material the gather does not model is refused by name.

@@ -148,14 +148,7 @@ fn run(args: Args) -> Result<ExitCode> {
         }
     }
     if let Some(path) = &args.leaves {
-        let mut csv = String::from("element,surface,triangle,level,area_m2,x,y,z,solution,gathered\n");
-        for (leaf, g) in &gathered {
-            let e = &solution.elements[*leaf];
-            let c = gather.centroid(e);
-            let b = luminance(e.radiosity.map(f64::from));
-            csv += &format!("{leaf},{},{},{},{:e},{},{},{},{b:e},{:e}\n", names[surface_of(e.triangle)], e.triangle, e.level, e.area, c.x, c.y, c.z, luminance(g.radiosity));
-        }
-        write_bytes_atomically(path, csv.as_bytes())?;
+        write_bytes_atomically(path, gather.leaves_csv(&solution, &gathered, &|t| names[surface_of(t)].clone()).as_bytes())?;
     }
     write_bytes_atomically(&args.output, text.as_bytes())?;
     print!("{text}");
