@@ -844,7 +844,7 @@ fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: 
 mod tests {
     use super::*;
     use crate::links::leaf_deviation;
-    use crate::test_scenes::FloorAndWall;
+    use crate::test_scenes::{split_levels, FloorAndWall};
     use radiometry::form_factor::point_to_polygon;
     use test_support::closed_form::mean_over_triangle;
 
@@ -863,20 +863,8 @@ mod tests {
     fn a_sender_passing_under_its_receiver_sends_its_leaves_kernel_weighted_mean() {
         let mut scene = FloorAndWall::new(1.5);
         let h = &mut scene.h;
-        let mut leaves = vec![0u32];
-        for _ in 0..5 {
-            leaves = leaves
-                .into_iter()
-                .flat_map(|e| {
-                    h.ensure_children(Node::Element(e));
-                    let first = h.elements[e as usize].first_child;
-                    first..first + 4
-                })
-                .collect();
-        }
-        h.ensure_children(Node::Element(2));
-        let first = h.elements[2].first_child;
-        let receiver = (first..first + 4).min_by(|&a, &b| h.centroid(a).z.total_cmp(&h.centroid(b).z)).unwrap();
+        let leaves = split_levels(h, 0, 5);
+        let receiver = split_levels(h, 2, 1).into_iter().min_by(|&a, &b| h.centroid(a).z.total_cmp(&h.centroid(b).z)).unwrap();
         let mut b = vec![[0.0; 3]; h.cluster_count() + h.elements.len()];
         for &e in &leaves {
             let from_wall = 1.0 - h.centroid(e).x;

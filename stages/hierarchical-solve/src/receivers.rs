@@ -301,14 +301,11 @@ impl ReceiverTerms {
             }
             if let Some(seen) = seen[l].take() {
                 // One source per part, shared by the elements below it.
-                let mut views = seen.into_iter();
-                let mut part = None;
-                for &(e, w, j) in list {
-                    if part != Some(j) {
-                        part = Some(j);
-                        part_sources.push(PartSource::Parts { link: l, terms: views.next().expect("a view per part") });
+                for (shares, terms) in by_part(list).zip(seen) {
+                    for &(e, w, _) in shares {
+                        by_element[e as usize].push((part_sources.len(), w));
                     }
-                    by_element[e as usize].push((part_sources.len() - 1, w));
+                    part_sources.push(PartSource::Parts { link: l, terms });
                 }
                 continue;
             }
@@ -514,16 +511,7 @@ fn near_sender_terms(h: &Hierarchy, l: &Link, parts: &PartWeights, resolution: R
         return None;
     }
     let c = h.centroid(r);
-    let mut views = Vec::new();
-    if box_distance((c, c), h.bounds(l.sender)) <= NEAR_RECEIVER * h.radius(r) {
-        for (k, &(_, _, j)) in parts.iter().enumerate() {
-            if k == 0 || parts[k - 1].2 != j {
-                views.push(SenderTerms::seen_from(h, j, l, resolution, tracer).0);
-            }
-        }
-        return Some(views);
-    }
-    None
+    (box_distance((c, c), h.bounds(l.sender)) <= NEAR_RECEIVER * h.radius(r)).then(|| by_part(parts).map(|shares| SenderTerms::seen_from(h, shares[0].2, l, resolution, tracer).0).collect())
 }
 
 /// `f`, receiving element `receiver`'s factor to sender part `part`,
@@ -542,6 +530,11 @@ fn seen_factor(h: &Hierarchy, visibility: Option<Tracer>, receiver: u32, part: N
 /// `(e, w_e, j)`: an element at or below part `j` of a receiving element
 /// (element indices) and its weight ([`part_weights`]), grouped by part.
 type PartWeights = Vec<(u32, f64, u32)>;
+
+/// The groups of `shares` that share one part, in order.
+fn by_part(shares: &[(u32, f64, u32)]) -> impl Iterator<Item = &[(u32, f64, u32)]> {
+    shares.chunk_by(|a, b| a.2 == b.2)
+}
 
 /// Per part of a receiver, the sender terms `(flat node index, w)` it sees.
 type PartViews = Vec<Vec<(usize, f64)>>;
@@ -830,7 +823,7 @@ impl Part {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_scenes::FloorAndWall;
+    use crate::test_scenes::{split_levels, FloorAndWall};
     use glam::DVec3;
 
     /// A cluster of a unit floor and a unit wall on its edge (triangles
@@ -873,7 +866,7 @@ mod tests {
     fn the_light_of_a_part_is_shared_below_it_by_the_elements_own_factors() {
         use radiometry::form_factor::{triangle_to_polygon, Quadrature};
         let FloorAndWall { mut h, .. } = FloorAndWall::new(2.0);
-        let level = crate::test_scenes::split_levels(&mut h, 0, 3);
+        let level = split_levels(&mut h, 0, 3);
         let (scene, occluders) = crate::test_scenes::traced(&h);
         let wall = 2;
         let link = Link { receiver: Node::Element(0), sender: Node::Element(wall), form_factor: 0.1, spread: 0.0, visibility: Some(1.0), occluder_distance: f32::INFINITY, clear: true };
@@ -922,7 +915,7 @@ mod tests {
         ]);
         let manifest = manifest(3, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [1.0; 3]), material([0.0; 3], [0.0; 3])]);
         let mut h = Hierarchy::new(&mesh, &manifest, None, None);
-        let level = crate::test_scenes::split_levels(&mut h, 0, 3);
+        let level = split_levels(&mut h, 0, 3);
         let (scene, occluders) = crate::test_scenes::traced(&h);
         let link = Link { receiver: Node::Element(0), sender: Node::Element(2), form_factor: 0.1, spread: 0.0, visibility: Some(0.5), occluder_distance: 0.5, clear: false };
         let mut links = [link];
