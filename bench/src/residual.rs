@@ -64,7 +64,6 @@ pub struct Sampling {
 
 /// The scene as the gather traces it, and the field it gathers.
 pub struct Gather<'a> {
-    mesh: &'a Mesh,
     geometry: Vec<TriangleGeometry>,
     scene: SceneRays,
     /// Per triangle: diffuse reflectance and emission.
@@ -161,7 +160,6 @@ impl<'a> Gather<'a> {
         Ok(Gather {
             reflectance: mesh.triangles.iter().map(|t| material(t).diffuse).collect(),
             emits: mesh.triangles.iter().map(|t| luminance(material(t).emission) > 0.0).collect(),
-            mesh,
             geometry,
             scene,
             field,
@@ -305,11 +303,6 @@ impl<'a> Gather<'a> {
             .collect();
         leaves.par_iter().filter_map(|&i| self.leaf(solution, i, sampling, attribution).map(|g| (i, g))).collect()
     }
-
-    /// The object of triangle `t`.
-    pub fn object(&self, t: u32) -> u32 {
-        self.mesh.triangles[t as usize].object
-    }
 }
 
 impl Gather<'_> {
@@ -317,7 +310,12 @@ impl Gather<'_> {
     /// with an [`Attribution`]): (link, its flux as the gather credits
     /// it, its own flux `A_r V F B_sent`), luminance in W, `A_r` the
     /// receiver's whole area (its links' visibility counts a buried part
-    /// as hidden); links into clusters left out (module docs).
+    /// as hidden); links into clusters left out (module docs). `B_sent` is
+    /// what the link sends its receiver's centroid: where the last solve
+    /// has each part of the receiver see the sender for itself (a receiver
+    /// next to its sender, hierarchical-solve's `near_sender_terms`), the
+    /// leaves got those parts' views instead, and the link's own flux is
+    /// not what they got.
     pub fn link_fluxes(&self, solution: &Solution, gathered: &[(usize, Gathered)]) -> Vec<(usize, f64, f64)> {
         let mut credited: HashMap<usize, f64> = HashMap::new();
         for (leaf, g) in gathered {
