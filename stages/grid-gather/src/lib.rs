@@ -168,6 +168,8 @@ stage_kit::knobs! {
         material_seams: bool = true, "", switch;
         /// Passes correcting the vertex radiosity towards values whose interpolant has each leaf's radiosity as its mean over the leaf; 0: plain area-weighted means.
         mean_passes: u32 = 8, "", value(0..=64);
+        /// Each leaf shown as its four children on the least-squares plane through its neighbours' values, keeping its own as their mean; off: each leaf's value alone.
+        leaf_gradients: bool = true, "", switch;
         /// Full: the grid, uniform in post-perspective space or cubes (000 Sec. 4.2).
         grid: GridKind = GridKind::Perspective, "", value;
         /// Full: grid spacing on screen.
@@ -337,7 +339,7 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     })?;
     let triangles = mesh_triangles(scene.mesh);
     let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
-    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams, mean_passes: params.mean_passes };
+    let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams, mean_passes: params.mean_passes, leaf_gradients: params.leaf_gradients };
     // Checks in every mode that the solution belongs to the mesh; the
     // preview's shading.
     let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
