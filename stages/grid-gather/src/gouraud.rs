@@ -28,7 +28,7 @@
 //! `B(p) = sum_k l_k B_{c_k}` with `l` the point's barycentric coordinates
 //! in the leaf (linear interpolation, Gouraud 1971).
 //!
-//! These are the values of `mean_passes` 0. By default (`mean_passes` 8)
+//! These are the values of `mean_passes` 0. With passes (3 by default)
 //! the `B_j` in the sum are then corrected until each leaf's interpolated
 //! mean is close to its own radiosity ([`mean_preserving`]): plain means
 //! showed the border of a wall too bright and its interior too dark.
@@ -39,7 +39,15 @@
 //! (the solver's subdivision rule), lying on the plane through the leaf's
 //! value that fits its neighbours' values best (a least-squares gradient,
 //! [`Shown::on_gradients`]); the corners above are then those of the
-//! children. A leaf's children keep its value as their mean.
+//! children. A leaf's children keep its value as their mean, nearly, so
+//! fewer passes are needed than for the leaves' own values (8, the
+//! default before), and each pass also carries the noise of the solver's
+//! leaves into the corners: on the built-in Cornell box (preview against
+//! Mitsuba, seeds 1-8) 2, 3 and 8 passes gave 1.586%, 1.597% and 1.655%
+//! relative RMSE at `EPS` 1e-3, 1.099%, 1.109% and 1.145% at 6e-4, 2.471%,
+//! 2.464% and 2.510% at 1.5e-3; with exact means (the `EPS` 2.5e-5
+//! solve's over the 1e-3 solve's leaves), where more passes converge
+//! further, 1.116%, 1.087% and 1.081% (4: 1.075%).
 //!
 //! # Coincident corners
 //!
@@ -215,12 +223,12 @@ struct Shown {
 /// How far past the range of a leaf's and its neighbours' values its
 /// children may reach, as a fraction of that range's width
 /// ([`Shown::on_gradients`]). On the built-in Cornell box (`EPS` 1e-3,
-/// seeds 1 and 2, preview against Mitsuba) 1/4 never binds: 1.702% and
-/// 1.579% relative RMSE, as with no bound; 1/10 gives 1.710% and 1.591%;
-/// 0 (the limiter of Barth and Jespersen, at the children's centroids)
-/// 1.840% and 1.733%. Beside a step from 0 to 1 (a hard shadow edge
-/// across coarse leaves) the preview then shows at most 1.29 (1.32 with
-/// no bound, 1.17 at 1/10).
+/// seeds 1 and 2, preview against Mitsuba, 8 passes) 1/4 never binds:
+/// 1.702% and 1.579% relative RMSE, as with no bound; 1/10 gives 1.710%
+/// and 1.591%; 0 (the limiter of Barth and Jespersen, at the children's
+/// centroids) 1.840% and 1.733%. Beside a step from 0 to 1 (a hard
+/// shadow edge across coarse leaves) the preview then shows at most 1.28
+/// (1.32 with no bound, 1.17 at 1/10).
 pub const SHOWN_RANGE: f64 = 0.25;
 
 /// Per corner of the shown leaves, the leaves it blends ([`Shown::blends`]).
@@ -311,18 +319,21 @@ impl Shown {
     /// volumes, Barth and Jespersen 1989, here without their limiter, which
     /// flattened every extremum back) takes the slope from the neighbours'
     /// values; the children carry it, and Gouraud over them keeps it. On
-    /// the built-in Cornell box at `EPS` 1e-3 (preview against Mitsuba,
-    /// emitters and 2 px round edges left out, seeds 1-8) the relative RMSE
-    /// went from 1.861% to 1.664%, at 8e-4 from 1.605% to 1.407%, at 6e-4
-    /// from 1.268% to 1.149%, at 1.5e-3 from 3.26% to 2.63%; with the
-    /// `EPS` 2.5e-5 solve's means on the 1e-3 solve's leaves (seed 1), from
-    /// 1.486% to 1.069%. Two levels of children instead of one: 1.766%
-    /// (seed 1; 1.708% with one), the gradient's neighbours weighed alike
-    /// or by `1 / d` instead of `1 / d²`: 1.750% and 1.723%, the gradient
-    /// scaled by 0.75 or 1.25: 1.847% and 1.729%, children without it:
-    /// 2.846%. RenderPark's solutions, linear per element and shown
-    /// through the same preview as 16 leaves each, come out a little
-    /// worse (1.629% -> 1.660% at its threshold 3e-5).
+    /// the built-in Cornell box (preview against Mitsuba, emitters and 2
+    /// px round edges left out, seeds 1-8; the leaves' own values at 8
+    /// passes, the gradients at the default 3, module docs) the relative
+    /// RMSE went from 1.861% to 1.597% at `EPS` 1e-3, from 1.605% to
+    /// 1.354% at 8e-4, from 1.268% to 1.109% at 6e-4, from 3.26% to 2.46%
+    /// at 1.5e-3; with the `EPS` 2.5e-5 solve's means on the 1e-3 solve's
+    /// leaves (seed 1), from 1.486% to 1.087%. Measured at 8 passes (seed
+    /// 1): two levels of children instead of one 1.766% (1.702% with
+    /// one), the gradient's neighbours weighed alike or by `1 / d` instead
+    /// of `1 / d²` 1.750% and 1.723%, the gradient scaled by 0.75 or 1.25
+    /// 1.847% and 1.729%, children without it 2.846%. RenderPark's
+    /// solutions, linear per element and shown through the same preview
+    /// as 16 leaves each, come out about as before (1.629% at its
+    /// threshold 3e-5 with their own values at 8 passes, 1.660% with the
+    /// gradients at 8, 1.637% at 2).
     fn on_gradients(&self, blends: &[Vec<u32>], leaves: &[Leaf], triangles: &[TriangleGeometry]) -> Shown {
         let split: Vec<[([DVec3; 3], [f64; 3]); 4]> = leaves
             .par_iter()

@@ -167,7 +167,7 @@ stage_kit::knobs! {
         /// Leaves of different materials do not blend at a shared corner (B jumps where emission or reflectance does, even on a flat surface).
         material_seams: bool = true, "", switch;
         /// Passes correcting the vertex radiosity towards values whose interpolant has each leaf's radiosity as its mean over the leaf; 0: plain area-weighted means.
-        mean_passes: u32 = 8, "", value(0..=64);
+        mean_passes: u32 = 3, "", value(0..=64);
         /// Each leaf shown as its four children on the least-squares plane through its neighbours' values, keeping its own as their mean; off: each leaf's value alone.
         leaf_gradients: bool = true, "", switch;
         /// Full: the grid, uniform in post-perspective space or cubes (000 Sec. 4.2).
