@@ -296,7 +296,7 @@ impl Shown {
 
     /// Each leaf as its four children (`leaves`' corners split by
     /// radiometry's subdivision rule), lying on the leaf's least-squares
-    /// plane through its neighbours' values ([`Shown::gradient`]):
+    /// plane through its neighbours' values ([`Shown::plane`]):
     ///
     /// ```text
     /// B_m = B_k + g_k . (c_m - c_k)
@@ -316,9 +316,9 @@ impl Shown {
     /// interpolant is nearly flat, and along a falloff steeper than the
     /// leaves are fine (a crease, a penumbra) the corners' averages round
     /// the leaves off. The least-squares gradient (cell-centred finite
-    /// volumes, Barth and Jespersen 1989, here without their limiter, which
-    /// flattened every extremum back) takes the slope from the neighbours'
-    /// values; the children carry it, and Gouraud over them keeps it. On
+    /// volumes, Barth and Jespersen 1989, here with the looser bound above
+    /// instead of their limiter, which flattened every extremum back)
+    /// takes the slope from the neighbours' values; the children carry it, and Gouraud over them keeps it. On
     /// the built-in Cornell box (preview against Mitsuba, emitters and 2
     /// px round edges left out, seeds 1-8; the leaves' own values at 8
     /// passes, the gradients at the default 3, module docs) the relative
@@ -333,7 +333,7 @@ impl Shown {
     /// solutions, linear per element and shown through the same preview
     /// as 16 leaves each, come out about as before (1.629% at its
     /// threshold 3e-5 with their own values at 8 passes, 1.660% with the
-    /// gradients at 8, 1.637% at 2).
+    /// gradients at 8, 1.65% at the default 3).
     fn on_gradients(&self, blends: &[Vec<u32>], leaves: &[Leaf], triangles: &[TriangleGeometry]) -> Shown {
         let split: Vec<[([DVec3; 3], [f64; 3]); 4]> = leaves
             .par_iter()
