@@ -144,18 +144,8 @@ impl Gouraud {
         smoothing: Smoothing,
         value: &(dyn Fn(&Corners, &schemas::solution::Element) -> [f64; 3] + Sync),
     ) -> Result<Self> {
-        let leaves = solution.leaves(triangles.len(), ROOT, children).map_err(|why| {
-            Error::invalid(solution_path, None, format!("solution does not belong to this mesh: {why}"))
-        })?;
+        let leaves = checked_leaves(triangles, solution, solution_path)?;
         let elements = &solution.elements;
-        if let Some(leaf) = leaves.iter().find(|l| !elements[l.element as usize].radiosity.iter().all(|b| b.is_finite())) {
-            return Err(Error::invalid(solution_path, None, format!("element {} has a non-finite radiosity", leaf.element)));
-        }
-        let mut leaf_of_element = vec![NONE; elements.len()];
-        for (k, leaf) in leaves.iter().enumerate() {
-            leaf_of_element[leaf.element as usize] = k as u32;
-        }
-
         // Per leaf: world corners, normal, area, radiosity.
         let own = Shown {
             positions: leaves.iter().flat_map(|l| triangles[l.triangle as usize].element(&l.corners)).collect(),
@@ -167,6 +157,7 @@ impl Gouraud {
         let cell = weld_cell(triangles, smoothing.weld_tolerance);
         let blends = own.blends(cell, smoothing);
         let mut first_child: Vec<u32> = elements.iter().map(|e| e.first_child).collect();
+        let mut leaf_of_element = vec![NONE; elements.len()];
         let (shown, blends) = if smoothing.leaf_gradients {
             // Leaf k's four shown leaves follow the solution's elements,
             // as its children would (radiometry's subdivision rule).
@@ -175,11 +166,13 @@ impl Gouraud {
                 first_child[leaf.element as usize] = (elements.len() + 4 * k) as u32;
             }
             first_child.resize(elements.len() + 4 * leaves.len(), NONE);
-            leaf_of_element = vec![NONE; elements.len()];
             leaf_of_element.extend(0..4 * leaves.len() as u32);
             let blends = split.blends(cell, smoothing);
             (split, blends)
         } else {
+            for (k, leaf) in leaves.iter().enumerate() {
+                leaf_of_element[leaf.element as usize] = k as u32;
+            }
             (own, blends)
         };
         let lists: Vec<&[u32]> = blends.lists.iter().map(Vec::as_slice).collect();
@@ -208,6 +201,19 @@ impl Gouraud {
         let corners = &self.corner_radiosity[self.leaf_of_element[element] as usize];
         std::array::from_fn(|channel| (0..3).map(|k| local[k] * corners[k][channel]).sum())
     }
+}
+
+/// The leaf elements of `solution`, checked to belong to the mesh of
+/// `triangles` and to have a finite radiosity (`solution_path` only names
+/// the file in errors).
+pub fn checked_leaves(triangles: &[TriangleGeometry], solution: &Solution, solution_path: &Path) -> Result<Vec<Leaf>> {
+    let leaves = solution.leaves(triangles.len(), ROOT, children).map_err(|why| {
+        Error::invalid(solution_path, None, format!("solution does not belong to this mesh: {why}"))
+    })?;
+    if let Some(leaf) = leaves.iter().find(|l| !solution.elements[l.element as usize].radiosity.iter().all(|b| b.is_finite())) {
+        return Err(Error::invalid(solution_path, None, format!("element {} has a non-finite radiosity", leaf.element)));
+    }
+    Ok(leaves)
 }
 
 /// Leaves as the preview shows them: per leaf its three world corners,

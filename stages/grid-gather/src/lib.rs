@@ -340,13 +340,13 @@ pub fn gather_with(params: &Params, scene: &Scene, extras: Extras, rows_done: &(
     let triangles = mesh_triangles(scene.mesh);
     let materials: Vec<u32> = scene.mesh.triangles.iter().map(|t| t.material).collect();
     let smoothing = Smoothing { crease_angle_deg: params.crease_angle_deg, weld_tolerance: params.weld_tolerance, material_seams: params.material_seams, mean_passes: params.mean_passes, leaf_gradients: params.leaf_gradients };
-    // Checks in every mode that the solution belongs to the mesh; the
-    // preview's shading.
-    let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
     let frame = Frame { camera: &camera, width, height, triangles: &triangles, materials: &materials, smoothing };
     if params.mode != Mode::Preview {
+        // The solution belongs to the mesh; only the preview shades it.
+        gouraud::checked_leaves(&triangles, scene.solution, scene.solution_path)?;
         return full_image::gather(params, scene, extras, &frame, rows_done).map(|(r, d)| (r, Some(d)));
     }
+    let shading = Gouraud::new(&triangles, &materials, scene.solution, scene.solution_path, smoothing)?;
     preview::render(params, scene, extras, &frame, &shading, rows_done).map(|r| (r, None))
 }
 
