@@ -410,6 +410,31 @@ fn square_leaves(depth: u32) -> Vec<(u32, Corners, [DVec3; 3])> {
     leaves.into_iter().map(|(t, c)| (t, c, c.map(|uv| world(t, uv)))).collect()
 }
 
+/// Radiosity falling from the middle of the square towards two borders,
+/// as on a wall between two creases: quadratic in x.
+fn falloff(p: DVec3) -> f64 {
+    1.0 + 4.0 * p.x * (1.0 - p.x)
+}
+
+/// [`falloff`]'s exact mean over the leaf with world corners `w`: a
+/// quadratic's mean over a triangle is the mean of its values at the edge
+/// midpoints.
+fn falloff_mean(w: [DVec3; 3]) -> f64 {
+    (falloff(0.5 * (w[0] + w[1])) + falloff(0.5 * (w[1] + w[2])) + falloff(0.5 * (w[2] + w[0]))) / 3.0
+}
+
+/// A dark strip along the border y = 0, a leaf wide at depth 3 (a contact
+/// shadow), beside uniform light: 0 for the leaves within it, else 1.
+fn dark_strip(w: [DVec3; 3]) -> f64 {
+    if w.iter().all(|p| p.y <= 0.125 + 1e-9) { 0.0 } else { 1.0 }
+}
+
+/// The centroid of a leaf with corners `c`, in its triangle's barycentric
+/// coordinates.
+fn uv_centroid(c: &Corners) -> [f64; 2] {
+    [0, 1].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0)
+}
+
 /// Gouraud over the square's leaves at `depth`, each with the radiosity
 /// `mean(its world corners)`, with `passes` mean-preserving passes.
 fn square_gouraud(depth: u32, passes: u32, mean: &dyn Fn([DVec3; 3]) -> f64) -> Gouraud {
@@ -490,19 +515,17 @@ fn negative_leaves_keep_their_corners_in_range() {
 /// Radiosity falling from the middle towards two borders, as on a wall
 /// between two creases: each leaf shows its mean (a quadratic's mean over
 /// a triangle is the mean of its values at the edge midpoints, exactly),
-/// within 3% of the range of f after 8 passes (1.3% without the
+/// within 3% of the range of [`falloff`] after 8 passes (1.3% without the
 /// limit on the corners, [`mean_preserving`]), where plain means miss by
 /// 13%; the whole square's mean within 1e-4.
 #[test]
 fn mean_passes_keep_each_leafs_mean() {
-    let f = |p: DVec3| 1.0 + 4.0 * p.x * (1.0 - p.x);
-    let mean = |w: [DVec3; 3]| (f(0.5 * (w[0] + w[1])) + f(0.5 * (w[1] + w[2])) + f(0.5 * (w[2] + w[0]))) / 3.0;
     let leaves = square_leaves(3);
     let shown_minus_mean = |passes: u32| -> Vec<f64> {
-        let g = square_gouraud(3, passes, &mean);
+        let g = square_gouraud(3, passes, &falloff_mean);
         leaves
             .iter()
-            .map(|(t, c, w)| g.radiosity(*t, [0, 1].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0))[0] - mean(*w))
+            .map(|(t, c, w)| g.radiosity(*t, uv_centroid(c))[0] - falloff_mean(*w))
             .collect()
     };
     for (passes, most) in [(0, 0.12), (OWN_VALUE_PASSES, 0.03)] {
@@ -520,8 +543,7 @@ fn mean_passes_keep_each_leafs_mean() {
 /// width, the corners where all leaves agree keep their value.
 #[test]
 fn mean_passes_never_make_radiosity_negative() {
-    let shadow = |w: [DVec3; 3]| if w.iter().all(|p| p.y <= 0.125 + 1e-9) { 0.0 } else { 1.0 };
-    let g = square_gouraud(3, OWN_VALUE_PASSES, &shadow);
+    let g = square_gouraud(3, OWN_VALUE_PASSES, &dark_strip);
     let lowest = square_leaves(3).iter().flat_map(|(t, c, _)| c.map(|uv| g.radiosity(*t, uv)[0])).fold(f64::INFINITY, f64::min);
     assert!(lowest == 0.0, "lowest corner {lowest}");
     let highest = square_leaves(3).iter().flat_map(|(t, c, _)| c.map(|uv| g.radiosity(*t, uv)[0])).fold(0.0, f64::max);
@@ -560,11 +582,9 @@ fn rms_off(g: &Gouraud, f: &dyn Fn(DVec3) -> f64) -> f64 {
 /// `mean_passes_keep_each_leafs_mean`).
 #[test]
 fn leaf_gradients_show_a_falloff_closer() {
-    let f = |p: DVec3| 1.0 + 4.0 * p.x * (1.0 - p.x);
-    let mean = |w: [DVec3; 3]| (f(0.5 * (w[0] + w[1])) + f(0.5 * (w[1] + w[2])) + f(0.5 * (w[2] + w[0]))) / 3.0;
-    let shown = square_shown(3, shown_by_default(), &mean);
-    let own = square_shown(3, Smoothing { leaf_gradients: false, mean_passes: OWN_VALUE_PASSES, ..shown_by_default() }, &mean);
-    let (with, without) = (rms_off(&shown, &f), rms_off(&own, &f));
+    let shown = square_shown(3, shown_by_default(), &falloff_mean);
+    let own = square_shown(3, Smoothing { leaf_gradients: false, mean_passes: OWN_VALUE_PASSES, ..shown_by_default() }, &falloff_mean);
+    let (with, without) = (rms_off(&shown, &falloff), rms_off(&own, &falloff));
     assert!(with < 0.85 * without, "rms {with} with leaf gradients, {without} without");
     let mut worst_mean: f64 = 0.0;
     for (t, c, w) in square_leaves(3) {
@@ -572,7 +592,7 @@ fn leaf_gradients_show_a_falloff_closer() {
         // each the mean of its corners.
         let quarters = children(&c);
         let shown_mean = quarters.iter().map(|q| q.iter().map(|&uv| shown.radiosity(t, uv)[0]).sum::<f64>() / 3.0).sum::<f64>() / 4.0;
-        worst_mean = worst_mean.max((shown_mean - mean(w)).abs());
+        worst_mean = worst_mean.max((shown_mean - falloff_mean(w)).abs());
     }
     assert!(worst_mean < 0.01, "a leaf's shown mean is off its own by {worst_mean}");
 }
@@ -580,20 +600,20 @@ fn leaf_gradients_show_a_falloff_closer() {
 /// A dark strip along one border (a contact shadow) beside uniform light,
 /// as `mean_passes_never_make_radiosity_negative` has it, each leaf shown
 /// on its gradient: the leaves beside the step would take its slope, the
-/// dark ones' children going below 0 and the bright ones' past 1. Kept in
-/// X of its width and
-/// over 0, nothing is shown below 0, nothing over 1.28 at the default
+/// dark ones' children going below 0 and the bright ones' past 1. Kept
+/// within the range of the leaf's and its neighbours' values widened by a
+/// quarter of its width ([`crate::gouraud::SHOWN_RANGE`]) and not below 0, nothing is
+/// shown below 0, nothing over 1.28 at the default
 /// passes (at the shown leaves' centroids; 1.29 after 8 passes, 1.32 with
 /// no bound on the range), and the bright leaves away from the step show
 /// 1.
 #[test]
 fn leaf_gradients_stay_near_their_neighbours_beside_a_step() {
-    let shadow = |w: [DVec3; 3]| if w.iter().all(|p| p.y <= 0.125 + 1e-9) { 0.0 } else { 1.0 };
-    let g = square_shown(3, shown_by_default(), &shadow);
-    let shown: Vec<f64> = square_leaves(3).iter().flat_map(|(t, c, _)| children(c).map(|q| g.radiosity(*t, [0, 1].map(|k| (q[0][k] + q[1][k] + q[2][k]) / 3.0))[0])).collect();
+    let g = square_shown(3, shown_by_default(), &dark_strip);
+    let shown: Vec<f64> = square_leaves(3).iter().flat_map(|(t, c, _)| children(c).map(|q| g.radiosity(*t, uv_centroid(&q))[0])).collect();
     let (lowest, highest) = shown.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &b| (lo.min(b), hi.max(b)));
     assert!(lowest == 0.0 && highest < 1.3, "shown from {lowest} to {highest}");
-    let far = square_leaves(3).into_iter().filter(|(_, _, w)| w.iter().all(|p| p.y >= 0.5)).map(|(t, c, _)| g.radiosity(t, [0, 1].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0))[0]);
+    let far = square_leaves(3).into_iter().filter(|(_, _, w)| w.iter().all(|p| p.y >= 0.5)).map(|(t, c, _)| g.radiosity(t, uv_centroid(&c))[0]);
     for b in far {
         assert!((b - 1.0).abs() < 1e-9, "a bright leaf away from the step shows {b}");
     }
