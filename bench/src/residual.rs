@@ -362,7 +362,7 @@ mod tests {
         let manifest = manifest(2, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [10.0; 3])]);
         let elements = vec![Element::root(0, 0.5, [0.0; 3]), Element::root(1, 0.5, [10.0; 3])];
         let link = Link { receiver: Node::Element(0), sender: Node::Element(1), form_factor: f as f32, visibility: v, unoccluded_irradiance: [(10.0 * f) as f32; 3], occluder_distance: f32::INFINITY };
-        let solution = Solution { header: Solution::header(Provenance::in_memory("bench-residual test")), elements, clusters: Vec::new(), links: vec![link] };
+        let solution = Solution { header: Solution::header(Provenance::in_memory("bench-residual test")), elements, clusters: Vec::new(), links: vec![link], slopes: Vec::new() };
         (mesh, manifest, solution)
     }
 

@@ -292,7 +292,7 @@ impl<'a> Surfaces<'a> {
                 p.area += area;
             }
         }
-        Ok(Solution { header, elements, clusters: Vec::new(), links: Vec::new() })
+        Ok(Solution { header, elements, clusters: Vec::new(), links: Vec::new(), slopes: Vec::new() })
     }
 
     /// The surface input triangle `triangle` belongs to.
@@ -473,7 +473,7 @@ mod tests {
             area: if k == 0 { 0.0 } else { 0.125 },
             radiosity: [b[k]; 3],
         }));
-        Solution { header: Solution::header(Provenance::in_memory("bench-surfaces test")), elements, clusters: Vec::new(), links: Vec::new() }
+        Solution { header: Solution::header(Provenance::in_memory("bench-surfaces test")), elements, clusters: Vec::new(), links: Vec::new(), slopes: Vec::new() }
     }
 
     /// A triangle's pieces and a quadrilateral's (two triangles) cover it

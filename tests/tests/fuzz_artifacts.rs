@@ -140,7 +140,7 @@ fn fuzz_clusters_tables() {
 #[test]
 fn fuzz_solution_tables() {
     let solution = solution(&closed_box().0);
-    fuzz_tables::<Solution>("solution.exr", &["element", "cluster", "link"], |p| solution.write(p), |path| {
+    fuzz_tables::<Solution>("solution.exr", &["element", "cluster", "link", "slope"], |p| solution.write(p), |path| {
         let _ = Solution::read(path);
     });
 }

@@ -197,7 +197,7 @@ mod tests {
         for corners in [[[0.0, 0.0], [0.5, 0.0], [0.0, 0.5]], [[0.5, 0.0], [1.0, 0.0], [0.5, 0.5]], [[0.0, 0.5], [0.5, 0.5], [0.0, 1.0]], [[0.5, 0.5], [0.0, 0.5], [0.5, 0.0]]] {
             elements.push(Element { triangle: 0, parent: 0, first_child: NONE, level: 1, corners, area: 0.125, radiosity: [0.0; 3] });
         }
-        let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements, clusters: Vec::new(), links: Vec::new() };
+        let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements, clusters: Vec::new(), links: Vec::new(), slopes: Vec::new() };
         let groups = [SurfaceGroup { name: "square".into(), objects: vec![0] }, SurfaceGroup { name: "both".into(), objects: vec![0, 1] }];
         // Square: 4 leaves of triangle 0 and triangle 1's root; corners: the
         // square's 4 and triangle 0's 3 edge midpoints (triangle 1 shares

@@ -89,7 +89,7 @@ pub fn solution(mesh: &Mesh, radiosity: &[[f64; 3]], provenance: Provenance) -> 
         .enumerate()
         .map(|(i, (t, b))| Element::root(i as u32, t.area, b.map(|x| x as f32)))
         .collect();
-    Solution { header: Solution::header(provenance), elements, clusters: Vec::new(), links: Vec::new() }
+    Solution { header: Solution::header(provenance), elements, clusters: Vec::new(), links: Vec::new(), slopes: Vec::new() }
 }
 
 /// Every edge is shared by exactly two triangles that run along it in

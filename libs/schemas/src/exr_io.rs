@@ -261,10 +261,13 @@ pub struct ExrArtifact {
 impl ExrArtifact {
     /// The layer called `name`; `path` names the file in the error.
     pub fn layer(&self, path: &Path, name: &str) -> Result<&Layer> {
-        self.layers
-            .iter()
-            .find(|l| l.name == name)
-            .ok_or_else(|| Error::invalid(path, None, format!("no layer '{name}' in this {}", self.header.schema)))
+        self.optional_layer(name).ok_or_else(|| Error::invalid(path, None, format!("no layer '{name}' in this {}", self.header.schema)))
+    }
+
+    /// The layer called `name`, or `None` where the file has none: for a
+    /// layer that older files of the same schema version lack.
+    pub fn optional_layer(&self, name: &str) -> Option<&Layer> {
+        self.layers.iter().find(|l| l.name == name)
     }
 }
 

@@ -132,7 +132,7 @@ mod tests {
         };
         let mut elements = vec![element(0, NONE, NONE, 0, ROOT), element(1, NONE, 2, 0, ROOT)];
         elements.extend(split(&ROOT).map(|c| element(1, 1, NONE, 1, c)));
-        Solution { header: Solution::header(Provenance::in_memory("test")), elements, clusters: vec![], links: vec![] }
+        Solution { header: Solution::header(Provenance::in_memory("test")), elements, clusters: vec![], links: vec![], slopes: vec![] }
     }
 
     #[test]

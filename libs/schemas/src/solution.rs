@@ -2,7 +2,10 @@
 //! `hierarchical-solve`: the element hierarchy with radiosity per element,
 //! the radiosity of every cluster (when solved with the cluster hierarchy
 //! of `clusters.exr`), and every link of every level, between elements or
-//! clusters (the final gather reads them).
+//! clusters (the final gather reads them), and the slope of the radiosity
+//! across the leaves where the solve measured one. Other solvers
+//! (`gpu-shoot`, `photon-trace`) write the same schema with no clusters,
+//! links or slopes.
 
 use crate::error::{Error, Result};
 use crate::exr_io::{check_finite, check_forest, read_exr, write_exr, Channel, ExrArtifact, Layer};
@@ -118,7 +121,29 @@ pub struct Link {
     pub occluder_distance: f32,
 }
 
-/// The solution: element hierarchy and links.
+/// The slope of a leaf's radiosity along its surface, where the solve
+/// measured one (hierarchical-solve: the direct light of emitters across a
+/// leaf in a penumbra). Readers draw the leaf as a plane through its mean
+/// with this gradient (blended as they document).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeafSlope {
+    /// The leaf element it belongs to.
+    pub element: u32,
+    /// Gradient of the radiosity along the surface, W/m² per m, world
+    /// space: `gradient[c]` is channel c's (R, G, B) gradient vector (x, y, z).
+    pub gradient: [[f32; 3]; 3],
+}
+
+/// Names of the `slope` layer's gradient channels: `[c][axis]` is channel
+/// c's (R, G, B) derivative along axis x, y, z.
+const SLOPE_CHANNELS: [[&str; 3]; 3] = [
+    ["dB.R/dx", "dB.R/dy", "dB.R/dz"],
+    ["dB.G/dx", "dB.G/dy", "dB.G/dz"],
+    ["dB.B/dx", "dB.B/dy", "dB.B/dz"],
+];
+
+/// The solution: element hierarchy, cluster radiosities, links and leaf
+/// slopes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Solution {
     /// Header with provenance.
@@ -130,6 +155,10 @@ pub struct Solution {
     pub clusters: Vec<ClusterRadiosity>,
     /// Links, sorted by receiver then sender.
     pub links: Vec<Link>,
+    /// Per-leaf slopes, ascending by element, at most one per leaf; empty
+    /// where the producer measured none (every producer but
+    /// hierarchical-solve).
+    pub slopes: Vec<LeafSlope>,
 }
 
 impl Schema for Solution {
@@ -142,7 +171,8 @@ fn column<T: Copy, U>(rows: &[T], f: impl Fn(&T) -> U) -> Vec<U> {
 }
 
 impl Solution {
-    /// Writes `solution.exr`: layers `element` and `link`.
+    /// Writes `solution.exr`: layers `element`, `cluster`, `link` and
+    /// `slope` (tables; `cluster`, `link` and `slope` may hold no record).
     pub fn write(&self, path: &Path) -> Result<()> {
         let e = &self.elements;
         let corner = |k: usize, axis: usize| column(e, move |x: &Element| x.corners[k][axis]);
@@ -194,12 +224,23 @@ impl Solution {
                 Channel::f32("B.B", "area-weighted mean radiosity, W/m^2", column(c, |x| x.radiosity[2])),
             ],
         );
-        write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![element, cluster, link] })
+        let sl = &self.slopes;
+        let mut slope_channels = vec![Channel::u32("element", "leaf element index", column(sl, |x| x.element))];
+        for (c, (names, colour)) in SLOPE_CHANNELS.iter().zip(["R", "G", "B"]).enumerate() {
+            for (axis, (name, along)) in names.iter().zip(["x", "y", "z"]).enumerate() {
+                let meaning = format!("d(radiosity {colour})/d{along} along the surface, W/m^2 per m");
+                slope_channels.push(Channel::f32(name, &meaning, column(sl, |x| x.gradient[c][axis])));
+            }
+        }
+        let slope = Layer::table("slope", sl.len(), slope_channels);
+        write_exr(path, &ExrArtifact { header: self.header.clone(), layers: vec![element, cluster, link, slope] })
     }
 
     /// Reads `solution.exr` and checks its structure (see
-    /// [`Solution::check_elements`] and [`Solution::check_link`]), so that a
-    /// stage may walk and index it without further checks.
+    /// [`Solution::check_elements`], [`Solution::check_link`] and
+    /// [`Solution::check_slope`]), so that a stage may walk and index it
+    /// without further checks. A file with no `slope` layer (written before
+    /// there was one) reads with no slopes.
     pub fn read(path: &Path) -> Result<(Solution, Input)> {
         let (artifact, input) = read_exr::<Solution>(path)?;
         let el = artifact.layer(path, "element")?;
@@ -247,7 +288,29 @@ impl Solution {
             Solution::check_link(path, i, &link, n, clusters.len())?;
             links.push(link);
         }
-        Ok((Solution { header: artifact.header, elements, clusters, links }, input))
+        let slopes = match artifact.optional_layer("slope") {
+            Some(layer) => Solution::read_slopes(path, layer, &elements)?,
+            None => Vec::new(),
+        };
+        Ok((Solution { header: artifact.header, elements, clusters, links, slopes }, input))
+    }
+
+    /// The rows of the `slope` layer, each checked (finite gradients, then
+    /// [`Solution::check_slope`]) against `elements`.
+    fn read_slopes(path: &Path, layer: &Layer, elements: &[Element]) -> Result<Vec<LeafSlope>> {
+        check_finite(path, layer, "slope", SLOPE_CHANNELS.as_flattened())?;
+        let element = layer.u32s(path, "element")?;
+        let mut g = Vec::with_capacity(9);
+        for name in SLOPE_CHANNELS.as_flattened() {
+            g.push(layer.f32s(path, name)?);
+        }
+        let mut slopes: Vec<LeafSlope> = Vec::with_capacity(layer.len());
+        for i in 0..layer.len() {
+            let slope = LeafSlope { element: element[i], gradient: std::array::from_fn(|c| std::array::from_fn(|axis| g[3 * c + axis][i])) };
+            Solution::check_slope(path, i, &slope, slopes.last(), elements)?;
+            slopes.push(slope);
+        }
+        Ok(slopes)
     }
 
     /// The invariants of the element table, checked on read; a file that
@@ -306,6 +369,29 @@ impl Solution {
             false => Ok(()),
         }
     }
+
+    /// The invariants of slope row `i`, checked on read: it names an
+    /// element of `elements` that is a leaf, and a later one than the row
+    /// before (`previous`), so rows ascend by element, at most one per
+    /// leaf (the gradients are checked finite with their channels).
+    fn check_slope(path: &Path, i: usize, slope: &LeafSlope, previous: Option<&LeafSlope>, elements: &[Element]) -> Result<()> {
+        let invalid = |message: String| Err(Error::invalid(path, None, message));
+        let e = slope.element;
+        let Some(element) = elements.get(e as usize) else {
+            return invalid(format!("slope {i}: field element names element {e}, but the solution has {}", elements.len()));
+        };
+        if !element.is_leaf() {
+            return invalid(format!("slope {i}: field element names element {e}, which is not a leaf (its first_child is {})", element.first_child));
+        }
+        match previous {
+            Some(p) if p.element >= e => invalid(format!(
+                "slope {i}: field element is {e}, but slope {} names element {} (rows must ascend by element, one per leaf)",
+                i - 1,
+                p.element
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -317,7 +403,8 @@ mod tests {
         Element { triangle, parent, first_child, level, corners: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], area: 0.5, radiosity: [1.0; 3] }
     }
 
-    /// Two input triangles; the second split into elements 2..6.
+    /// Two input triangles; the second split into elements 2..6; slopes on
+    /// leaves 0 and 3.
     fn solution() -> Solution {
         let mut elements = vec![element(0, NONE, NONE, 0), element(1, NONE, 2, 0)];
         elements.extend((0..4).map(|_| element(1, 1, NONE, 1)));
@@ -334,6 +421,10 @@ mod tests {
             elements,
             clusters: vec![ClusterRadiosity { area: 1.0, radiosity: [2.0; 3] }],
             links: vec![link],
+            slopes: vec![
+                LeafSlope { element: 0, gradient: [[0.5, -0.25, 0.0], [1e-7, 3.0e5, -0.0], [-2.5, 0.125, 7.0]] },
+                LeafSlope { element: 3, gradient: [[-1.0, 0.0, 2.0], [0.0, 0.0, 0.0], [1.5, -1.5, 1.0 / 3.0]] },
+            ],
         }
     }
 
@@ -353,6 +444,28 @@ mod tests {
     #[test]
     fn a_valid_solution_round_trips() {
         assert_eq!(round_trip("valid", &solution()).unwrap(), solution());
+    }
+
+    #[test]
+    fn slopes_round_trip_exactly_and_an_empty_slope_table_reads_empty() {
+        let solution = solution();
+        assert_eq!(solution.slopes.len(), 2);
+        assert_eq!(round_trip("slopes", &solution).unwrap().slopes, solution.slopes);
+        let none = Solution { slopes: Vec::new(), ..solution };
+        assert_eq!(round_trip("no-slopes", &none).unwrap(), none);
+    }
+
+    #[test]
+    fn a_file_without_a_slope_layer_reads_with_no_slopes() {
+        let path = std::env::temp_dir().join(format!("solution-old-{}.exr", std::process::id()));
+        solution().write(&path).unwrap();
+        let (mut artifact, _) = read_exr::<Solution>(&path).unwrap();
+        artifact.layers.retain(|l| l.name != "slope");
+        assert_eq!(artifact.layers.len(), 3);
+        write_exr(&path, &artifact).unwrap();
+        let back = Solution::read(&path).map(|(s, _)| s);
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(back.unwrap(), Solution { slopes: Vec::new(), ..solution() });
     }
 
     /// Asserts that `solution` after `edit` is refused with a message
@@ -383,5 +496,26 @@ mod tests {
         let element = "link 0: field receiver names element 6, but the solution has 6";
         assert_refused("element", |s| s.links[0].receiver = Node::Element(6), element);
         assert_refused("cluster", |s| s.links[0].sender = Node::Cluster(1), "link 0: field sender names cluster 1, but the solution has 1");
+    }
+
+    #[test]
+    fn a_slope_on_a_missing_or_inner_element_is_refused() {
+        assert_refused("slope-past", |s| s.slopes[1].element = 6, "slope 1: field element names element 6, but the solution has 6");
+        let inner = "slope 1: field element names element 1, which is not a leaf (its first_child is 2)";
+        assert_refused("slope-inner", |s| s.slopes[1].element = 1, inner);
+    }
+
+    #[test]
+    fn slopes_out_of_order_or_twice_for_one_leaf_are_refused() {
+        let twice = "slope 1: field element is 0, but slope 0 names element 0 (rows must ascend by element, one per leaf)";
+        assert_refused("slope-twice", |s| s.slopes[1].element = 0, twice);
+        let descending = "slope 1: field element is 3, but slope 0 names element 4 (rows must ascend by element, one per leaf)";
+        assert_refused("slope-descending", |s| s.slopes[0].element = 4, descending);
+    }
+
+    #[test]
+    fn a_non_finite_slope_is_refused() {
+        assert_refused("slope-nan", |s| s.slopes[1].gradient[2][1] = f32::NAN, "slope 1: field dB.B/dy is NaN");
+        assert_refused("slope-inf", |s| s.slopes[0].gradient[0][2] = f32::NEG_INFINITY, "slope 0: field dB.R/dz is -inf");
     }
 }

@@ -8,7 +8,7 @@ use schemas::header::{Provenance, Schema};
 use schemas::image::{HdrImage, PixelSurfaces, EMITTER, NO_SURFACE, SINGLE_SURFACE};
 use schemas::lightmap::{Lightmap, Region};
 use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
-use schemas::solution::{ClusterRadiosity, Element, Link, Node, Solution, NONE};
+use schemas::solution::{ClusterRadiosity, Element, LeafSlope, Link, Node, Solution, NONE};
 use schemas::surface::{self, Surface, Texture, TextureKind};
 
 /// The provenance of every artifact here: one in-memory "run", so that a
@@ -82,7 +82,8 @@ pub fn clusters_over(mesh: &Mesh) -> Clusters {
 }
 
 /// A solution over `mesh`: one element per triangle, triangle 0 split
-/// into four, a link from every root to the next and one from a cluster.
+/// into four, a link from every root to the next and one from a cluster,
+/// and a slope on leaf 1 and on the last child of triangle 0.
 pub fn solution(mesh: &Mesh) -> Solution {
     let element = |triangle: u32, parent: u32, level: u32| Element {
         triangle,
@@ -108,7 +109,11 @@ pub fn solution(mesh: &Mesh) -> Solution {
     let mut links: Vec<Link> = (0..roots).map(|t| link(Node::Element(t), Node::Element((t + 1) % roots))).collect();
     links.push(link(Node::Element(roots), Node::Cluster(0)));
     let clusters = vec![ClusterRadiosity { area: 6.0, radiosity: [0.5; 3] }];
-    Solution { header: Solution::header(provenance()), elements, clusters, links }
+    let slopes = vec![
+        LeafSlope { element: 1, gradient: [[0.5, -0.25, 0.0], [0.125, 0.0, -1.0], [0.0, 2.0, 0.75]] },
+        LeafSlope { element: roots + 3, gradient: [[-0.5, 0.0, 0.25]; 3] },
+    ];
+    Solution { header: Solution::header(provenance()), elements, clusters, links, slopes }
 }
 
 /// A lightmap of `mesh`: a region of 2 x 2 interior texels per triangle,

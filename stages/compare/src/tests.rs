@@ -255,12 +255,12 @@ fn hierarchical() -> Solution {
         element(0, 5, NONE, 2, 0.375, [8.0, 1.0, 4.0]),
         element(0, 5, NONE, 2, 0.375, [12.0, 1.0, 12.0]),
     ];
-    Solution { header: Solution::header(provenance()), elements, clusters: vec![], links: vec![] }
+    Solution { header: Solution::header(provenance()), elements, clusters: vec![], links: vec![], slopes: vec![] }
 }
 
 fn flat(t0: [f32; 3], t1: [f32; 3]) -> Solution {
     let elements = vec![element(0, NONE, NONE, 0, 4.0, t0), element(1, NONE, NONE, 0, 2.0, t1)];
-    Solution { header: Solution::header(provenance()), elements, clusters: vec![], links: vec![] }
+    Solution { header: Solution::header(provenance()), elements, clusters: vec![], links: vec![], slopes: vec![] }
 }
 
 #[test]

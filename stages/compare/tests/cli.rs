@@ -27,7 +27,7 @@ fn write_image(path: &Path, width: usize, rgb: Vec<[f32; 3]>) {
 
 fn write_solution(path: &Path, radiosity: [f32; 3]) {
     let e = Element::root(0, 0.5, radiosity);
-    Solution { header: Solution::header(provenance()), elements: vec![e], clusters: vec![], links: vec![] }.write(path).unwrap();
+    Solution { header: Solution::header(provenance()), elements: vec![e], clusters: vec![], links: vec![], slopes: vec![] }.write(path).unwrap();
 }
 
 fn compare(args: &[&Path], flags: &[&str]) -> Output {

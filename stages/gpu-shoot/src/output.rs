@@ -398,5 +398,5 @@ pub fn solution(lm: &Lightmap, mesh: &Mesh, manifest: &Manifest, tiles: &[Tile],
         elements[e].radiosity = sum.map(|s| if area > 0.0 { (s / area) as f32 } else { 0.0 });
         elements[e].area = area as f32;
     }
-    Solution { header, elements, clusters: Vec::new(), links: Vec::new() }
+    Solution { header, elements, clusters: Vec::new(), links: Vec::new(), slopes: Vec::new() }
 }

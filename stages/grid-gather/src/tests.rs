@@ -78,7 +78,7 @@ fn solution(triangle_count: usize, depth: u32, b: impl Fn(u32, &Corners) -> f32)
         }
         frontier = next;
     }
-    Solution { header: Solution::header(provenance()), elements, clusters: vec![], links: vec![] }
+    Solution { header: Solution::header(provenance()), elements, clusters: vec![], links: vec![], slopes: vec![] }
 }
 
 /// The unit square in z = 0 facing +z, split along its diagonal (0,0)-(1,1):

@@ -43,7 +43,7 @@ fn write_scene(dir: &Path, roots: u32) {
     };
     write_ron(&dir.join("manifest.ron"), &manifest).unwrap();
     let root = |t: u32| Element::root(t, 0.5, [1.0 + 2.0 * t as f32; 3]);
-    let solution = Solution { header: Solution::header(provenance()), elements: (0..roots).map(root).collect(), clusters: vec![], links: vec![] };
+    let solution = Solution { header: Solution::header(provenance()), elements: (0..roots).map(root).collect(), clusters: vec![], links: vec![], slopes: vec![] };
     solution.write(&dir.join("solution.exr")).unwrap();
 }
 

@@ -71,7 +71,7 @@ impl stage_kit::stage::Stage for Args {
         let solved = solve(&mesh, &manifest, params, &mut observer).map_err(|message| schemas::Error::invalid(manifest_path, None, message))?;
         bar.finish_and_clear();
         let done = summarise(&solved.work, params, skipped, snapshots);
-        let solution = Solution { header, elements: solved.elements, clusters: Vec::new(), links: Vec::new() };
+        let solution = Solution { header, elements: solved.elements, clusters: Vec::new(), links: Vec::new(), slopes: Vec::new() };
         outputs.write(required(&self.output, "-o")?, |p| solution.write(p))?;
         Ok(done)
     }

@@ -45,7 +45,7 @@ impl SnapshotDir {
             Stage::Stochastic if snapshot.photons >= preview_photons => "stochastic.exr".to_string(),
             stage => format!("{stage}-{:012}.exr", snapshot.photons),
         };
-        let solution = Solution { header: header.clone(), elements: snapshot.elements.clone(), clusters: Vec::new(), links: Vec::new() };
+        let solution = Solution { header: header.clone(), elements: snapshot.elements.clone(), clusters: Vec::new(), links: Vec::new(), slopes: Vec::new() };
         let mut outputs = Outputs::new();
         outputs.write(&self.dir.join(&name), |p| solution.write(p)).and_then(|()| outputs.keep()).map_err(|e| e.to_string())?;
         let error = if snapshot.max_error.is_finite() { format!(", largest vertex error {:.3e}", snapshot.max_error) } else { String::new() };

@@ -71,6 +71,7 @@ fn room() -> Room {
         elements: vec![element(0, 0.1), element(1, 0.1), element(2, 20.0), element(3, 20.0)],
         clusters: vec![],
         links: vec![link(0, 2), link(0, 3), link(1, 2), link(1, 3)],
+        slopes: vec![],
     };
     Room { mesh, manifest, solution }
 }
