@@ -49,7 +49,7 @@ fn clustered_box(triangles: usize, eps: f64) -> (Mesh, Manifest, Solution, schem
     let clusters = schemas::cluster::Clusters { header: schemas::cluster::Clusters::header(Provenance::in_memory("test")), nodes: h.nodes, order: h.order };
     let params = hierarchical_solve::Params { eps, share_floor: 1.0, ..hierarchical_solve::Params::default() };
     let solved = hierarchical_solve::solve(&mesh, &manifest, Some(clusters.clone()), &params, &|_| {}).expect("solve");
-    let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: Vec::new() };
+    let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: solved.slopes };
     (mesh, manifest, solution, clusters)
 }
 
@@ -148,7 +148,7 @@ fn straddled() -> Room {
         statistics: MeshStatistics::default(),
     };
     let solved = hierarchical_solve::solve(&mesh, &manifest, None, &hierarchical_solve::Params::default(), &|_| {}).expect("solve");
-    let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: Vec::new() };
+    let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: solved.slopes };
     Room { mesh, manifest, solution }
 }
 
@@ -223,7 +223,7 @@ fn a_clustered_solution_needs_its_hierarchy_and_full_mode_writes_diagnostics() {
     let clusters = schemas::cluster::Clusters { header: schemas::cluster::Clusters::header(Provenance::in_memory("test")), nodes: h.nodes, order: h.order };
     let params = hierarchical_solve::Params { eps: 1e-2, ..hierarchical_solve::Params::default() };
     let solved = hierarchical_solve::solve(&mesh, &manifest, Some(clusters.clone()), &params, &|_| {}).unwrap();
-    let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: Vec::new() };
+    let solution = Solution { header: Solution::header(Provenance::in_memory("test")), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: solved.slopes };
     mesh.write(&dir.join("mesh.exr")).unwrap();
     write_ron(&dir.join("manifest.ron"), &manifest).unwrap();
     solution.write(&dir.join("solution.exr")).unwrap();

@@ -573,7 +573,7 @@ impl SenderTerms {
                 _ if !partly_occluded => (factor, 1.0),
                 Some(v) if v == 0.0 || v == 1.0 => (factor * v, v),
                 _ => {
-                    let (seen, cast) = visibility::visible_factor(h, tracer, r, e, factor, if parent.is_some() { CHILD_PART_RAYS } else { SENDER_PART_RAYS });
+                    let (seen, cast) = visibility::visible_factor(h, tracer, r, e, factor, if parent.is_some() { CHILD_PART_RAYS } else { SENDER_PART_RAYS }, None);
                     rays += cast;
                     (seen, if factor > 0.0 { seen / factor } else { 1.0 })
                 }

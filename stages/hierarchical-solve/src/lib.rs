@@ -61,6 +61,7 @@ pub mod report;
 pub mod rows;
 pub mod shadowed;
 pub mod shaft;
+pub mod slopes;
 #[cfg(test)]
 mod test_scenes;
 pub mod transfer;
@@ -286,6 +287,9 @@ pub struct Solved {
     pub clusters: Vec<solution::ClusterRadiosity>,
     /// Links, sorted by receiver then sender.
     pub links: Vec<solution::Link>,
+    /// Emitters' direct-light slopes inside the leaves of penumbrae
+    /// ([`slopes`]).
+    pub slopes: Vec<solution::LeafSlope>,
     /// Work done.
     pub work: Work,
 }
@@ -377,6 +381,9 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let mut senders = gather::SenderTerms::new(&h, &[], gather::Senders::Means);
     // The weights of the links into clusters, kept from pass to pass (receivers).
     let mut receiver_weights = receivers::WeightCache::default();
+    // The last solve's measured slopes of emitters' light inside leaves
+    // (slopes); none where it did not run.
+    let mut direct_slopes = Vec::new();
     for pass in 1..=passes {
         let started = Instant::now();
         let mut refined_any = false;
@@ -507,6 +514,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
                 let resolution = gather::Resolution::new(&b, &deviation, convergence.rates);
                 senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { resolution, tracer });
                 receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Last { tracer, resolution: Some(resolution) }, &mut receiver_weights);
+                direct_slopes = std::mem::take(&mut receivers.slopes);
                 work.part_rays += (senders.rays() + receivers.rays) as u64;
                 work.resolved_links = senders.resolved();
                 let means = convergence;
@@ -542,7 +550,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     let clusters_out = (0..h.cluster_count())
         .map(|c| solution::ClusterRadiosity { area: h.area(Node::Cluster(c as u32)) as f32, radiosity: f32x3(b[c]) })
         .collect();
-    Ok(Solved { elements: output_elements(&h, &b), clusters: clusters_out, links: output_links(&all_links, &senders.sent(&b)), work })
+    let slopes = slopes::leaf_slopes(&h, &b, &direct_slopes);
+    Ok(Solved { elements: output_elements(&h, &b), clusters: clusters_out, links: output_links(&all_links, &senders.sent(&b)), slopes, work })
 }
 
 /// What a refinement may err by, given the absolute `threshold` and, once

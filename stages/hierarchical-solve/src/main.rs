@@ -65,7 +65,7 @@ impl Stage for Args {
         eprintln!("hierarchical-solve: {} passes, {} links, {} elements ({} leaves), {} rays, {} iterations", w.passes, w.links, w.elements, w.leaves, w.rays, w.iterations);
         let done = report::done(w, params, &mesh, &manifest, with_surface, clustered);
         done.notes.iter().for_each(|note| eprintln!("hierarchical-solve: warning: {note}"));
-        let solution = Solution { header: Solution::header(run.provenance(params)), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: Vec::new() };
+        let solution = Solution { header: Solution::header(run.provenance(params)), elements: solved.elements, clusters: solved.clusters, links: solved.links, slopes: solved.slopes };
         outputs.write(required(&self.output, "-o")?, |p| solution.write(p))?;
         Ok(done)
     }

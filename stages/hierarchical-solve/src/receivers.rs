@@ -159,6 +159,7 @@ use crate::elements::Hierarchy;
 use crate::links::{box_distance, Link};
 use crate::nodes::key;
 use crate::rows::Rows;
+use crate::slopes::{self, DirectSlope, VisibilitySlope};
 use crate::gather::{Resolution, SenderTerms};
 use crate::visibility::{self, Tracer};
 use radiometry::form_factor::{point_kernel, DUNAVANT_5};
@@ -234,6 +235,9 @@ pub struct ReceiverTerms {
     element_rows: Rows<f64>,
     /// What lights the parts, in the order of `k`.
     pub part_sources: Vec<PartSource>,
+    /// Emitters' visibility slopes on the leaves their partly occluded
+    /// links' parts traced ([`crate::slopes`]).
+    pub slopes: Vec<DirectSlope>,
 }
 
 /// What lights the parts of an inner element by weight
@@ -286,22 +290,22 @@ impl ReceiverTerms {
     pub fn new(h: &Hierarchy, links: &mut [Link], build: Build, cache: &mut WeightCache) -> Self {
         let to_parts: Vec<bool> = links.iter().map(|l| build.sends_to_parts(h, l)).collect();
         let tracer = build.tracer();
-        let part_built: Vec<Option<(PartWeights, usize, Option<f64>)>> =
+        let part_built: Vec<Option<Weighing>> =
             links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l.receiver, l.sender, tracer.filter(|_| l.partly_occluded())))).collect();
         let mut seen: Vec<Option<PartViews>> = links
             .par_iter()
             .zip(&part_built)
-            .map(|(l, built)| near_sender_terms(h, l, &built.as_ref()?.0, build.resolution()?, tracer?))
+            .map(|(l, built)| near_sender_terms(h, l, &built.as_ref()?.shares, build.resolution()?, tracer?))
             .collect();
         let mut by_element: Vec<Vec<(usize, f64)>> = vec![Vec::new(); h.elements.len()];
         let mut part_sources = Vec::new();
-        for (l, (list, _, measured)) in part_built.iter().enumerate().filter_map(|(l, b)| Some((l, b.as_ref()?))) {
-            if let Some(v) = measured {
-                links[l].visibility = Some(*v as f32);
+        for (l, weighing) in part_built.iter().enumerate().filter_map(|(l, b)| Some((l, b.as_ref()?))) {
+            if let Some(v) = weighing.measured {
+                links[l].visibility = Some(v as f32);
             }
             if let Some(seen) = seen[l].take() {
                 // One source per part, shared by the elements below it.
-                for (shares, terms) in by_part(list).zip(seen) {
+                for (shares, terms) in by_part(&weighing.shares).zip(seen) {
                     for &(e, w, _) in shares {
                         by_element[e as usize].push((part_sources.len(), w));
                     }
@@ -309,7 +313,7 @@ impl ReceiverTerms {
                 }
                 continue;
             }
-            for &(e, w, _) in list {
+            for &(e, w, _) in &weighing.shares {
                 by_element[e as usize].push((part_sources.len(), w));
             }
             part_sources.push(PartSource::Link(l));
@@ -341,7 +345,7 @@ impl ReceiverTerms {
             .collect();
         // In the last solve a distributed link's light on a triangle with
         // children goes on to the triangle's parts, as a link into it would.
-        let triangle_parts: Vec<Vec<(u32, PartWeights, usize)>> = links
+        let triangle_parts: Vec<Vec<(u32, Weighing)>> = links
             .par_iter()
             .zip(&built)
             .map(|(l, b)| match (b, visibility) {
@@ -350,27 +354,25 @@ impl ReceiverTerms {
                     triangles.dedup();
                     triangles
                         .into_iter()
-                        .map(|t| {
-                            let (w, rays, _) = part_weights(h, Node::Element(t), l.sender, visibility.filter(|_| l.partly_occluded()));
-                            (t, w, rays)
-                        })
+                        .map(|t| (t, part_weights(h, Node::Element(t), l.sender, visibility.filter(|_| l.partly_occluded()))))
                         .collect()
                 }
                 _ => Vec::new(),
             })
             .collect();
         let rays = built.iter().flatten().map(|b| b.3).sum::<usize>()
-            + part_built.iter().flatten().map(|b| b.1).sum::<usize>()
-            + triangle_parts.iter().flatten().map(|x| x.2).sum::<usize>();
+            + part_built.iter().flatten().map(|b| b.rays).sum::<usize>()
+            + triangle_parts.iter().flatten().map(|x| x.1.rays).sum::<usize>();
+        let slopes = part_built.iter().flatten().chain(triangle_parts.iter().flatten().map(|x| &x.1)).flat_map(|w| w.slopes.iter().copied()).collect();
         let mut lists: Vec<Vec<(usize, (usize, f64))>> = vec![Vec::new(); h.triangles.len()];
         for (l, (_, list, measured, _)) in built.iter().enumerate().filter_map(|(l, b)| Some((l, b.as_ref()?))) {
             let parted = &triangle_parts[l];
             for &(t, p, w) in list.iter().filter(|x| !parted.iter().any(|y| y.0 == x.0)) {
                 lists[t as usize].push((l, (p, w)));
             }
-            for (t, parts, _) in parted {
+            for (t, weighing) in parted {
                 let terms = list.iter().filter(|x| x.0 == *t).map(|&(_, p, w)| (p, w)).collect();
-                for &(e, u, _) in parts {
+                for &(e, u, _) in &weighing.shares {
                     by_element[e as usize].push((part_sources.len(), u));
                 }
                 part_sources.push(PartSource::Parts { link: l, terms });
@@ -383,7 +385,7 @@ impl ReceiverTerms {
             cache.0 = links.iter().zip(built).filter_map(|(l, b)| b.map(|(nodes, w, measured, _)| ((l.receiver, l.sender), (nodes, w, measured)))).collect();
         }
         let distributed = to_triangles.iter().zip(&to_parts).map(|(a, b)| *a || *b).collect();
-        ReceiverTerms { rays, rows: Rows::from_lists(lists), distributed, element_rows, part_sources }
+        ReceiverTerms { rays, rows: Rows::from_lists(lists), distributed, element_rows, part_sources, slopes }
     }
 
     /// Whether link `l`'s light goes to its receiver's triangles or parts by
@@ -521,7 +523,7 @@ fn near_sender_terms(h: &Hierarchy, l: &Link, parts: &PartWeights, resolution: R
 /// link's; and the rays cast.
 fn seen_factor(h: &Hierarchy, visibility: Option<Tracer>, receiver: u32, part: Node, f: f64, v_link: f64, pairs: usize) -> (f64, usize) {
     match (visibility, part) {
-        (Some(tracer), Node::Element(e)) => visibility::visible_factor(h, tracer, receiver, e, f, pairs),
+        (Some(tracer), Node::Element(e)) => visibility::visible_factor(h, tracer, receiver, e, f, pairs, None),
         (Some(_), Node::Cluster(_)) => (f * v_link, 0),
         (None, _) => (f, 0),
     }
@@ -565,16 +567,31 @@ type PartViews = Vec<Vec<(usize, f64)>>;
 /// 0.98% at 2.5e-4, for 6-7% more solve time (one thread; `plants-2k`
 /// 2%, its relative RMSE 2.96% -> 2.95%). 256 parts everywhere gave the
 /// same band for much more.
-fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<Tracer>) -> (PartWeights, usize, Option<f64>) {
-    let Node::Element(r) = receiver else { return (Vec::new(), 0, None) };
+fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<Tracer>) -> Weighing {
+    let Node::Element(r) = receiver else { return Weighing { shares: Vec::new(), rays: 0, measured: None, slopes: Vec::new() } };
     let visibility = visibility.map(|t| t.within(h, receiver, sender));
     let sending = Part::new(h, sender, key(receiver));
-    let mut rays = 0;
+    // An emitter's rays to a leaf right below the receiver measure the
+    // slope of its light there too (crate::slopes).
+    let emitter = visibility.zip(slopes::emitting(h, sender));
+    let (mut rays, mut slopes) = (0, Vec::new());
     let mut weigh = |j: u32| {
         let factor = sending.weight(h, j);
-        // A cluster sender: every part sees the same one, so the link's
-        // fraction would scale all weights alike; it is left out.
-        let (seen, cast) = seen_factor(h, visibility, j, sender, factor, 1.0, part_rays(h, r, j, visibility));
+        let pairs = part_rays(h, r, j, visibility);
+        let part = &h.elements[j as usize];
+        let (seen, cast) = match emitter.filter(|_| part.parent == r && part.is_leaf()) {
+            Some((tracer, s)) => {
+                let mut slope = VisibilitySlope::over(h, j);
+                let seen = visibility::visible_factor(h, tracer, j, s, factor, pairs, Some(&mut slope));
+                if let Some(g) = slope.gradient() {
+                    slopes.push(DirectSlope { leaf: j, sender, factor_slope: g * factor });
+                }
+                seen
+            }
+            // A cluster sender: every part sees the same one, so the link's
+            // fraction would scale all weights alike; it is left out.
+            None => seen_factor(h, visibility, j, sender, factor, 1.0, pairs),
+        };
         rays += cast;
         Weighed { element: j, area: h.area(Node::Element(j)), factor, seen }
     };
@@ -592,7 +609,20 @@ fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<
     for p in &parts {
         spread_below(h, &sending, p.element, if even { 1.0 } else { p.seen * area / seen }, &mut shares);
     }
-    (shares, rays, measured)
+    Weighing { shares, rays, measured, slopes }
+}
+
+/// What [`part_weights`] found for a link's receiver.
+struct Weighing {
+    /// The shares of its parts.
+    shares: PartWeights,
+    /// Rays cast.
+    rays: usize,
+    /// The link's visible fraction as the parts measured it.
+    measured: Option<f64>,
+    /// An emitter's visibility slopes on the leaves right below the
+    /// receiver ([`crate::slopes`]).
+    slopes: Vec<DirectSlope>,
 }
 
 /// Most elements below a part of a receiving element that share its light

@@ -44,6 +44,7 @@
 use crate::elements::Hierarchy;
 use crate::links::{Link, Linking};
 use crate::shaft::{Among, Occluders, MOST_AMONG};
+use crate::slopes::VisibilitySlope;
 use crate::transfer;
 use radiometry::form_factor::{point_kernel, WeightedVisibility};
 use radiometry::rays::SceneRays;
@@ -57,7 +58,7 @@ use schemas::solution::Node;
 pub fn of_link(h: &Hierarchy, scene: &SceneRays, link: &Link, rays: usize, linking: Linking) -> (f32, f32, usize) {
     match (link.receiver, link.sender) {
         (Node::Element(r), Node::Element(s)) => {
-            let e = estimate(h, scene, r, s, rays, linking.seed, Occluder::Nearest);
+            let e = estimate(h, scene, r, s, rays, linking.seed, Occluder::Nearest, None);
             (e.visibility, e.occluder_distance, e.rays)
         }
         (r, s) => {
@@ -95,12 +96,13 @@ pub const PART_VISIBILITY_RAYS: usize = 8;
 /// was traced), and the rays cast: how a partly
 /// occluded link weighs the parts of its sender
 /// ([`crate::gather::SenderTerms`]) and the faces of a receiving cluster
-/// ([`crate::receivers`]). A factor of 0 stays 0 and casts none.
-pub fn visible_factor(h: &Hierarchy, tracer: Tracer, receiver: u32, part: u32, factor: f64, rays: usize) -> (f64, usize) {
+/// ([`crate::receivers`]). A factor of 0 stays 0 and casts none. `slope`,
+/// if given, takes the rays too.
+pub fn visible_factor(h: &Hierarchy, tracer: Tracer, receiver: u32, part: u32, factor: f64, rays: usize, slope: Option<&mut VisibilitySlope>) -> (f64, usize) {
     if factor <= 0.0 {
         return (factor, 0);
     }
-    let v = estimate(h, tracer.scene, receiver, part, rays, tracer.seed, Occluder::Any(tracer.among));
+    let v = estimate(h, tracer.scene, receiver, part, rays, tracer.seed, Occluder::Any(tracer.among), slope);
     (factor * f64::from(v.visibility), v.rays)
 }
 
@@ -183,10 +185,12 @@ pub enum Occluder {
 
 /// Kernel-weighted visibility (module docs) and, if `occluder` asks for
 /// it, the nearest-occluder distance of the link `receiver <- sender`,
-/// from `rays` stratified pairs. The random stream is keyed by the two
+/// from `rays` stratified pairs; each ray of weight goes to `slope` too,
+/// if given ([`crate::slopes`]). The random stream is keyed by the two
 /// elements, so the estimate does not depend on the order links are
 /// processed in.
-pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, rays: usize, seed: u64, occluder: Occluder) -> Visibility {
+#[allow(clippy::too_many_arguments)]
+pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, rays: usize, seed: u64, occluder: Occluder, mut slope: Option<&mut VisibilitySlope>) -> Visibility {
     let (r, s) = (&h.elements[receiver as usize], &h.elements[sender as usize]);
     let (nr, ns) = (h.normal(receiver), h.normal(sender));
     let skip = [r.triangle, s.triangle];
@@ -217,6 +221,9 @@ pub fn estimate(h: &Hierarchy, scene: &SceneRays, receiver: u32, sender: u32, ra
             }
         };
         visible.add(g, blocker.is_none());
+        if let Some(slope) = slope.as_deref_mut() {
+            slope.add(from, g, blocker.is_none());
+        }
         if let Some(distance) = blocker {
             nearest = nearest.min(distance);
         }
