@@ -124,7 +124,7 @@ pub fn render(params: &Params, scene: &Scene, extras: Extras, frame: &Frame, sha
         Some(detail) => Some(Gouraud::of(triangles, materials, scene.solution, scene.solution_path, smoothing, &|corners, e| {
             let m = &scene.manifest.materials[scene.mesh.triangles[e.triangle as usize].material as usize];
             detail.irradiance(e.triangle, corners, e.radiosity.map(f64::from), m.emission, m.diffuse)
-        })?),
+        }, &[])?),
         None => None,
     };
     let textured = textures.zip(irradiance.as_ref()).map(|(detail, irradiance)| Textured { detail, irradiance, emission: &emission });

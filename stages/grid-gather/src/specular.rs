@@ -194,7 +194,7 @@ pub fn window_light(
         };
         let from_links = |c: usize| links.iter().map(|&l| f64::from(solution.links[l].visibility) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
         std::array::from_fn(|c| if h[c] > 0.0 { (h[c] - from_links(c) - direct).max(0.0) } else { 0.0 })
-    })
+    }, &[])
 }
 
 #[cfg(test)]
