@@ -159,7 +159,10 @@ pub fn emitting(h: &Hierarchy, sender: Node) -> Option<u32> {
 /// The solution's slope table from the measured `slopes` and the solved
 /// radiosity `b` (by [`Hierarchy::flat`] index): per leaf, ascending,
 /// `sum rho F_js B_s grad V / x` over its links (module docs); leaves with
-/// no exposure left out.
+/// no exposure left out, and a slope the table's 32-bit floats cannot hold
+/// (a sliver of a leaf under an emitter near the floats' range), which
+/// the preview then draws on its neighbours' plane alone rather than the
+/// solution being written with an infinity every reader refuses.
 pub fn leaf_slopes(h: &Hierarchy, b: &[[f64; 3]], slopes: &[DirectSlope]) -> Vec<LeafSlope> {
     let mut sorted = slopes.to_vec();
     sorted.sort_by_key(|s| s.leaf);
@@ -174,7 +177,8 @@ pub fn leaf_slopes(h: &Hierarchy, b: &[[f64; 3]], slopes: &[DirectSlope]) -> Vec
             let rho = h.reflectance_of(leaf);
             let gradient: [DVec3; 3] =
                 std::array::from_fn(|c| of_leaf.iter().map(|s| s.factor_slope * (rho[c] * b[h.flat(s.sender)][c] / exposure)).sum());
-            Some(LeafSlope { element: leaf, gradient: gradient.map(|g| g.as_vec3().to_array()) })
+            let gradient = gradient.map(|g| g.as_vec3().to_array());
+            gradient.as_flattened().iter().all(|g| g.is_finite()).then_some(LeafSlope { element: leaf, gradient })
         })
         .collect()
 }
