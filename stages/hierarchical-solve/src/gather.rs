@@ -517,6 +517,10 @@ pub struct SenderTerms {
     parts: Rows<f64>,
     /// Visibility rays cast for the parts.
     rays: usize,
+    /// Per link, what its sender sends beyond its parts' (or its own)
+    /// radiosity, W/m² RGB: the measured slopes inside them as the
+    /// receiver sees them ([`crate::slopes::sender_offsets`]); empty: none.
+    offsets: Vec<[f64; 3]>,
 }
 
 impl SenderTerms {
@@ -532,7 +536,7 @@ impl SenderTerms {
                 (Rows::from_lists(lists), rays.iter().sum())
             }
         };
-        SenderTerms { senders: links.iter().map(|l| h.flat(l.sender)).collect(), parts, rays }
+        SenderTerms { senders: links.iter().map(|l| h.flat(l.sender)).collect(), parts, rays, offsets: Vec::new() }
     }
 
     /// Visibility rays cast for the parts of partly occluded links.
@@ -597,13 +601,27 @@ impl SenderTerms {
         (0..self.senders.len()).into_par_iter().map(|l| self.radiosity(l, b)).collect()
     }
 
-    /// The radiosity link `l` sends, `sum_j w_j B_j`.
+    /// The terms `(flat node index, w_j)` of what link `l` sends: its
+    /// sender's kernel-weighted parts, or the sender itself at weight 1.
+    pub fn terms(&self, l: usize) -> Vec<(usize, f64)> {
+        let parts: Vec<(usize, f64)> = self.parts.row(l).map(|(node, &w)| (node, w)).collect();
+        if parts.is_empty() { vec![(self.senders[l], 1.0)] } else { parts }
+    }
+
+    /// Adds `offsets` (per link, in order) to what each link sends.
+    pub fn set_offsets(&mut self, offsets: Vec<[f64; 3]>) {
+        self.offsets = offsets;
+    }
+
+    /// The radiosity link `l` sends, `sum_j w_j B_j`, plus its offset if
+    /// any (not below 0).
     fn radiosity(&self, l: usize, b: &[[f64; 3]]) -> [f64; 3] {
         let mut parts = self.parts.row(l).peekable();
-        if parts.peek().is_none() {
-            return b[self.senders[l]];
+        let sent = if parts.peek().is_none() { b[self.senders[l]] } else { weighted(parts.map(|(node, &w)| (node, w)), b) };
+        match self.offsets.get(l) {
+            Some(offset) => std::array::from_fn(|c| (sent[c] + offset[c]).max(0.0)),
+            None => sent,
         }
-        weighted(parts.map(|(node, &w)| (node, w)), b)
     }
 }
 

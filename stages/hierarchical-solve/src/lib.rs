@@ -515,6 +515,9 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
                 senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { resolution, tracer });
                 receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Last { tracer, resolution: Some(resolution) }, &mut receiver_weights);
                 direct_slopes = std::mem::take(&mut receivers.slopes);
+                // The leaves' slopes lit through their neighbours too (slopes).
+                let sent_slopes = slopes::sender_offsets(&h, &all_links, &senders, &b, &direct_slopes);
+                senders.set_offsets(sent_slopes);
                 work.part_rays += (senders.rays() + receivers.rays) as u64;
                 work.resolved_links = senders.resolved();
                 let means = convergence;
