@@ -54,6 +54,7 @@ use crate::gather::SenderTerms;
 use crate::links::Link;
 use glam::DVec3;
 use radiometry::form_factor::point_to_polygon;
+use radiometry::subdivision::children;
 use rayon::prelude::*;
 use schemas::solution::{LeafSlope, Node};
 use std::collections::HashMap;
@@ -206,9 +207,10 @@ pub fn leaf_slopes(h: &Hierarchy, b: &[[f64; 3]], slopes: &[DirectSlope]) -> Vec
 /// offset = sum_j w_j g_j . (y_j - c_j),   y_j = sum_k F(c_r -> T_k) c_k / sum_k F(c_r -> T_k)
 /// ```
 ///
-/// (`c_j` the leaf's centroid, `T_k` its four quarters with centroids
-/// `c_k`, `F` Lambert's factor from the receiver's centroid `c_r`): the
-/// sender's light as a plane, not a constant, weighed by the kernel. A
+/// (`c_j` the leaf's centroid, `T_k` the four children the hierarchy would
+/// split it into, with centroids `c_k`, `F` Lambert's factor from the
+/// receiver's centroid `c_r`): the sender's light as a plane, not a
+/// constant, weighed by the kernel. A
 /// block's face standing on a floor sees most the floor next to it, where
 /// the block's own shadow on the floor is darkest, and the floor's leaves
 /// there sent their means: the short block's camera face was the Cornell
@@ -238,7 +240,8 @@ pub fn sender_offsets(h: &Hierarchy, links: &[Link], senders: &SenderTerms, b: &
                 if centre.distance_squared(c_j) > (FAR_PART * h.radius(j)).powi(2) {
                     continue;
                 }
-                let quarters = quarters(&h.elements[j as usize].points);
+                let leaf = &h.elements[j as usize];
+                let quarters = children(&leaf.corners).map(|c| h.triangles[leaf.triangle as usize].element(&c));
                 let factors = quarters.map(|q| point_to_polygon(centre, normal, &q));
                 let total: f64 = factors.iter().sum();
                 if total <= 0.0 {
@@ -252,13 +255,6 @@ pub fn sender_offsets(h: &Hierarchy, links: &[Link], senders: &SenderTerms, b: &
             offset
         })
         .collect()
-}
-
-/// The four quarters of a triangle with corners `p` (midpoint
-/// subdivision, the hierarchy's rule).
-fn quarters(p: &[DVec3; 3]) -> [[DVec3; 3]; 4] {
-    let m = [(p[0] + p[1]) * 0.5, (p[1] + p[2]) * 0.5, (p[2] + p[0]) * 0.5];
-    [[p[0], m[0], m[2]], [m[0], p[1], m[1]], [m[2], m[1], p[2]], [m[1], m[2], m[0]]]
 }
 
 #[cfg(test)]
