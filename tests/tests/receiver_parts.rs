@@ -17,7 +17,7 @@ use end_to_end::{scratch, Solved};
 use schemas::solution::{Node, NONE};
 use std::collections::HashSet;
 use test_support::artifacts::leaf_world_corners;
-use test_support::closed_form::{lambert_polygon, mean_over_triangle, midpoint_square_lamp};
+use test_support::closed_form::{floor_plane, lambert_polygon, mean_over_triangle, midpoint_square_lamp};
 use test_support::scenes::{rectangle, QuadScene};
 
 const RHO: f64 = 0.5;
@@ -113,36 +113,6 @@ fn a_partly_occluded_coarse_link_lights_each_part_by_its_own_visibility() {
     }
 }
 
-/// The centroids of a triangle's `4^levels` sub-triangles after `levels`
-/// midpoint subdivisions (equal areas).
-fn centroids(c: &[[f64; 3]; 3], levels: u32, out: &mut Vec<[f64; 3]>) {
-    if levels == 0 {
-        out.push(std::array::from_fn(|a| (c[0][a] + c[1][a] + c[2][a]) / 3.0));
-        return;
-    }
-    let mid = |i: usize, j: usize| std::array::from_fn::<f64, 3, _>(|a| 0.5 * (c[i][a] + c[j][a]));
-    let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
-    for t in [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]] {
-        centroids(&t, levels - 1, out);
-    }
-}
-
-/// The slope `(d/dx, d/dy)` and mean of the least-squares plane of `f`
-/// over a floor triangle (`z = 0`), fitted at its 256 sub-triangles'
-/// centroids.
-fn floor_plane(c: &[[f64; 3]; 3], f: &dyn Fn([f64; 3]) -> f64) -> ([f64; 2], f64) {
-    let mut points = Vec::new();
-    centroids(c, 4, &mut points);
-    let values: Vec<f64> = points.iter().map(|&p| f(p)).collect();
-    let n = points.len() as f64;
-    let mean = |g: &dyn Fn(usize) -> f64| (0..points.len()).map(g).sum::<f64>() / n;
-    let (mx, my, mv) = (mean(&|k| points[k][0]), mean(&|k| points[k][1]), mean(&|k| values[k]));
-    let (sxx, sxy, syy) = (mean(&|k| (points[k][0] - mx).powi(2)), mean(&|k| (points[k][0] - mx) * (points[k][1] - my)), mean(&|k| (points[k][1] - my).powi(2)));
-    let (sxv, syv) = (mean(&|k| (points[k][0] - mx) * (values[k] - mv)), mean(&|k| (points[k][1] - my) * (values[k] - mv)));
-    let det = sxx * syy - sxy * sxy;
-    ([(syy * sxv - sxy * syv) / det, (sxx * syv - sxy * sxv) / det], mv)
-}
-
 /// The solve's measured slopes of the lamp's light across the floor's
 /// leaves in the occluder's penumbra (the solution's `slope` table,
 /// hierarchical-solve's `slopes` module), `rho E F grad V`: the shadow's
@@ -176,7 +146,7 @@ fn penumbra_slopes(test: &str, args: &[&str]) -> (f64, f64, usize) {
         if corners.iter().any(|c| c[2].abs() > 1e-6) {
             continue;
         }
-        let (occluded, unoccluded) = (floor_plane(&corners, &|p| exact(p, true)), floor_plane(&corners, &|p| exact(p, false)));
+        let (occluded, unoccluded) = (floor_plane(&corners, 4, &|p| exact(p, true)), floor_plane(&corners, 4, &|p| exact(p, false)));
         let v = occluded.1 / unoccluded.1;
         let want = [occluded.0[0] - v * unoccluded.0[0], occluded.0[1] - v * unoccluded.0[1]];
         let got = [f64::from(slope.gradient[0][0]), f64::from(slope.gradient[0][1])];

@@ -102,6 +102,20 @@ pub fn mean_over_triangle(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -
     [[c[0], m01, m20], [m01, c[1], m12], [m20, m12, c[2]], [m01, m12, m20]].iter().map(|t| mean_over_triangle(t, levels - 1, f)).sum::<f64>() / 4.0
 }
 
+/// The least-squares plane of `f` over a triangle in the plane `z = 0`,
+/// fitted at the centroids of [`mean_over_triangle`]`(c, levels, ..)`: its
+/// slope `(d/dx, d/dy)` from the central moments, `cov(p, f) / var(p)`
+/// solved over `x` and `y`, and the mean of `f`. What a leaf's measured
+/// slope is checked against.
+pub fn floor_plane(c: &[[f64; 3]; 3], levels: u32, f: &dyn Fn([f64; 3]) -> f64) -> ([f64; 2], f64) {
+    let mean = |g: &dyn Fn([f64; 3]) -> f64| mean_over_triangle(c, levels, g);
+    let (mx, my, mf) = (mean(&|p| p[0]), mean(&|p| p[1]), mean(f));
+    let (sxx, sxy, syy) = (mean(&|p| (p[0] - mx).powi(2)), mean(&|p| (p[0] - mx) * (p[1] - my)), mean(&|p| (p[1] - my).powi(2)));
+    let (sxf, syf) = (mean(&|p| (p[0] - mx) * (f(p) - mf)), mean(&|p| (p[1] - my) * (f(p) - mf)));
+    let det = sxx * syy - sxy * sxy;
+    ([(syy * sxf - sxy * syf) / det, (sxx * syf - sxy * sxf) / det], mf)
+}
+
 /// The factor from point `p` facing up (`+z`) to a square lamp facing down
 /// at height `z`, `x, y in [lo, hi]`, by the midpoint rule over `n x n`
 /// cells, leaving out the cells `blocked(p, q)` (`q` a cell's centre) says

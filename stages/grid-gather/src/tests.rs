@@ -12,6 +12,7 @@ use schemas::header::{Provenance, Schema};
 use schemas::mesh::{Camera, Effects, Manifest, Material, Mesh, MeshStatistics, Triangle};
 use schemas::solution::{Element, LeafSlope, Solution, NONE};
 use std::f64::consts::PI;
+use test_support::closed_form::floor_plane;
 use std::path::Path;
 
 fn provenance() -> Provenance {
@@ -635,27 +636,13 @@ fn penumbra(p: DVec3) -> f64 {
     ((p.x - 0.40) / 0.15).clamp(0.0, 1.0)
 }
 
-/// `f`'s mean over the triangle `w` and the slope of its least-squares
-/// plane in z = 0, from the centroids of its 256 sub-triangles.
-fn plane_of(w: [DVec3; 3], f: &dyn Fn(DVec3) -> f64) -> (f64, DVec3) {
-    let mut parts = vec![ROOT];
-    for _ in 0..4 {
-        parts = parts.iter().flat_map(children).collect();
-    }
-    let points: Vec<DVec3> = parts.iter().map(|c| {
-        let uv = uv_centroid(c);
-        w[0] + uv[0] * (w[1] - w[0]) + uv[1] * (w[2] - w[0])
-    }).collect();
-    let n = points.len() as f64;
-    let values: Vec<f64> = points.iter().map(|&p| f(p)).collect();
-    let (centre, mean) = (points.iter().sum::<DVec3>() / n, values.iter().sum::<f64>() / n);
-    let (mut xx, mut xy, mut yy, mut xv, mut yv) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for (p, v) in points.iter().zip(&values) {
-        let (d, dv) = (*p - centre, v - mean);
-        (xx, xy, yy, xv, yv) = (xx + d.x * d.x, xy + d.x * d.y, yy + d.y * d.y, xv + d.x * dv, yv + d.y * dv);
-    }
-    let det = xx * yy - xy * xy;
-    (mean, DVec3::new((yy * xv - xy * yv) / det, (xx * yv - xy * xv) / det, 0.0))
+/// [`penumbra`]'s least-squares plane over the leaf with world corners `w`
+/// (in z = 0; test-support's `floor_plane` over 256 points): its mean, and
+/// its slope where the rise crosses the leaf.
+fn penumbra_plane(w: [DVec3; 3]) -> (f64, Option<DVec3>) {
+    let ([dx, dy], mean) = floor_plane(&w.map(|p| p.to_array()), 4, &|p| penumbra(DVec3::from(p)));
+    let slope = DVec3::new(dx, dy, 0.0);
+    (mean, (slope != DVec3::ZERO).then_some(slope))
 }
 
 /// A penumbra across leaves wider than it (each leaf its exact mean):
@@ -667,11 +654,8 @@ fn plane_of(w: [DVec3; 3], f: &dyn Fn(DVec3) -> f64) -> (f64, DVec3) {
 /// (wrong) 0.0381.
 #[test]
 fn measured_slopes_show_a_penumbra_closer() {
-    let mean = |w: [DVec3; 3]| plane_of(w, &penumbra).0;
-    let crossed = |w: [DVec3; 3]| {
-        let g = plane_of(w, &penumbra).1;
-        (g != DVec3::ZERO).then_some(g)
-    };
+    let mean = |w: [DVec3; 3]| penumbra_plane(w).0;
+    let crossed = |w: [DVec3; 3]| penumbra_plane(w).1;
     let plain = rms_off(&square_shown(3, shown_by_default(), &mean), &penumbra);
     let measured = rms_off(&square_sloped(3, shown_by_default(), &mean, &crossed), &penumbra);
     let turned = rms_off(&square_sloped(3, shown_by_default(), &mean, &|w| crossed(w).map(|g| -g)), &penumbra);
