@@ -258,7 +258,7 @@ def read_sweep(path):
     series = {}
     with open(path) as f:
         rows = list(csv.DictReader(f))
-    fixed = {"solver", "gather", "cluster_s", "solve_s", "gather_s", "total_s", "total_min_s", "total_max_s", "error", "error_min", "error_max", "pareto", "reference"}
+    fixed = {"solver", "gather", "cluster_s", "solve_s", "gather_s", "total_s", "total_min_s", "total_max_s", "error", "error_min", "error_max", "worst_surface", "worst_surface_min", "worst_surface_max", "pareto", "reference"}
     for row in rows:
         knobs = ", ".join(f"{k}={v}" for k, v in row.items() if k not in fixed and v not in ("", None))
         series.setdefault(f"{row['solver']}/{row['gather']}", []).append((float(row["total_s"]), float(row["error"]), knobs))

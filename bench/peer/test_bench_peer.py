@@ -92,5 +92,20 @@ class BestRuns(unittest.TestCase):
             self.assertEqual(objects, [("floor", -0.004), ("ceiling", 0.003)])
 
 
+class ReadSweep(unittest.TestCase):
+    def test_series_label_points_by_their_knobs_only(self):
+        import tempfile
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "sweep.csv")
+            open(path, "w").write(
+                "solver,gather,EPS,cluster_s,solve_s,gather_s,total_s,total_min_s,total_max_s,error,error_min,error_max,"
+                "worst_surface,worst_surface_min,worst_surface_max,pareto,reference\n"
+                'hierarchical,preview,0.001,0.01,0.2,0.05,0.26,0.25,0.3,1.5e-2,1.4e-2,1.6e-2,5e-3,4e-3,7e-3,true,"ref"\n'
+                'hierarchical,full,0.001,0.01,0.2,0.3,0.51,0.5,0.6,1.2e-2,1.1e-2,1.3e-2,,,,true,"ref"\n')
+            series = bp.read_sweep(path)
+            self.assertEqual(series["hierarchical/preview"], [(0.26, 0.015, "EPS=0.001")])
+            self.assertEqual(series["hierarchical/full"], [(0.51, 0.012, "EPS=0.001")])
+
+
 if __name__ == "__main__":
     unittest.main()

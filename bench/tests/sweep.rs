@@ -41,6 +41,7 @@ fn a_sweep_of_the_integrating_sphere_has_both_points_and_its_error_falls_as_eps_
         let stages: Vec<&str> = p.stages.iter().map(|s| s.stage.as_str()).collect();
         assert_eq!(stages, ["cluster", "hierarchical-solve", "grid-gather"]);
         assert!(p.stages.iter().all(|s| s.seconds.median.is_finite()));
+        assert_eq!(p.worst_surface, None, "a closed form per element has no surfaces' means: {p:?}");
     }
     eprintln!("sphere-1000: error {:.3e} at EPS 1, {:.3e} at EPS 0.01", loose.error.median, tight.error.median);
     assert!(tight.error.median < loose.error.median, "error at EPS 0.01 {} not below EPS 1 {}", tight.error.median, loose.error.median);
@@ -76,6 +77,16 @@ fn a_sweep_of_the_simple_environment_is_measured_against_its_exact_image() {
     let at = |eps: f64| table.points.iter().find(|p| p.knob("EPS") == Some(eps)).unwrap_or_else(|| panic!("no point at EPS {eps}")).error.median;
     eprintln!("simple environment against its exact image: error {:.3e} at EPS 0.05, {:.3e} at EPS 0.001", at(0.05), at(0.001));
     assert!(at(0.001) < at(0.05) && at(0.001) > 0.0);
+    // Each point's worst surface is the largest per-object mean error in
+    // its kept compare report (one rep: the median is that run's).
+    for p in table.points.iter().filter(|p| p.solver == Solver::Hierarchical) {
+        let worst = p.worst_surface.as_ref().unwrap_or_else(|| panic!("no worst surface: {p:?}"));
+        let kept: schemas::report::Report = read_ron(&std::path::Path::new(&p.runs).join("rep0").join(format!("compare-{}.ron", p.gather))).unwrap().value;
+        let objects: Vec<f64> = kept.counters.iter().filter(|(k, _)| k.starts_with("object[") && k.ends_with("].mean_signed_error")).map(|(_, v)| v.abs()).collect();
+        assert!(objects.len() >= 2, "the simple environment's surfaces: {:?}", kept.counters.keys().collect::<Vec<_>>());
+        assert_eq!(worst.median, objects.iter().copied().fold(0.0, f64::max), "{p:?}");
+        assert!(worst.median > 0.0 && worst.median < 0.5, "{p:?}");
+    }
     for (solver, stages) in [(Solver::Photon, ["photon-trace", "grid-gather"].as_slice()), (Solver::Structured, ["structured-sample"].as_slice())] {
         let p = table.points.iter().find(|p| p.solver == solver).unwrap_or_else(|| panic!("no {solver} point"));
         assert_eq!(p.stages.iter().map(|s| s.stage.as_str()).collect::<Vec<_>>(), stages);

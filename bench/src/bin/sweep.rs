@@ -121,12 +121,13 @@ fn run(args: Args) -> Result<ExitCode> {
     for p in &sweep.points {
         let knobs: Vec<String> = p.knobs.iter().map(|k| format!("{}={}", k.name, k.value)).collect();
         eprintln!(
-            "  {:<12} {:<7} {:<24} total {:>8.3} s  error {:.3e}{}",
+            "  {:<12} {:<7} {:<24} total {:>8.3} s  error {:.3e}{}{}",
             p.solver.name(),
             p.gather.name(),
             knobs.join(" "),
             p.total_s.median,
             p.error.median,
+            p.worst_surface.as_ref().map(|w| format!("  worst surface {:.2}%", 100.0 * w.median)).unwrap_or_default(),
             if p.pareto { "  (Pareto front)" } else { "" }
         );
     }

@@ -313,11 +313,34 @@ pub fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solve
 }
 
 /// compare's `relative_rmse` of `a` against `b`, its report in `report`.
-fn error(stages: &Stages, a: &Path, b: &Path, flags: &[&str], report: &Path) -> Result<f64> {
+fn error(stages: &Stages, a: &Path, b: &Path, flags: &[&str], report: &Path) -> Result<Errors> {
     let mut args = vec![s(a), s(b)];
     args.extend(flags.iter().map(|f| f.to_string()));
     let report_value = stages.run("compare", &args, report)?;
-    report_value.counters.get("relative_rmse").copied().ok_or_else(|| Error::invalid(report, None, "no relative_rmse counter"))
+    let relative_rmse = report_value.counters.get("relative_rmse").copied().ok_or_else(|| Error::invalid(report, None, "no relative_rmse counter"))?;
+    Ok(Errors { relative_rmse, worst_surface: worst_surface(&report_value) })
+}
+
+/// What a run's gather measured against the reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Errors {
+    /// compare's `relative_rmse`.
+    relative_rmse: f64,
+    /// [`worst_surface`] of the same comparison.
+    worst_surface: Option<f64>,
+}
+
+/// The largest `|object[..].mean_signed_error|` of a compare report: the
+/// worst surface's mean luminance off the reference's, relative (the
+/// issue's "every surface within 1%"). `None` where compare reports no
+/// objects (solutions, and images without a surface layer).
+fn worst_surface(report: &Report) -> Option<f64> {
+    report
+        .counters
+        .iter()
+        .filter(|(k, _)| k.starts_with("object[") && k.ends_with("].mean_signed_error"))
+        .map(|(_, v)| v.abs())
+        .reduce(f64::max)
 }
 
 /// How points are compared with the reference.
@@ -329,8 +352,8 @@ pub enum Measure {
 }
 
 impl Measure {
-    /// The error of each gather of a run.
-    fn errors(&self, stages: &Stages, run: &RunOutput, dir: &Path) -> Result<Vec<f64>> {
+    /// The errors of each gather of a run.
+    fn errors(&self, stages: &Stages, run: &RunOutput, dir: &Path) -> Result<Vec<Errors>> {
         match self {
             Measure::Solution(reference) => {
                 let e = error(stages, &run.solution, reference, &[], &dir.join("compare.ron"))?;
@@ -453,7 +476,15 @@ pub fn run(config: &Config, plans: &[Plan], stages: &Stages, progress: &mut dyn 
                 let errors = measure.errors(stages, &run, &dir)?;
                 done += 1;
                 let times: Vec<String> = run.solve_stages.iter().map(|(st, t)| format!("{st} {t:.3} s")).chain(run.gathers.iter().map(|(g, t, _)| format!("{g} {t:.3} s"))).collect();
-                let errs: Vec<String> = plan.gathers.iter().zip(&errors).map(|(g, e)| format!("{g} {e:.3e}")).collect();
+                let errs: Vec<String> = plan
+                    .gathers
+                    .iter()
+                    .zip(&errors)
+                    .map(|(g, e)| match e.worst_surface {
+                        Some(w) => format!("{g} {:.3e} (worst surface {:.2}%)", e.relative_rmse, 100.0 * w),
+                        None => format!("{g} {:.3e}", e.relative_rmse),
+                    })
+                    .collect();
                 progress(&format!(
                     "[{done}/{runs_total}] {} {} rep {}/{}: {}; error {}",
                     plan.solver,
@@ -521,8 +552,8 @@ fn emitter_share_note(mesh: &Mesh, manifest: &Manifest, radiosity: &[[f64; 3]]) 
 struct RepFigures {
     /// (stage, seconds) of cluster and solve, in pipeline order.
     solve_stages: Vec<(String, f64)>,
-    /// Per gather mode: (seconds, error).
-    gathers: Vec<(f64, f64)>,
+    /// Per gather mode: its seconds and errors.
+    gathers: Vec<(f64, Errors)>,
 }
 
 /// The point of gather mode `gather` (index `g`) of a setting, from its
@@ -548,7 +579,8 @@ fn point(solver: Solver, gather: Gather, g: usize, setting: &Setting, reps: &[Re
         knobs: knob_values(setting),
         stages,
         total_s: spread(&total),
-        error: spread(&|r| r.gathers[g].1),
+        error: spread(&|r| r.gathers[g].1.relative_rmse),
+        worst_surface: reps.iter().map(|r| r.gathers[g].1.worst_surface).collect::<Option<Vec<f64>>>().map(|w| Spread::of(&w)),
         pareto: false,
         runs: s(dir),
     }
@@ -656,6 +688,31 @@ fn strictest_run(stages: &Stages, config: &Config, plan: &Plan, prepared: &Prepa
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The worst surface is the largest per-object mean signed error in
+    /// magnitude, whatever its sign; materials and the whole image do not
+    /// count, and a report without objects has none.
+    #[test]
+    fn the_worst_surface_is_the_largest_object_mean_error_in_magnitude() {
+        let report = |counters: &[(&str, f64)]| Report {
+            header: Report::header(schemas::header::Provenance::in_memory("test")),
+            wall_time_s: 0.0,
+            counters: counters.iter().map(|&(k, v)| (k.to_string(), v)).collect(),
+            skipped: Vec::new(),
+            notes: Vec::new(),
+        };
+        let image = report(&[
+            ("relative_rmse", 0.02),
+            ("mean_signed_error", -0.05),
+            ("material[white].mean_signed_error", 0.04),
+            ("object[floor].mean_signed_error", 0.003),
+            ("object[short_block].mean_signed_error", -0.0125),
+            ("object[#7].mean_signed_error", 0.01),
+            ("object[short_block].relative_rmse", 0.5),
+        ]);
+        assert_eq!(worst_surface(&image), Some(0.0125));
+        assert_eq!(worst_surface(&report(&[("relative_rmse", 0.02), ("mean_signed_error", 0.01)])), None);
+    }
 
     fn config(solvers: &[Solver], knobs: &[(&str, &[f64])], gathers: Option<Vec<Gather>>) -> Config {
         Config {

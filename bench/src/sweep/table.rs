@@ -130,6 +130,13 @@ pub struct Point {
     pub total_s: Spread,
     /// The error against the reference; median and range over runs.
     pub error: Spread,
+    /// The worst surface: the largest relative difference of an object's
+    /// mean luminance from the reference's (`compare`'s per-object mean
+    /// signed error, taken absolute); median and range over runs. None
+    /// where the errors are per element (a closed form), and in tables
+    /// written before it was measured.
+    #[serde(default)]
+    pub worst_surface: Option<Spread>,
     /// Whether no other point of the sweep is both faster and more
     /// accurate (median time and error).
     pub pareto: bool,
@@ -160,8 +167,9 @@ impl Sweep {
     /// The table as CSV: one row per point; a column per knob swept in
     /// any point (empty where a point's solver does not have it), the
     /// median time of cluster, solve and gather (seconds; cluster empty
-    /// where it did not run), the total and the error with their ranges,
-    /// the Pareto flag and the reference's label.
+    /// where it did not run), the total, the error and the worst surface
+    /// with their ranges (the worst surface empty where it is not
+    /// measured), the Pareto flag and the reference's label.
     pub fn csv(&self) -> String {
         let mut knobs: Vec<&str> = Vec::new();
         for p in &self.points {
@@ -175,12 +183,13 @@ impl Sweep {
         for k in &knobs {
             let _ = write!(out, ",{k}");
         }
-        out += ",cluster_s,solve_s,gather_s,total_s,total_min_s,total_max_s,error,error_min,error_max,pareto,reference\n";
+        out += ",cluster_s,solve_s,gather_s,total_s,total_min_s,total_max_s,error,error_min,error_max,worst_surface,worst_surface_min,worst_surface_max,pareto,reference\n";
         // Knob values as given; seconds to the microsecond, errors to 7
         // significant digits (the RON keeps every digit).
         let cell = |v: Option<f64>| v.map(|v| format!("{v}")).unwrap_or_default();
         let time = |v: Option<f64>| v.map(|v| format!("{v:.6}")).unwrap_or_default();
         let error = |v: f64| format!("{v:.6e}");
+        let worst = |p: &Point, f: fn(&Spread) -> f64| p.worst_surface.as_ref().map(|w| error(f(w))).unwrap_or_default();
         for p in &self.points {
             let _ = write!(out, "{},{}", p.solver, p.gather);
             for k in &knobs {
@@ -188,7 +197,7 @@ impl Sweep {
             }
             let _ = writeln!(
                 out,
-                ",{},{},{},{},{},{},{},{},{},{},\"{}\"",
+                ",{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
                 time(p.stage_median("cluster")),
                 time(p.stage_median("solve")),
                 time(p.stage_median("gather")),
@@ -198,6 +207,9 @@ impl Sweep {
                 error(p.error.median),
                 error(p.error.min),
                 error(p.error.max),
+                worst(p, |w| w.median),
+                worst(p, |w| w.min),
+                worst(p, |w| w.max),
                 p.pareto,
                 self.reference.label.replace('"', "\"\"")
             );
@@ -219,6 +231,7 @@ mod tests {
             stages: stages.iter().map(|(n, t)| StageTime { stage: n.to_string(), seconds: once(*t) }).collect(),
             total_s: once(stages.iter().map(|s| s.1).sum()),
             error: once(error),
+            worst_surface: (solver == Solver::Hierarchical).then(|| once(error / 10.0)),
             pareto: true,
             runs: String::new(),
         }
@@ -242,9 +255,11 @@ mod tests {
         };
         let csv = sweep.csv();
         let rows: Vec<&str> = csv.lines().collect();
-        assert_eq!(rows[0], "solver,gather,EPS,GPU_CONVERGENCE,cluster_s,solve_s,gather_s,total_s,total_min_s,total_max_s,error,error_min,error_max,pareto,reference");
-        assert_eq!(rows[1], "hierarchical,preview,0.001,,0.500000,1.000000,2.000000,3.500000,3.500000,3.500000,2.500000e-1,2.500000e-1,2.500000e-1,true,\"reference: strictest run (not converged truth)\"");
+        assert_eq!(rows[0], "solver,gather,EPS,GPU_CONVERGENCE,cluster_s,solve_s,gather_s,total_s,total_min_s,total_max_s,error,error_min,error_max,worst_surface,worst_surface_min,worst_surface_max,pareto,reference");
+        assert_eq!(rows[1], "hierarchical,preview,0.001,,0.500000,1.000000,2.000000,3.500000,3.500000,3.500000,2.500000e-1,2.500000e-1,2.500000e-1,2.500000e-2,2.500000e-2,2.500000e-2,true,\"reference: strictest run (not converged truth)\"");
         assert!(rows[2].starts_with("gpu,preview,,0.99,,4.000000,2.000000,6.000000,"), "{}", rows[2]);
+        // A point whose worst surface was not measured has empty cells.
+        assert!(rows[2].ends_with("1.250000e-1,,,,true,\"reference: strictest run (not converged truth)\""), "{}", rows[2]);
         // The table reads back through its schema.
         let text = schemas::ron_io::to_ron_text(&sweep);
         let back: Sweep = schemas::ron_io::parse_ron(std::path::Path::new("sweep.ron"), &text).unwrap();
