@@ -55,7 +55,10 @@
 //!
 //! The error is `compare`'s `relative_rmse`:
 //! `sqrt(Σ w (a − b)² / Σ w b²)` over pixels (or triangles, weighted by
-//! area) and channels.
+//! area) and channels. Against an image each point also has its worst
+//! surface, the largest `|mean signed error|` of compare's objects (each
+//! object's mean luminance against the reference's), summarised over the
+//! runs like the error.
 
 pub mod closed_form;
 pub mod knobs;
@@ -312,7 +315,8 @@ pub fn run_pipeline(stages: &Stages, config: &Config, prepared: &Prepared, solve
     Ok(RunOutput { solve_stages, solution, gathers: images, solve_report })
 }
 
-/// compare's `relative_rmse` of `a` against `b`, its report in `report`.
+/// compare's `relative_rmse` of `a` against `b` and its worst surface
+/// ([`worst_surface`]), its report in `report`.
 fn error(stages: &Stages, a: &Path, b: &Path, flags: &[&str], report: &Path) -> Result<Errors> {
     let mut args = vec![s(a), s(b)];
     args.extend(flags.iter().map(|f| f.to_string()));
