@@ -1,5 +1,6 @@
 //! The slope of emitters' direct light inside the leaves of a penumbra,
-//! for the preview to draw (the solution's `slope` table).
+//! for the preview to draw (the solution's `slope` table) and for what
+//! those leaves send to receivers near them ([`sender_offsets`]).
 //!
 //! A leaf is one radiosity, its mean; the preview draws it as a plane
 //! whose slope it fits to the neighbouring leaves' means. Where a shadow's
@@ -54,6 +55,7 @@ use crate::gather::SenderTerms;
 use crate::links::Link;
 use glam::DVec3;
 use radiometry::form_factor::point_to_polygon;
+use radiometry::geometry::frame_with_normal;
 use radiometry::subdivision::children;
 use rayon::prelude::*;
 use schemas::solution::{LeafSlope, Node};
@@ -82,11 +84,11 @@ pub struct VisibilitySlope {
 }
 
 impl VisibilitySlope {
-    /// An empty fit over element `e` of `h`.
+    /// An empty fit over element `e` of `h`, in the element's plane
+    /// (radiometry's frame of its normal).
     pub fn over(h: &Hierarchy, e: u32) -> Self {
-        let points = &h.elements[e as usize].points;
-        let u = (points[1] - points[0]).normalize();
-        Self::new(h.centroid(e), [u, h.normal(e).cross(u)])
+        let [t, b, _] = frame_with_normal(h.normal(e));
+        Self::new(h.centroid(e), [t, b])
     }
 
     /// An empty fit in the plane through `origin` spanned by the
