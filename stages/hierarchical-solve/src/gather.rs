@@ -603,9 +603,10 @@ impl SenderTerms {
 
     /// The terms `(flat node index, w_j)` of what link `l` sends: its
     /// sender's kernel-weighted parts, or the sender itself at weight 1.
-    pub fn terms(&self, l: usize) -> Vec<(usize, f64)> {
-        let parts: Vec<(usize, f64)> = self.parts.row(l).map(|(node, &w)| (node, w)).collect();
-        if parts.is_empty() { vec![(self.senders[l], 1.0)] } else { parts }
+    pub fn terms(&self, l: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let mut parts = self.parts.row(l).map(|(node, &w)| (node, w)).peekable();
+        let whole = parts.peek().is_none().then_some((self.senders[l], 1.0));
+        whole.into_iter().chain(parts)
     }
 
     /// Adds `offsets` (per link, in order) to what each link sends.
@@ -616,6 +617,8 @@ impl SenderTerms {
     /// The radiosity link `l` sends, `sum_j w_j B_j`, plus its offset if
     /// any (not below 0).
     fn radiosity(&self, l: usize, b: &[[f64; 3]]) -> [f64; 3] {
+        // Self::terms by hand, with no iterator chain: this runs per link
+        // per iteration (the chain cost 1% to 2% of the solve).
         let mut parts = self.parts.row(l).peekable();
         let sent = if parts.peek().is_none() { b[self.senders[l]] } else { weighted(parts.map(|(node, &w)| (node, w)), b) };
         match self.offsets.get(l) {
