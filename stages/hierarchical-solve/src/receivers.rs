@@ -210,14 +210,30 @@ fn to_triangles(h: &Hierarchy, l: &Link, last: bool) -> bool {
     triangles.len() <= MAX_RECEIVER_TRIANGLES || (last && triangles.len() <= MAX_ORIENTED_TRIANGLES && !flat())
 }
 
+/// What one build of [`ReceiverTerms`] leaves for the next.
+///
 /// The weights of the links into clusters of the last build, by link ends,
 /// with the sender's parts they were computed for: a link that refinement
 /// kept, whose sender still opens into the same parts, has the same weights
 /// (those without visibility), so the next pass's build takes them from
 /// here instead of computing the Lambert factors again (on plants-10k at
 /// `EPS` 1e-2 a build took about 1 s of every pass).
+///
+/// And the traced part weights of the links into the leaves a
+/// [`Build::Opened`] opened, by link ends: the last build, which follows it
+/// on the same hierarchy, weighs those links' parts again with the same
+/// arguments and the same random streams, so it takes them from here where
+/// it traces the link too (a link whose parts measured it wholly visible or
+/// wholly hidden is no longer partly occluded, and is weighed anew). The
+/// same solution to the bit. On the built-in Cornell box the last build
+/// casts 9% to 15% fewer part rays, and the solve is 1.9%, 1.2% and 3.5%
+/// faster at `EPS` 1.5e-3, 1e-3 and 6e-4 (one thread, interleaved medians
+/// of 11, 11 and 7).
 #[derive(Default)]
-pub struct WeightCache(HashMap<(Node, Node), (Vec<Node>, Weights, Measured)>);
+pub struct WeightCache {
+    clusters: HashMap<(Node, Node), (Vec<Node>, Weights, Measured)>,
+    opened: HashMap<(Node, Node), Weighing>,
+}
 
 /// Per input triangle, the links into clusters above it, each with its
 /// sender's parts and their weights `w_tp`.
@@ -290,8 +306,16 @@ impl ReceiverTerms {
     pub fn new(h: &Hierarchy, links: &mut [Link], build: Build, cache: &mut WeightCache) -> Self {
         let to_parts: Vec<bool> = links.iter().map(|l| build.sends_to_parts(h, l)).collect();
         let tracer = build.tracer();
-        let part_built: Vec<Option<Weighing>> =
-            links.par_iter().zip(&to_parts).map(|(l, &d)| d.then(|| part_weights(h, l.receiver, l.sender, tracer.filter(|_| l.partly_occluded())))).collect();
+        let traced: Vec<bool> = links.iter().zip(&to_parts).map(|(l, &d)| d && tracer.is_some() && l.partly_occluded()).collect();
+        // The opened build's traced weights, for the links this build traces.
+        let mut opened = std::mem::take(&mut cache.opened);
+        let reused: Vec<Option<Weighing>> = links.iter().zip(&traced).map(|(l, &t)| if t { opened.remove(&(l.receiver, l.sender)) } else { None }).collect();
+        let part_built: Vec<Option<Weighing>> = links
+            .par_iter()
+            .zip(&to_parts)
+            .zip(reused)
+            .map(|((l, &d), reused)| d.then(|| reused.unwrap_or_else(|| part_weights(h, l.receiver, l.sender, tracer.filter(|_| l.partly_occluded())))))
+            .collect();
         let mut seen: Vec<Option<PartViews>> = links
             .par_iter()
             .zip(&part_built)
@@ -334,7 +358,7 @@ impl ReceiverTerms {
                 let whole = h.triangles_below(l.receiver).len() > MAX_RECEIVER_TRIANGLES;
                 let nodes = if whole { vec![l.sender] } else { h.parts(l.sender, MAX_PARTS) };
                 let visibility = visibility.filter(|_| l.partly_occluded() && !whole);
-                Some(match cache.0.get(&(l.receiver, l.sender)) {
+                Some(match cache.clusters.get(&(l.receiver, l.sender)) {
                     Some((cached, w, measured)) if visibility.is_none() && *cached == nodes => (nodes, w.clone(), *measured, 0),
                     _ => {
                         let (w, measured, rays) = weights(h, l, &nodes, visibility);
@@ -380,9 +404,18 @@ impl ReceiverTerms {
             measured.apply(&mut links[l]);
         }
         let element_rows = Rows::from_lists(by_element);
+        if matches!(build, Build::Opened { .. }) {
+            // Cast already: the last build casts none for them.
+            cache.opened = links
+                .iter()
+                .zip(&traced)
+                .zip(part_built)
+                .filter_map(|((l, &t), w)| Some(((l.receiver, l.sender), Weighing { rays: 0, ..w.filter(|_| t)? })))
+                .collect();
+        }
         // The next pass reads the weights of a build without visibility.
         if visibility.is_none() {
-            cache.0 = links.iter().zip(built).filter_map(|(l, b)| b.map(|(nodes, w, measured, _)| ((l.receiver, l.sender), (nodes, w, measured)))).collect();
+            cache.clusters = links.iter().zip(built).filter_map(|(l, b)| b.map(|(nodes, w, measured, _)| ((l.receiver, l.sender), (nodes, w, measured)))).collect();
         }
         let distributed = to_triangles.iter().zip(&to_parts).map(|(a, b)| *a || *b).collect();
         ReceiverTerms { rays, rows: Rows::from_lists(lists), distributed, element_rows, part_sources, slopes }
@@ -918,6 +951,52 @@ mod tests {
         assert!(worst < 0.05, "worst leaf {worst}; L2 {shared} against {pushed} pushed alike");
     }
 
+    /// The scene of the next test: a unit floor (triangles 0 and 1, the
+    /// first split to level 3, whose 64 leaves are returned), a lamp quad
+    /// 1 m up facing down (triangles 2 and 3) and a black sheet 10 cm up
+    /// over `x < 0.4` (4 and 5); and a partly occluded link from the lamp's
+    /// triangle 2 into floor triangle 0.
+    fn floor_under_sheet() -> (Hierarchy, Vec<u32>, Link) {
+        use glam::dvec3;
+        use test_support::meshes::{manifest, material, quads};
+        let mesh = quads(&[
+            (DVec3::ZERO, DVec3::X, DVec3::Y, 0, 0),
+            (dvec3(0.25, 0.25, 1.0), DVec3::Y * 0.5, DVec3::X * 0.5, 1, 1),
+            (dvec3(-1.0, -1.0, 0.1), DVec3::X * 1.4, DVec3::Y * 3.0, 2, 2),
+        ]);
+        let manifest = manifest(3, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [1.0; 3]), material([0.0; 3], [0.0; 3])]);
+        let mut h = Hierarchy::new(&mesh, &manifest, None, None);
+        let level = split_levels(&mut h, 0, 3);
+        let link = Link { receiver: Node::Element(0), sender: Node::Element(2), form_factor: 0.1, spread: 0.0, visibility: Some(0.5), occluder_distance: 0.5, clear: false };
+        (h, level, link)
+    }
+
+    /// The last build takes the part weights that an opened build traced
+    /// for a link from the cache ([`WeightCache`]), casting no ray for
+    /// them: the same terms on every element and the same measured visible
+    /// fraction, to the bit, as a last build on its own, which casts rays.
+    #[test]
+    fn the_last_build_takes_the_opened_builds_traced_part_weights() {
+        let (h, _, link) = floor_under_sheet();
+        let (scene, occluders) = crate::test_scenes::traced(&h);
+        let tracer = Tracer::new(&scene, &occluders, 1, 16);
+        let mut alone = [link];
+        let own = ReceiverTerms::new(&h, &mut alone, Build::Last { tracer, resolution: None }, &mut WeightCache::default());
+        let mut opened = vec![false; h.elements.len()];
+        opened[0] = true;
+        let (mut links, mut cache) = ([link], WeightCache::default());
+        let first = ReceiverTerms::new(&h, &mut links, Build::Opened { tracer, opened: &opened }, &mut cache);
+        let last = ReceiverTerms::new(&h, &mut links, Build::Last { tracer, resolution: None }, &mut cache);
+        assert!(own.rays > 0 && first.rays == own.rays, "rays: alone {}, opened {}", own.rays, first.rays);
+        assert_eq!(last.rays, 0, "the last build cast rays again");
+        assert_eq!(links[0].visibility, alone[0].visibility);
+        let rows = |t: &ReceiverTerms, e: usize| t.of_element(e).map(|(k, w)| (k, w.to_bits())).collect::<Vec<_>>();
+        for e in 0..h.elements.len() {
+            assert_eq!(rows(&last, e), rows(&own, e), "element {e}");
+        }
+        assert_eq!(last.slopes.len(), own.slopes.len());
+    }
+
     /// A lamp (`x, y` in [0.25, 0.75], 1 m up, facing down) over a unit
     /// floor, and a black sheet 10 cm up over `x < 0.4`: the floor's
     /// shadow edge, 5 cm wide, runs across the parts of the floor's
@@ -937,17 +1016,8 @@ mod tests {
     #[test]
     fn a_partly_occluded_link_into_an_element_follows_the_shadow_edge_below_its_parts() {
         use glam::dvec3;
-        use test_support::meshes::{manifest, material, quads};
-        let mesh = quads(&[
-            (DVec3::ZERO, DVec3::X, DVec3::Y, 0, 0),
-            (dvec3(0.25, 0.25, 1.0), DVec3::Y * 0.5, DVec3::X * 0.5, 1, 1),
-            (dvec3(-1.0, -1.0, 0.1), DVec3::X * 1.4, DVec3::Y * 3.0, 2, 2),
-        ]);
-        let manifest = manifest(3, vec![material([0.5; 3], [0.0; 3]), material([0.0; 3], [1.0; 3]), material([0.0; 3], [0.0; 3])]);
-        let mut h = Hierarchy::new(&mesh, &manifest, None, None);
-        let level = split_levels(&mut h, 0, 3);
+        let (h, level, link) = floor_under_sheet();
         let (scene, occluders) = crate::test_scenes::traced(&h);
-        let link = Link { receiver: Node::Element(0), sender: Node::Element(2), form_factor: 0.1, spread: 0.0, visibility: Some(0.5), occluder_distance: 0.5, clear: false };
         let mut links = [link];
         let terms = ReceiverTerms::new(&h, &mut links, Build::Last { tracer: Tracer::new(&scene, &occluders, 1, 16), resolution: None }, &mut WeightCache::default());
         // Each leaf's share: its own part's weight, or the part above it.
