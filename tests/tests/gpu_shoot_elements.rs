@@ -393,7 +393,7 @@ fn a_hard_shadow_stays_dark_inside_its_umbra() {
     let lm = &solved.lightmap;
     // The mesh frame is the scene's, moved by the manifest's translation.
     let shift = solved.manifest.world_from_mesh_translation;
-    let world = |p: [f64; 3]| [0, 1, 2].map(|k| p[k] + f64::from(shift[k]));
+    let world = |p: [f64; 3]| [0, 1, 2].map(|k| p[k] + shift[k]);
     let (mut umbra, mut brightest, mut lit_worst, mut lit) = (Vec::new(), 0.0f64, 0.0f64, 0usize);
     for (t, r) in lm.regions.iter().enumerate() {
         if solved.object_of(t) != "receiver" {
@@ -453,7 +453,7 @@ fn a_leaf_crossing_a_solids_footprint_shows_its_exposed_part() {
     let Some(solved) = shoot("gpu_elements_buried", &scene, &["--texels", "8000"]) else { return };
     let shift = solved.manifest.world_from_mesh_translation;
     let exposed = |p: [f64; 3]| {
-        let (x, y) = (p[0] + f64::from(shift[0]), p[1] + f64::from(shift[1]));
+        let (x, y) = (p[0] + shift[0], p[1] + shift[1]);
         !((x0..=x1).contains(&x) && (y0..=y1).contains(&y))
     };
     let (mut bias, mut weight, mut worst, mut area_worst, mut count) = (0.0, 0.0, 0.0f64, 0.0f64, 0);

@@ -37,8 +37,8 @@ fn floor_values(image: &Rendered) -> Vec<f64> {
 /// The closed box built into mesh-prep (`box-<n>`: a convex room, so no
 /// surface hides another) solved with clusters: links with cluster ends,
 /// among them the root's self-link refined, so some senders are clusters
-/// holding the grid vertices. The links' whole allowance (`share_floor`
-/// 1) keeps the coarse links these tests are about: with the default
+/// holding the grid vertices. The links' whole allowance
+/// (`share_floor` 1) keeps the coarse links these tests are about: with the default
 /// share, this 300-triangle box's solve left the full gather no grid
 /// vertex.
 fn clustered_box(triangles: usize, eps: f64) -> (Mesh, Manifest, Solution, schemas::cluster::Clusters) {

@@ -152,7 +152,7 @@ fn names<const N: usize>(channels: &[(&'static str, &'static str); N]) -> [&'sta
 impl Surface {
     /// Writes `surface.exr`.
     pub fn write(&self, path: &Path) -> Result<()> {
-        let (uvs, normals): (Vec<(u32, [f32; 6])>, Vec<(u32, [f32; 9])>) = (flatten(&self.uvs), flatten(&self.shading_normals));
+        let (uvs, normals) = (flatten::<2, 6>(&self.uvs), flatten::<3, 9>(&self.shading_normals));
         let mut layers = vec![table("uv", &uvs, &UV), table("shading_normal", &normals, &NORMAL), table("tangent", &self.tangents, &TANGENT)];
         let slot = |s: usize| self.material_maps.iter().map(|m| m[s]).collect();
         layers.push(Layer::table(
@@ -229,15 +229,13 @@ impl Surface {
             return Err(Error::invalid(path, None, format!("layer 'material_maps' has {} records for the manifest's {materials} materials", maps.len())));
         }
         let slots = [maps.u32s(path, "diffuse")?, maps.u32s(path, "alpha")?, maps.u32s(path, "normal")?];
-        let mut material_maps = Vec::with_capacity(materials);
-        for m in 0..materials {
-            let entry: [u32; 3] = std::array::from_fn(|s| slots[s][m]);
+        let material_maps: Vec<[u32; 3]> = (0..materials).map(|m| std::array::from_fn(|s| slots[s][m])).collect();
+        for (m, entry) in material_maps.iter().enumerate() {
             for (slot, &t) in entry.iter().enumerate() {
                 if t != NONE && textures.get(t as usize).is_none_or(|x: &Texture| x.kind.slot() != slot) {
                     return Err(Error::invalid(path, None, format!("layer 'material_maps' record {m}: texture {t} is missing or not of the kind its slot names")));
                 }
             }
-            material_maps.push(entry);
         }
         Ok((Surface { header: artifact.header, uvs, shading_normals, tangents, material_maps, textures }, input))
     }

@@ -29,9 +29,12 @@ pub fn encode(positions: &[[f32; 3]], faces: &[[u32; 3]], note: &str) -> Vec<u8>
     bytes
 }
 
+/// A PLY file's positions and faces.
+pub type Decoded = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+
 /// Reads back a file [`encode`] wrote: positions and faces, or what is
 /// wrong with it.
-pub fn decode(bytes: &[u8]) -> Result<(Vec<[f32; 3]>, Vec<[u32; 3]>), String> {
+pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
     const END: &[u8] = b"end_header\n";
     let end = bytes.windows(END.len()).position(|w| w == END).ok_or("no end_header")? + END.len();
     let header = std::str::from_utf8(&bytes[..end]).map_err(|e| e.to_string())?;
