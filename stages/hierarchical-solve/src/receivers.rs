@@ -306,15 +306,17 @@ impl ReceiverTerms {
     pub fn new(h: &Hierarchy, links: &mut [Link], build: Build, cache: &mut WeightCache) -> Self {
         let to_parts: Vec<bool> = links.iter().map(|l| build.sends_to_parts(h, l)).collect();
         let tracer = build.tracer();
+        // Which links' parts this build weighs by their visibility.
         let traced: Vec<bool> = links.iter().zip(&to_parts).map(|(l, &d)| d && tracer.is_some() && l.partly_occluded()).collect();
         // The opened build's traced weights, for the links this build traces.
-        let mut opened = std::mem::take(&mut cache.opened);
-        let reused: Vec<Option<Weighing>> = links.iter().zip(&traced).map(|(l, &t)| if t { opened.remove(&(l.receiver, l.sender)) } else { None }).collect();
+        let mut from_opened = std::mem::take(&mut cache.opened);
+        let reused: Vec<Option<Weighing>> = links.iter().zip(&traced).map(|(l, &t)| if t { from_opened.remove(&(l.receiver, l.sender)) } else { None }).collect();
         let part_built: Vec<Option<Weighing>> = links
             .par_iter()
             .zip(&to_parts)
+            .zip(&traced)
             .zip(reused)
-            .map(|((l, &d), reused)| d.then(|| reused.unwrap_or_else(|| part_weights(h, l.receiver, l.sender, tracer.filter(|_| l.partly_occluded())))))
+            .map(|(((l, &d), &t), reused)| d.then(|| reused.unwrap_or_else(|| part_weights(h, l.receiver, l.sender, tracer.filter(|_| t)))))
             .collect();
         let mut seen: Vec<Option<PartViews>> = links
             .par_iter()
