@@ -5,7 +5,8 @@
 //! - [`form_factor`]: Lambert's point-to-polygon factor (paper 002 Eq. 3)
 //!   and area-averaged element factors by Dunavant quadrature.
 //! - [`sampling`]: deterministic per-work-item random streams, stratified
-//!   points on triangles, the radical inverse and the Sobol (0,2)-sequence.
+//!   points on triangles, the radical inverse, the Sobol (0,2)-sequence
+//!   and Owen-scrambled Sobol points in four dimensions.
 //! - [`bounds`]: axis-aligned boxes.
 //! - [`burial`]: whether a surface point lies inside a closed solid.
 //! - [`subdivision`]: the 1:4 element subdivision rule and point location.
