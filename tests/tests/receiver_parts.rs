@@ -164,9 +164,12 @@ fn penumbra_slopes(test: &str, args: &[&str]) -> (f64, f64, usize) {
 /// Measured (`EPS` 3e-3, area floor 1e-3 m², leaves of 3 to 12 cm, 36 to
 /// 40 leaves compared): with 1024 rays a link 11.4% relative L2 and 0.995
 /// along the reference, which checks the fit and the formula; with the
-/// default 16, 57.7% and 0.843 (seeds 2-6: 56% to 115%, 0.71 to 1.11),
-/// the noise of 16 rays a leaf, which is why the preview takes half of it
-/// (grid-gather's `MEASURED_SLOPE`).
+/// default 16, over seeds 1-8, 51% to 129% (mean 82%) and 0.58 to 1.26
+/// along it (mean 0.95), the noise of 16 rays a leaf, which is why the
+/// preview takes half of it (grid-gather's `MEASURED_SLOPE`). One seed
+/// alone swings too far to test (the link rays' sampling moved seed 1
+/// from 58% to 129%), so the 16 rays are held to their mean over the
+/// eight.
 #[test]
 fn the_solve_measures_the_lamps_slope_across_the_leaves_of_a_penumbra() {
     let args = ["--eps", "3e-3", "--min-area", "1e-3"];
@@ -174,8 +177,14 @@ fn the_solve_measures_the_lamps_slope_across_the_leaves_of_a_penumbra() {
     assert!(count >= 20, "1024 rays: only {count} floor leaves have a measured slope");
     assert!(error <= 0.2, "1024 rays: the measured slopes are {:.0}% off the quadrature's (L2)", 100.0 * error);
     assert!((0.9..=1.1).contains(&along), "1024 rays: the measured slopes are {along:.3} times the quadrature's along it");
-    let (error, along, count) = penumbra_slopes("receiver_parts_slopes_16", &args);
-    assert!(count >= 20, "16 rays: only {count} floor leaves have a measured slope");
-    assert!(error <= 0.8, "16 rays: the measured slopes are {:.0}% off the quadrature's (L2)", 100.0 * error);
-    assert!((0.7..=1.3).contains(&along), "16 rays: the measured slopes are {along:.3} times the quadrature's along it");
+    let seeds = ["1", "2", "3", "4", "5", "6", "7", "8"];
+    let (mut errors, mut alongs) = (0.0, 0.0);
+    for seed in seeds {
+        let (error, along, count) = penumbra_slopes(&format!("receiver_parts_slopes_16_seed_{seed}"), &[&args[..], &["--seed", seed]].concat());
+        assert!(count >= 20, "16 rays, seed {seed}: only {count} floor leaves have a measured slope");
+        (errors, alongs) = (errors + error, alongs + along);
+    }
+    let (error, along) = (errors / seeds.len() as f64, alongs / seeds.len() as f64);
+    assert!(error <= 1.0, "16 rays: the measured slopes are {:.0}% off the quadrature's (L2, mean over seeds 1-8)", 100.0 * error);
+    assert!((0.85..=1.15).contains(&along), "16 rays: the measured slopes are {along:.3} times the quadrature's along it (mean over seeds 1-8)");
 }
