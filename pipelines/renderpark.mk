@@ -30,6 +30,9 @@ RPK_BIN := $(RPK_DIR)/build-radiance/rpk
 RPK_THRESHOLDS ?= 3e-5,1e-4
 RPK_EPS ?= 6e-4
 RPK_RUNS ?= 9
+# More seeds whose solutions' images are averaged with the timed one's
+# (comma-separated; empty: the timed seed's image alone).
+RPK_IMAGE_SEEDS ?=
 # The reference the surfaces are measured against: hierarchical-solve at
 # this EPS (within 0.01% of EPS 1e-5 on every surface of the built-in
 # Cornell box), solved once.
@@ -70,7 +73,7 @@ $(RPK_OUT)/reference-$(RPK_REF_EPS).exr: $(BIN)/hierarchical-solve $(OUT)/params
 
 bench-renderpark: $(BINS) $(BIN)/bench-surfaces $(RPK_BIN) $(OUT)/params/grid-gather.ron $(MITSUBA_XML) $(OUT)/params/hierarchical-solve.ron $(OUT)/params/clusters $(OUT)/mesh.exr $(OUT)/manifest.ron $(OUT)/surface.exr $(CLUSTERS_EXR) $(RPK_OUT)/reference-$(RPK_REF_EPS).exr
 	python3 bench/renderpark/bench_renderpark.py --xml $(MITSUBA_XML) --rpk $(RPK_BIN) \
-	  --thresholds $(RPK_THRESHOLDS) --eps $(RPK_EPS) --runs $(RPK_RUNS) --out $(RPK_OUT) \
+	  --thresholds $(RPK_THRESHOLDS) --eps $(RPK_EPS) --runs $(RPK_RUNS) --out $(RPK_OUT) $(if $(RPK_IMAGE_SEEDS),--image-seeds $(RPK_IMAGE_SEEDS)) \
 	  --surfaces '$(BIN)/bench-surfaces --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --reference $(RPK_OUT)/reference-$(RPK_REF_EPS).exr' \
 	  $(if $(wildcard $(RPK_IMAGE_REF)),--image-reference $(RPK_IMAGE_REF)) \
 	  --preview '$(BIN)/grid-gather --params $(OUT)/params/grid-gather.ron --mode preview --mesh $(OUT)/mesh.exr --manifest $(OUT)/manifest.ron --surface $(OUT)/surface.exr' \

@@ -99,6 +99,15 @@ class Accuracy(unittest.TestCase):
         self.assertIn("| tall_block | +0.73% |", table)
         self.assertIn("| worst surface | 0.73% |", table)
 
+    def test_seeds_images_are_averaged_per_surface_they_share(self):
+        # Two seeds' reports; a surface one of them lacks is left out.
+        mean = br.averaged([(0.0200, {"floor": -0.004, "tall_block": 0.010}), (0.0180, {"floor": 0.002, "tall_block": 0.006, "ceiling": 0.001})])
+        self.assertAlmostEqual(mean[0], 0.0190)
+        self.assertEqual(set(mean[1]), {"floor", "tall_block"})
+        self.assertAlmostEqual(mean[1]["floor"], -0.001)
+        self.assertAlmostEqual(mean[1]["tall_block"], 0.008)
+        self.assertEqual(br.averaged([(0.0163, {"floor": -0.0059})]), (0.0163, {"floor": -0.0059}))
+
     def test_equal_error_interpolates_log_log_between_our_neighbours(self):
         # rpk 3e-5 at 1.63% in 0.134 s; ours 1.91% at 0.209 s and 1.34% at
         # 0.350 s (make bench-renderpark at 986a593): 1.63% at
