@@ -1,6 +1,7 @@
-//! Visibility of a link, estimated by rays between jittered stratified
-//! points on receiver and sender, each ray weighted by the form-factor
-//! kernel of its two end points, with the distance from the receiver to the
+//! Visibility of a link, estimated by rays between pairs of points on
+//! receiver and sender (Owen-scrambled Sobol pairs for a link's own rays,
+//! jittered strata for its parts': [`Pairing`]), each ray weighted by the
+//! form-factor kernel of its two end points, with the distance from the receiver to the
 //! nearest occluder that a weighted ray hit (the final gather sizes
 //! penumbrae from it, paper 000 Section 5.3).
 //!
@@ -47,8 +48,8 @@ use crate::shaft::{Among, Occluders, MOST_AMONG};
 use crate::slopes::VisibilitySlope;
 use crate::transfer;
 use radiometry::form_factor::{point_kernel, WeightedVisibility};
-use radiometry::rays::SceneRays;
 use glam::DVec3;
+use radiometry::rays::SceneRays;
 use radiometry::sampling::{point_on, ScrambledSobol, Strata, Stream};
 use schemas::solution::Node;
 
