@@ -73,19 +73,25 @@ impl FloorAndWall {
     /// factor to the lamp triangle: the centroids of the `m^2` triangles of
     /// its regular subdivision.
     pub fn triangle_factor(&self, corners: &[DVec3; 3], normal: DVec3, m: usize) -> f64 {
-        let point = |u: f64, v: f64| corners[0] + (corners[1] - corners[0]) * (u / m as f64) + (corners[2] - corners[0]) * (v / m as f64);
-        let factor = |p: DVec3| point_to_one_sided_polygon(p, normal, &self.lamp, -DVec3::Z);
-        let mut sum = 0.0;
-        for i in 0..m {
-            for j in 0..m - i {
-                sum += factor(point(i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0));
-                if i + j + 1 < m {
-                    sum += factor(point(i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0));
-                }
+        subdivision_centroids(corners, m).into_iter().map(|p| point_to_one_sided_polygon(p, normal, &self.lamp, -DVec3::Z)).sum::<f64>() / (m * m) as f64
+    }
+}
+
+/// The centroids of the `m^2` triangles, all of one area, of triangle
+/// `corners`' regular subdivision into `m` steps along each edge: the
+/// midpoint rule the tests' quadratures over a triangle use.
+pub fn subdivision_centroids(corners: &[DVec3; 3], m: usize) -> Vec<DVec3> {
+    let point = |u: f64, v: f64| corners[0] + (corners[1] - corners[0]) * (u / m as f64) + (corners[2] - corners[0]) * (v / m as f64);
+    let mut centroids = Vec::with_capacity(m * m);
+    for i in 0..m {
+        for j in 0..m - i {
+            centroids.push(point(i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0));
+            if i + j + 1 < m {
+                centroids.push(point(i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0));
             }
         }
-        sum / (m * m) as f64
     }
+    centroids
 }
 
 /// The rays and the occluders' box tree over `h`'s triangles, for a

@@ -322,10 +322,7 @@ mod tests {
     /// triangles, with the pairs' visibility tested, read 1.8% low: the
     /// rule errs across a discontinuity.)
     fn strip_visibility(h: &Hierarchy, r: u32, s: u32) -> f64 {
-        let m = 40;
-        let t = &h.elements[r as usize].points;
         let lamp = h.elements[s as usize].points;
-        let at = |u: f64, v: f64| t[0] + (t[1] - t[0]) * (u / m as f64) + (t[2] - t[0]) * (v / m as f64);
         // The lamp's part with lo <= x <= hi (Sutherland-Hodgman).
         let between = |lo: f64, hi: f64| {
             let mut polygon = lamp.to_vec();
@@ -346,19 +343,11 @@ mod tests {
             polygon
         };
         let (mut all, mut visible) = (0.0, 0.0);
-        let mut add = |x: DVec3| {
+        for x in crate::test_scenes::subdivision_centroids(&h.elements[r as usize].points, 40) {
             let whole = radiometry::form_factor::point_to_polygon(x, h.normal(r), &lamp);
             let hidden = between(0.7 - x.x, 1.2 - x.x);
             all += whole;
             visible += whole - if hidden.len() >= 3 { radiometry::form_factor::point_to_polygon(x, h.normal(r), &hidden) } else { 0.0 };
-        };
-        for i in 0..m {
-            for j in 0..m - i {
-                add(at(i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0));
-                if i + j + 1 < m {
-                    add(at(i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0));
-                }
-            }
         }
         visible / all
     }
