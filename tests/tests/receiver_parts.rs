@@ -185,6 +185,6 @@ fn the_solve_measures_the_lamps_slope_across_the_leaves_of_a_penumbra() {
         (errors, alongs) = (errors + error, alongs + along);
     }
     let (error, along) = (errors / seeds.len() as f64, alongs / seeds.len() as f64);
-    assert!(error <= 1.0, "16 rays: the measured slopes are {:.0}% off the quadrature's (L2, mean over seeds 1-8)", 100.0 * error);
+    assert!(error <= 0.9, "16 rays: the measured slopes are {:.0}% off the quadrature's (L2, mean over seeds 1-8)", 100.0 * error);
     assert!((0.85..=1.15).contains(&along), "16 rays: the measured slopes are {along:.3} times the quadrature's along it (mean over seeds 1-8)");
 }
