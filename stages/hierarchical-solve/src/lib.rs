@@ -501,7 +501,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
                 work.luminaire_rays += luminaires::extend(&mut h, &direct, params.quadrature_depth);
                 work.exposure_rays += exposure::extend(&mut h, &scene, params.seed);
                 offsets = csr_offsets(&h, &all_links, b.len());
-                receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Opened { tracer, opened: &is_opened }, &mut receiver_weights);
+                let budget = links::Budget::new(&h, &b, allowance);
+                receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Opened { tracer: tracer.budgeted(&budget), opened: &is_opened }, &mut receiver_weights);
                 work.part_rays += receivers.rays as u64;
                 let means = convergence;
                 convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, left, means.rates, &senders, &receivers);
@@ -513,7 +514,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
                 let deviation = links::leaf_deviation(&h, &b);
                 let resolution = gather::Resolution::new(&b, &deviation, convergence.rates);
                 senders = gather::SenderTerms::new(&h, &all_links, gather::Senders::Resolved { resolution, tracer });
-                receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Last { tracer, resolution: Some(resolution) }, &mut receiver_weights);
+                let budget = links::Budget::new(&h, &b, allowance);
+                receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Last { tracer: tracer.budgeted(&budget), resolution: Some(resolution) }, &mut receiver_weights);
                 direct_slopes = std::mem::take(&mut receivers.slopes);
                 // The leaves' slopes lit through their neighbours too (slopes).
                 let sent_slopes = slopes::sender_offsets(&h, &all_links, &senders, &b, &direct_slopes);

@@ -225,7 +225,9 @@ fn to_triangles(h: &Hierarchy, l: &Link, last: bool) -> bool {
 /// arguments and the same random streams, so it takes them from here where
 /// it traces the link too (a link whose parts measured it wholly visible or
 /// wholly hidden is no longer partly occluded, and is weighed anew). The
-/// same solution to the bit. On the built-in Cornell box the last build
+/// same solution to the bit, but for the parts' ray counts where a budget
+/// sets them ([`crate::links::Budget`]): the opened build counted them on
+/// the radiosity before its own solve. On the built-in Cornell box the last build
 /// casts 9% to 15% fewer part rays, and the solve is 1.9%, 1.2% and 3.5%
 /// faster at `EPS` 1.5e-3, 1e-3 and 6e-4 (one thread, interleaved medians
 /// of 11, 11 and 7).
@@ -316,7 +318,7 @@ impl ReceiverTerms {
             .zip(&to_parts)
             .zip(&traced)
             .zip(reused)
-            .map(|(((l, &d), &t), reused)| d.then(|| reused.unwrap_or_else(|| part_weights(h, l.receiver, l.sender, tracer.filter(|_| t)))))
+            .map(|(((l, &d), &t), reused)| d.then(|| reused.unwrap_or_else(|| part_weights(h, l.receiver, l.sender, tracer.filter(|_| t), l.visible()))))
             .collect();
         let mut seen: Vec<Option<PartViews>> = links
             .par_iter()
@@ -380,7 +382,7 @@ impl ReceiverTerms {
                     triangles.dedup();
                     triangles
                         .into_iter()
-                        .map(|t| (t, part_weights(h, Node::Element(t), l.sender, visibility.filter(|_| l.partly_occluded()))))
+                        .map(|t| (t, part_weights(h, Node::Element(t), l.sender, visibility.filter(|_| l.partly_occluded()), l.visible())))
                         .collect()
                 }
                 _ => Vec::new(),
@@ -602,7 +604,7 @@ type PartViews = Vec<Vec<(usize, f64)>>;
 /// 0.98% at 2.5e-4, for 6-7% more solve time (one thread; `plants-2k`
 /// 2%, its relative RMSE 2.96% -> 2.95%). 256 parts everywhere gave the
 /// same band for much more.
-fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<Tracer>) -> Weighing {
+fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<Tracer>, v_link: f64) -> Weighing {
     let Node::Element(r) = receiver else { return Weighing { shares: Vec::new(), rays: 0, measured: None, slopes: Vec::new() } };
     let visibility = visibility.map(|t| t.within(h, receiver, sender));
     let sending = Part::new(h, sender, key(receiver));
@@ -612,7 +614,7 @@ fn part_weights(h: &Hierarchy, receiver: Node, sender: Node, visibility: Option<
     let (mut rays, mut slopes) = (0, Vec::new());
     let mut weigh = |j: u32| {
         let factor = sending.weight(h, j);
-        let pairs = part_rays(h, r, j, visibility);
+        let pairs = part_rays(h, r, j, sender, factor, v_link, visibility);
         let part = &h.elements[j as usize];
         let (seen, cast) = match emitter.filter(|_| part.parent == r && part.is_leaf()) {
             Some((tracer, s)) => {
@@ -710,21 +712,26 @@ fn spread_below(h: &Hierarchy, sending: &Part, j: u32, w: f64, shares: &mut Part
     shares.extend(below.iter().map(|&(d, _, f)| (d, w * f * area / reached, j)));
 }
 
-/// Visibility rays for part `j` of receiver `r` ([`part_weights`]):
-/// [`visibility::PART_VISIBILITY_RAYS`], but a leaf right below `r` takes
-/// what a link's own visibility takes at least (`visibility`'s
-/// [`Tracer::link_rays`]): it is what refinement would have made the
+/// Visibility rays for part `j` of receiver `r` ([`part_weights`]), whose
+/// factor to `sender` is `factor`, of a link `v_link` visible: at least
+/// [`visibility::PART_VISIBILITY_RAYS`], more where the tracer's budget
+/// wants them for the light the part takes ([`Tracer::part_rays`]), and
+/// at least what a link's own visibility takes for a leaf right below `r`
+/// (`visibility`'s [`Tracer::link_rays`]): it is what refinement would have made the
 /// receiver of a link had it split this one, and where the last solve
 /// opens a leaf a shadow edge crosses ([`crate::shadowed`]) its children
 /// are the leaves that show the shadow. With 8 rays for them the floor
 /// under a lamp and an occluder in `tests/tests/receiver_parts.rs` went
 /// from 0.35% to 0.39% (L2 over the leaves, against the quadrature) at
 /// `EPS` 4e-4 as the leaves in its penumbra opened, 0.31% with 16.
-fn part_rays(h: &Hierarchy, r: u32, j: u32, visibility: Option<Tracer>) -> usize {
+fn part_rays(h: &Hierarchy, r: u32, j: u32, sender: Node, factor: f64, v_link: f64, visibility: Option<Tracer>) -> usize {
     let part = &h.elements[j as usize];
     match visibility {
-        Some(tracer) if part.parent == r && part.is_leaf() => tracer.link_rays(),
-        _ => visibility::PART_VISIBILITY_RAYS,
+        Some(tracer) => {
+            let least = if part.parent == r && part.is_leaf() { tracer.link_rays() } else { visibility::PART_VISIBILITY_RAYS };
+            tracer.part_rays(h, j, sender, factor, v_link, least)
+        }
+        None => visibility::PART_VISIBILITY_RAYS,
     }
 }
 

@@ -43,7 +43,7 @@
 //! other candidate, would count the rays through the block's body again.
 
 use crate::elements::Hierarchy;
-use crate::links::{Link, Linking};
+use crate::links::{Budget, Link, Linking};
 use crate::shaft::{Among, Occluders, MOST_AMONG};
 use crate::slopes::VisibilitySlope;
 use crate::transfer;
@@ -122,13 +122,29 @@ pub struct Tracer<'a> {
     among: Option<Among>,
     /// The fewest rays a link's own visibility takes (`--visibility-rays`).
     link_rays: usize,
+    /// What counts the rays of a link's receiver's parts, where given
+    /// ([`Budget::part_rays`]).
+    budget: Option<&'a Budget<'a>>,
 }
 
 impl<'a> Tracer<'a> {
     /// Rays through the whole `scene` (`occluders` over the same
     /// triangles), for links traced with at least `link_rays` rays.
     pub fn new(scene: &'a SceneRays, occluders: &'a Occluders, seed: u64, link_rays: usize) -> Self {
-        Tracer { scene, occluders, seed, among: None, link_rays }
+        Tracer { scene, occluders, seed, among: None, link_rays, budget: None }
+    }
+
+    /// This tracer with the parts of a link's receiver counting their rays
+    /// by `budget`.
+    pub fn budgeted(self, budget: &'a Budget<'a>) -> Self {
+        Tracer { budget: Some(budget), ..self }
+    }
+
+    /// Rays for element `part` of a link's receiver, whose factor to the
+    /// link's `sender` is `factor`, the link `v` visible: `least`, or what
+    /// the budget counts where there is one.
+    pub fn part_rays(&self, h: &Hierarchy, part: u32, sender: Node, factor: f64, v: f64, least: usize) -> usize {
+        self.budget.map_or(least, |b| b.part_rays(h, part, sender, factor, v, least))
     }
 
     /// The fewest rays a link's own visibility takes.
