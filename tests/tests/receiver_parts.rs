@@ -164,12 +164,15 @@ fn penumbra_slopes(test: &str, args: &[&str]) -> (f64, f64, usize) {
 /// Measured (`EPS` 3e-3, area floor 1e-3 m², leaves of 3 to 12 cm, 36 to
 /// 40 leaves compared): with 1024 rays a link 11.4% relative L2 and 0.995
 /// along the reference, which checks the fit and the formula; with the
-/// default 16, over seeds 1-8, 51% to 129% (mean 82%) and 0.58 to 1.26
-/// along it (mean 0.95), the noise of 16 rays a leaf, which is why the
-/// preview takes half of it (grid-gather's `MEASURED_SLOPE`). One seed
-/// alone swings too far to test (the link rays' sampling moved seed 1
-/// from 58% to 129%), so the 16 rays are held to their mean over the
-/// eight.
+/// default 16, over seeds 1-8, 51% to 78% (mean 61%) and 0.82 to 1.10
+/// along it (mean 0.97), the noise of the leaves' rays, which is why the
+/// preview takes half of it (grid-gather's `MEASURED_SLOPE`). Those rays
+/// are at least 16 a leaf, more where the lamp's light on it calls for
+/// them (hierarchical-solve's `links::Budget`); with 16 everywhere the
+/// eight seeds gave 51% to 129% (mean 82%) and 0.58 to 1.26 (mean 0.95),
+/// and the bound on the mean, 75%, holds that gain. One seed alone swings
+/// too far to test (the link rays' sampling moved seed 1 from 58% to
+/// 129%), so the default is held to its mean over the eight.
 #[test]
 fn the_solve_measures_the_lamps_slope_across_the_leaves_of_a_penumbra() {
     let args = ["--eps", "3e-3", "--min-area", "1e-3"];
@@ -185,6 +188,6 @@ fn the_solve_measures_the_lamps_slope_across_the_leaves_of_a_penumbra() {
         (errors, alongs) = (errors + error, alongs + along);
     }
     let (error, along) = (errors / seeds.len() as f64, alongs / seeds.len() as f64);
-    assert!(error <= 0.9, "16 rays: the measured slopes are {:.0}% off the quadrature's (L2, mean over seeds 1-8)", 100.0 * error);
+    assert!(error <= 0.75, "16 rays: the measured slopes are {:.0}% off the quadrature's (L2, mean over seeds 1-8)", 100.0 * error);
     assert!((0.85..=1.15).contains(&along), "16 rays: the measured slopes are {along:.3} times the quadrature's along it (mean over seeds 1-8)");
 }
