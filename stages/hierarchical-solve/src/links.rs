@@ -694,7 +694,7 @@ pub fn visibility_rays(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], dimme
 /// half its share ([`visibility_rays`]); its parts' rays, in the last
 /// solve, decide where on its receiver its light lands, and each part's
 /// noise is then all of that part's error from the link: with 8 rays a
-/// part, seed to seed, that noise was 44% of the preview's squared error
+/// part, seed to seed, that noise was 43% of the preview's squared error
 /// on the built-in Cornell box at `EPS` 1e-3 (against Mitsuba, seeds
 /// 1-16). The preview over seeds 1-16 (relative RMSE) at `EPS` 1.5e-3,
 /// 1e-3 and 6.5e-4 went from 2.304%, 1.560% and 1.185% to 2.101%, 1.392%
