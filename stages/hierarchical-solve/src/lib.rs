@@ -26,7 +26,7 @@
 //! first pass, before any solve, refines with the absolute criterion), with
 //! a floor of `relative_floor` times the mean reflected radiosity so that
 //! black receivers terminate, and it sees a sender's radiosity variation at
-//! every level below it ([`links::leaf_deviation`]), not only at its
+//! every level below it ([`links::leaf_range`]), not only at its
 //! children, whose means can hide a bright spot. On the Cornell box at the
 //! default `eps` it moved the surfaces' means toward the reference (full
 //! gather: short block +15.5% -> +3.7%, tall block -7.5% -> -5.3%, floor
@@ -392,8 +392,8 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let allowance = allowance(params, threshold, (pass > 1).then(|| mean_reflected(&h, &b)));
         // The relative criterion sees a sender's variation at every level
         // below it; the absolute one only at its children, as before.
-        let (deviation, dimmest) = match allowance {
-            Allowance::Relative { .. } => (links::leaf_deviation(&h, &b), links::dimmest_leaf(&h, &b)),
+        let (range, dimmest) = match allowance {
+            Allowance::Relative { .. } => (links::leaf_range(&h, &b), links::dimmest_leaf(&h, &b)),
             Allowance::Absolute(_) => (Vec::new(), Vec::new()),
         };
         let linking = Linking { quadrature: allowance.quadrature(rates, params.quadrature_depth), ..linking };
@@ -402,7 +402,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // previous pass sorted them in: those it kept first (sort_links).
         let mut in_order = None;
         while !active.is_empty() {
-            let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, &deviation, &dimmest, &allowance, floors)).collect();
+            let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, &range, &dimmest, &allowance, floors)).collect();
             for (l, d) in active.iter().zip(&decisions) {
                 let node = match d {
                     Split::Sender => l.sender,
