@@ -239,6 +239,10 @@ pub struct Work {
     /// Bound of the irradiance the specular depth bound leaves out, W/m²
     /// ([`mirrors::Couplings::truncation`]), last pass.
     pub specular_truncation: f64,
+    /// The scene's windows where they are more than
+    /// [`mirrors::MAX_WINDOWS`] and their specular light was left out; 0
+    /// otherwise.
+    pub specular_windows_left_out: usize,
 }
 
 /// Progress of a solve, reported as each phase of a pass begins and when
@@ -333,7 +337,11 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         sender_level: params.specular_sender_level,
         max_events: params.specular_depth,
     };
-    let windows = mirrors::Windows::new(mesh, manifest, &h, knobs);
+    // More windows than can be traced: no specular light (mirrors::MAX_WINDOWS).
+    let windows = mirrors::Windows::new(mesh, manifest, &h, knobs).unwrap_or_else(|count| {
+        work.specular_windows_left_out = count;
+        None
+    });
     // Luminaires first (crate::luminaires): their direct light on the input
     // triangles, which joins the emission in the scale of the threshold,
     // then the elements refined for it.

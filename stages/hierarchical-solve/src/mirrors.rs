@@ -155,6 +155,19 @@ pub struct Knobs {
     pub max_events: u32,
 }
 
+/// Most windows whose couplings a solve traces. Every leaf takes the
+/// images of every sender in every window, and of those images in every
+/// window again up to `specular_depth` in a row, so the work grows with
+/// the windows' count to that power. A curved mirror or pane is as many
+/// windows as it has facets: McGuire's `CornellBox-Sphere`, whose mirror
+/// sphere and glass sphere are 2,176 of its 2,188 triangles, ran for over
+/// 11 minutes on one thread at `EPS` 0.1 without finishing its first
+/// pass's couplings. A scene with more windows than this is solved without
+/// its specular light, and the solve says so ([`Windows::new`]; on stderr
+/// and in the report's notes). The benchmark's mirror scenes have 5 and 2
+/// (`bench/assets/mirror`).
+pub const MAX_WINDOWS: usize = 64;
+
 /// The scene's windows and which triangle belongs to which.
 pub struct Windows {
     /// The windows.
@@ -314,13 +327,14 @@ pub fn mirror_direction(d: DVec3, n: DVec3) -> DVec3 {
 }
 
 impl Windows {
-    /// The windows of `mesh`, or `None` when the scene has no specular
-    /// reflection or transmission. `rays` per coupling, couplings under
+    /// The windows of `mesh`, or `Ok(None)` when the scene has no specular
+    /// reflection or transmission; `Err` with their count where there are
+    /// more than [`MAX_WINDOWS`]. `rays` per coupling, couplings under
     /// `min_factor` dropped, form factors to quadrature depth `depth`.
-    pub fn new(mesh: &Mesh, manifest: &Manifest, h: &Hierarchy, knobs: Knobs) -> Option<Windows> {
+    pub fn new(mesh: &Mesh, manifest: &Manifest, h: &Hierarchy, knobs: Knobs) -> Result<Option<Windows>, usize> {
         let e = &manifest.effects;
         if !(e.specular_reflection || e.specular_transmission) {
-            return None;
+            return Ok(None);
         }
         let scale = h.triangles.iter().flat_map(|t| t.corners).map(|p| p.abs().max_element()).fold(1e-12, f64::max);
         let mut windows: Vec<(u32, Window)> = Vec::new();
@@ -352,8 +366,11 @@ impl Windows {
             of_triangle[t] = Some(index as u32);
             windows[index].1.corners.extend(g.corners);
         }
+        if windows.len() > MAX_WINDOWS {
+            return Err(windows.len());
+        }
         let Knobs { rays, min_factor, quadrature, seed, sender_level, max_events } = knobs;
-        Some(Windows {
+        Ok(Some(Windows {
             windows: windows.into_iter().map(|(_, w)| w).collect(),
             of_triangle,
             rays,
@@ -363,7 +380,7 @@ impl Windows {
             seed,
             sender_level,
             traced: Mutex::new(Traced::default()),
-        })
+        }))
     }
 
     /// The couplings into the current leaves of `h` (module docs), with
@@ -523,5 +540,44 @@ impl Windows {
             }
         }
         (if total > 0.0 { clear / total } else { 0.0 }, cast)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::dvec3;
+    use std::f64::consts::TAU;
+    use test_support::meshes::{manifest, material, quads};
+
+    /// A ring of `n` mirror quads standing round a unit circle, each
+    /// facing its centre: `n` planes, as a tessellated curved mirror is.
+    fn ring(n: usize) -> (Mesh, Manifest) {
+        let faces: Vec<_> = (0..n)
+            .map(|i| {
+                let a = TAU * i as f64 / n as f64;
+                let tangent = dvec3(-a.sin(), a.cos(), 0.0) * 0.1;
+                (dvec3(a.cos(), a.sin(), 0.0), dvec3(0.0, 0.0, 0.1), tangent, 0, 0)
+            })
+            .collect();
+        let mut mirror = material([0.05; 3], [0.0; 3]);
+        mirror.specular_reflectance = [0.9; 3];
+        let mut manifest = manifest(1, vec![mirror]);
+        manifest.effects.specular_reflection = true;
+        (quads(&faces), manifest)
+    }
+
+    /// A curved mirror of [`MAX_WINDOWS`] facets is traced, window by
+    /// window; one of a facet more is refused with its count, which the
+    /// solve then reports and solves without (`lib.rs`, `report.rs`).
+    #[test]
+    fn a_mirror_of_more_facets_than_the_windows_traced_is_left_out() {
+        let knobs = Knobs { rays: 16, min_factor: 1e-6, quadrature: 2, seed: 1, sender_level: 0, max_events: 2 };
+        for (n, wanted) in [(MAX_WINDOWS, Ok(MAX_WINDOWS)), (MAX_WINDOWS + 1, Err(MAX_WINDOWS + 1))] {
+            let (mesh, manifest) = ring(n);
+            let h = Hierarchy::new(&mesh, &manifest, None, None);
+            let windows = Windows::new(&mesh, &manifest, &h, knobs).map(|w| w.map_or(0, |w| w.windows.len()));
+            assert_eq!(windows, wanted, "{n} facets");
+        }
     }
 }

@@ -47,6 +47,13 @@ pub fn done(work: &Work, params: &Params, mesh: &Mesh, manifest: &Manifest, surf
             count("specular_truncation_bound", w.specular_truncation);
         }
     }
+    if w.specular_windows_left_out > 0 {
+        done.notes.push(format!(
+            "specular light not simulated: the mirrors and panes lie in {} planes, more than the {} whose couplings a solve traces (a curved mirror or pane is one plane per facet); they reflect diffusely only",
+            w.specular_windows_left_out,
+            crate::mirrors::MAX_WINDOWS
+        ));
+    }
     // Left out where unknown (no contraction below 1 was known).
     for (name, value) in [("error_bound", w.error_bound), ("contraction", w.contraction)] {
         if value.is_finite() {
