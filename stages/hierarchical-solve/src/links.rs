@@ -633,15 +633,18 @@ fn decide_elements(h: &Hierarchy, link: &Link, radiosity: &[[f64; 3]], range: &[
     let b = radiosity[h.flat(link.sender)];
     let reflected = brightest_reflected(rho, b);
     let sender_element = &h.elements[sender as usize];
-    let spread = match range.get(sender as usize) {
+    // Its leaves' range, or without ranges (the absolute criterion) its
+    // children's.
+    let sender_range = match range.get(sender as usize) {
         _ if sender_element.is_leaf() => [0.0; 3],
         Some(&r) => r,
         None => {
             let children = (sender_element.first_child..sender_element.first_child + 4).map(|child| radiosity[h.flat(Node::Element(child))]);
-            std::array::from_fn(|c| children.clone().map(|x| x[c]).fold(f64::NEG_INFINITY, f64::max) - children.clone().map(|x| x[c]).fold(f64::INFINITY, f64::min))
+            let (lo, hi) = children.fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), x| (std::array::from_fn(|c| lo[c].min(x[c])), std::array::from_fn(|c| hi[c].max(x[c]))));
+            std::array::from_fn(|c| hi[c] - lo[c])
         }
     };
-    let sender_variation = (0..3).map(|c| rho[c] * spread[c]).fold(0.0, f64::max);
+    let sender_variation = (0..3).map(|c| rho[c] * sender_range[c]).fold(0.0, f64::max);
     let threshold = link.share(h, allowance, radiosity[h.flat(link.receiver)], reflected, dim);
     let errors = [
         (reflected * link.spread, Split::Receiver),

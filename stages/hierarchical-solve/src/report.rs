@@ -67,7 +67,7 @@ pub fn done(work: &Work, params: &Params, mesh: &Mesh, manifest: &Manifest, surf
         ));
     }
     let one_sided = Transmission::new(mesh, manifest).map_or(0, |t| t.one_sided);
-    done.skipped = skipped(&manifest.effects, surface, one_sided);
+    done.skipped = skipped(&manifest.effects, surface, one_sided, w.specular_windows_left_out == 0);
     if !clustered && manifest.effects.fine_clustered_geometry {
         done.skipped.push("clustering: no --clusters given; every pair of input triangles starts linked".to_string());
     }
@@ -77,13 +77,16 @@ pub fn done(work: &Work, params: &Params, mesh: &Mesh, manifest: &Manifest, surf
 /// What this stage does not simulate, for the effects the scene has;
 /// `surface`: whether surface.exr was given (textures, alpha masks and
 /// normal maps are simulated from it); `one_sided`: triangles of
-/// translucent materials that are not two-sided (they cannot transmit).
-fn skipped(effects: &Effects, surface: bool, one_sided: usize) -> Vec<String> {
+/// translucent materials that are not two-sided (they cannot transmit);
+/// `specular`: whether the mirrors and panes were traced (the limits of
+/// that tracing are listed only then; where they were left out, the note
+/// says so).
+fn skipped(effects: &Effects, surface: bool, one_sided: usize, specular: bool) -> Vec<String> {
     let transmits = format!("diffuse transmission: {one_sided} triangles of translucent materials that are not two-sided transmit nothing (their back face has no elements; make the material two_sided)");
     Effects::skipped(&[
         (!effects.diffuse_interreflection, "interreflection passes: no surface both receives light and reflects it; direct light only"),
-        (effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, up to --specular-depth mirrors and panes per path (light meeting one more stops there), senders at their elements' mean radiosity --specular-sender-level levels down; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
-        (effects.specular_transmission, "specular transmission: thin panes by transmitted senders, in the chains of up to --specular-depth mirrors and panes per path; no refraction bending by thick glass (a pane is a thin plate: light goes straight through)"),
+        (specular && effects.specular_reflection, "specular reflection: planar mirrors by virtual senders, up to --specular-depth mirrors and panes per path (light meeting one more stops there), senders at their elements' mean radiosity --specular-sender-level levels down; no glossy reflection (a curved mirror is its facets), goniometric lights not mirrored"),
+        (specular && effects.specular_transmission, "specular transmission: thin panes by transmitted senders, in the chains of up to --specular-depth mirrors and panes per path; no refraction bending by thick glass (a pane is a thin plate: light goes straight through)"),
         (effects.diffuse_transmission && one_sided > 0, &transmits),
         (effects.textures && !surface, "textures: no --surface given; radiosity uses each material's diffuse reflectance"),
         (effects.alpha_masks && !surface, "alpha masks: no --surface given; surfaces are treated as opaque"),
