@@ -12,6 +12,13 @@
 //! against another surface: a block flush against a wall has its face
 //! where the wall's front is, and a grazing ray meets both at one distance
 //! ([`COINCIDENT`]); the back face decides.
+//!
+//! A one-sided sheet lying low over a surface, its back towards it (a
+//! lamp hung 1 cm under a ceiling), buries the points under its middle
+//! too: light reaches them only within 6 degrees of their plane. But the
+//! points under it near its edge are open, so a roof vouches for the other
+//! points under it only where the grazing rays met walls across its plane,
+//! a solid's ([`Walls`]).
 
 use crate::rays::SceneRays;
 use crate::sampling::Stream;
@@ -61,37 +68,66 @@ pub fn roof(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, n
 /// their f32 origin). It is under a [`roof`] and [`walled_in`].
 pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, stream: &mut Stream) -> (bool, u64) {
     let turn = 2.0 * PI * stream.next_f64();
-    if roof(scene, normal_of, point, normal, triangle, t_min).is_none() {
-        return (false, 1);
-    }
-    let (walled, cast) = grazing(scene, normal_of, point, normal, triangle, t_min, turn);
-    (walled, 1 + cast)
+    let Some(over) = roof(scene, normal_of, point, normal, triangle, t_min) else { return (false, 1) };
+    let (walls, cast) = grazing(scene, normal_of, point, normal, triangle, over, t_min, turn);
+    (walls.buried(), 1 + cast)
 }
 
-/// The rest of [`buried`] for a point whose [`roof`] is known to be
-/// there: whether each of its [`GRAZING_RAYS`] meets a back face first,
-/// under one random turn drawn from `stream`, and the rays cast. A caller
-/// that has cast the ray along the normal itself need not cast it again.
-pub fn walled_in(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, stream: &mut Stream) -> (bool, u64) {
-    let turn = 2.0 * PI * stream.next_f64();
-    grazing(scene, normal_of, point, normal, triangle, t_min, turn)
+/// What the grazing rays of a point under a roof found ([`walled_in`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Walls {
+    /// A ray left the scene or met a front face first: the point is open.
+    Open,
+    /// Every ray met a back face first, and some of them one parallel to
+    /// the roof: a sheet lies low over the surface (a lamp hung just under
+    /// a ceiling), the point is buried, but the sheet's edge, open to the
+    /// room, may lie near another point under the same roof.
+    Sheet,
+    /// Every ray met the back face of a wall across the roof's plane
+    /// first: a solid closes down onto the surface round the point (a
+    /// block on a floor), and every other point under the same roof lies
+    /// inside it too.
+    Solid,
 }
+
+impl Walls {
+    /// Whether the point is buried.
+    pub fn buried(self) -> bool {
+        self != Walls::Open
+    }
+}
+
+/// The rest of [`buried`] for a point whose [`roof`] `over` is known:
+/// what its [`GRAZING_RAYS`] meet first, under one random turn drawn from
+/// `stream`, and the rays cast. A caller that has cast the ray along the
+/// normal itself need not cast it again.
+#[allow(clippy::too_many_arguments)]
+pub fn walled_in(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, over: u32, t_min: f32, stream: &mut Stream) -> (Walls, u64) {
+    let turn = 2.0 * PI * stream.next_f64();
+    grazing(scene, normal_of, point, normal, triangle, over, t_min, turn)
+}
+
+/// Cosine above which a back face a grazing ray meets counts as parallel
+/// to the roof ([`Walls::Sheet`]).
+const PARALLEL: f64 = 1.0 - 1e-6;
 
 /// [`walled_in`] with its turn in azimuth, radians.
-fn grazing(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, turn: f64) -> (bool, u64) {
+#[allow(clippy::too_many_arguments)]
+fn grazing(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, over: u32, t_min: f32, turn: f64) -> (Walls, u64) {
     let helper = if normal.x.abs() > 0.5 { DVec3::Y } else { DVec3::X };
     let u = normal.cross(helper).normalize();
     let v = normal.cross(u);
     let sin_grazing = (1.0 - GRAZING_COS * GRAZING_COS).sqrt();
+    let roof_normal = normal_of(over);
     // Second queries of the coincidence rule, counted as rays.
-    let mut extra = 0;
+    let (mut extra, mut sheet) = (0, false);
     for k in 1..EXPOSURE_RAYS {
         let phi = turn + 2.0 * PI * k as f64 / GRAZING_RAYS as f64;
         let direction = normal * GRAZING_COS + u * (sin_grazing * phi.cos()) + v * (sin_grazing * phi.sin());
         let back = |t: u32| normal_of(t).dot(direction) > 0.0;
         let back_face = match scene.closest_hit(point, direction, t_min, f32::INFINITY, [triangle, u32::MAX]) {
-            None => false,
-            Some(hit) if back(hit.triangle) => true,
+            None => None,
+            Some(hit) if back(hit.triangle) => Some(hit.triangle),
             // A front face with a back face in the same place (a block
             // pushed flush against a wall: the wall's front and the block's
             // face coincide) closes the solid: a grazing ray from the floor
@@ -99,14 +135,13 @@ fn grazing(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, no
             // traversal returns first.
             Some(hit) => {
                 extra += 1;
-                scene.closest_hit(point, direction, t_min, hit.t * (1.0 + COINCIDENT) + t_min, [triangle, hit.triangle]).is_some_and(|other| back(other.triangle))
+                scene.closest_hit(point, direction, t_min, hit.t * (1.0 + COINCIDENT) + t_min, [triangle, hit.triangle]).map(|other| other.triangle).filter(|&t| back(t))
             }
         };
-        if !back_face {
-            return (false, k as u64 + extra);
-        }
+        let Some(face) = back_face else { return (Walls::Open, k as u64 + extra) };
+        sheet |= normal_of(face).dot(roof_normal) > PARALLEL;
     }
-    (true, GRAZING_RAYS as u64 + extra)
+    (if sheet { Walls::Sheet } else { Walls::Solid }, GRAZING_RAYS as u64 + extra)
 }
 
 #[cfg(test)]
@@ -175,5 +210,34 @@ mod tests {
         let point = dvec3(0.7, 0.3, 0.0);
         assert_eq!(roof(&up_sheet, &|t| up_normals[t as usize], point, DVec3::Z, 1, 1e-6), Some(0));
         assert!(!buried(&up_sheet, &|t| up_normals[t as usize], point, DVec3::Z, 1, 1e-6, &mut Stream::new(1, 2, 3)).0, "under a sheet facing up");
+        // The grazing rays from under the cube meet its walls: a solid,
+        // whose roof holds every point under it.
+        let (walls, _) = walled_in(&scene, &normal_of, dvec3(0.5, 0.5, 0.0), DVec3::Z, floor, 2, 1e-6, &mut Stream::new(7, 8, 9));
+        assert_eq!(walls, Walls::Solid);
+    }
+
+    /// A sheet facing up 1 cm over a floor, 2 m wide (a lamp hung just
+    /// under a ceiling, upside down): a point under its middle is buried,
+    /// every grazing ray meeting the sheet's back, but that proves nothing
+    /// for the other points under it ([`Walls::Sheet`]): one 5 cm inside
+    /// its edge, under the same triangle, sees out under the edge.
+    #[test]
+    fn a_sheet_low_over_a_point_buries_it_without_burying_all_it_covers() {
+        let big = 5.0;
+        let triangles = [
+            [dvec3(-1.0, -1.0, 0.01), dvec3(1.0, -1.0, 0.01), dvec3(1.0, 1.0, 0.01)],
+            [dvec3(-1.0, -1.0, 0.01), dvec3(1.0, 1.0, 0.01), dvec3(-1.0, 1.0, 0.01)],
+            [dvec3(-big, -big, 0.0), dvec3(big, -big, 0.0), dvec3(big, big, 0.0)],
+        ];
+        let normals = [DVec3::Z, DVec3::Z, DVec3::Z];
+        let scene = SceneRays::new(&triangles);
+        let normal_of = |t: u32| normals[t as usize];
+        let (middle, edge) = (dvec3(0.3, -0.4, 0.0), dvec3(0.95, -0.5, 0.0));
+        assert_eq!(roof(&scene, &normal_of, middle, DVec3::Z, 2, 1e-6), Some(0));
+        assert_eq!(roof(&scene, &normal_of, edge, DVec3::Z, 2, 1e-6), Some(0), "the same roof");
+        let mut stream = Stream::new(1, 2, 3);
+        assert_eq!(walled_in(&scene, &normal_of, middle, DVec3::Z, 2, 0, 1e-6, &mut stream).0, Walls::Sheet);
+        assert_eq!(walled_in(&scene, &normal_of, edge, DVec3::Z, 2, 0, 1e-6, &mut stream).0, Walls::Open);
+        assert!(buried(&scene, &normal_of, middle, DVec3::Z, 2, 1e-6, &mut stream).0);
     }
 }
