@@ -35,9 +35,9 @@
 //!    towards the sender's centre times its own cosine to that centre,
 //!    which is Lambert's factor only where the sender is small as seen from
 //!    the pixel. For a wide or near sender the receiver's cosine varies
-//!    over it, however little the factor varies from point to point: a
-//!    floor 12 m wide 1 m under a ceiling, 0.5 m off the floor's centre
-//!    line, that product is 19% under Lambert's factor. So at the first
+//!    over it, however little the factor varies from point to point:
+//!    under a floor 12 m wide 1 m below, 0.5 m off its centre line, that
+//!    product is 19% under Lambert's factor. So at the first
 //!    [`FACTORING_SAMPLES`] samples the factored form is set against
 //!    Lambert's factor for each receiver normal near the vertex (at most
 //!    [`MOST_NORMALS`]), and the largest difference is `e_F`
