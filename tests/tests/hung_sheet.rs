@@ -38,11 +38,16 @@ const FLOOR_HALF: f64 = 6.0;
 /// The sheet's extent in x and y.
 const SHEET: ([f64; 2], [f64; 2]) = ([-0.2, 0.2], [-0.15, 0.15]);
 
+/// The emitting floor's corners.
+fn floor() -> [[f64; 3]; 4] {
+    rectangle(2, -DEPTH, [-FLOOR_HALF, -FLOOR_HALF], [FLOOR_HALF, FLOOR_HALF])
+}
+
 fn scene() -> QuadScene {
     let mut scene = QuadScene { camera: ([0.0, -0.7, -0.45], [0.0, 0.05, 0.0]), ..Default::default() };
     scene.material("ceiling", RHO, 0.0).material("floor", 0.0, 1.0).material("black", 0.0, 0.0);
     scene.quad("ceiling", "ceiling", rectangle(2, 0.0, [-1.0, -1.0], [1.0, 1.0]), [0.0, 0.0, -1.0]);
-    scene.quad("floor", "floor", rectangle(2, -DEPTH, [-FLOOR_HALF, -FLOOR_HALF], [FLOOR_HALF, FLOOR_HALF]), [0.0, 0.0, 1.0]);
+    scene.quad("floor", "floor", floor(), [0.0, 0.0, 1.0]);
     scene.quad("sheet", "black", rectangle(2, -GAP, [SHEET.0[0], SHEET.1[0]], [SHEET.0[1], SHEET.1[1]]), [0.0, 0.0, -1.0]);
     scene
 }
@@ -52,8 +57,7 @@ fn scene() -> QuadScene {
 /// projection from `x` onto the sheet's plane (module docs).
 fn radiosity(x: [f64; 3]) -> f64 {
     let down = [0.0, 0.0, -1.0];
-    let floor = rectangle(2, -DEPTH, [-FLOOR_HALF, -FLOOR_HALF], [FLOOR_HALF, FLOOR_HALF]);
-    let open = lambert_polygon(x, down, &floor);
+    let open = lambert_polygon(x, down, &floor());
     // The floor's projection onto z = -GAP from x: x + (c - x) GAP / DEPTH.
     let t = GAP / DEPTH;
     let projected = |a: usize, c: f64| x[a] + (c - x[a]) * t;
@@ -104,7 +108,7 @@ fn a_sheet_hung_one_centimetre_below_a_ceiling() {
     let manifest = read_ron::<Manifest>(&manifest_path).unwrap().value;
     let (solution, _) = Solution::read(&solution_path).unwrap();
     let ceiling = manifest.objects.iter().position(|o| o == "ceiling").unwrap() as u32;
-    let open = RHO * lambert_polygon([0.0; 3], [0.0, 0.0, -1.0], &rectangle(2, -DEPTH, [-FLOOR_HALF, -FLOOR_HALF], [FLOOR_HALF, FLOOR_HALF]));
+    let open = RHO * lambert_polygon([0.0; 3], [0.0, 0.0, -1.0], &floor());
 
     let (mut worst_leaf, mut leaves) = (0.0f64, 0);
     for e in solution.elements.iter().filter(|e| e.is_leaf() && mesh.triangles[e.triangle as usize].object == ceiling) {

@@ -117,9 +117,9 @@ struct Sampled {
 /// `CornellBox-Original` at `EPS` 7e-4 the full gather's mean signed error
 /// against the full gather of an `EPS` 2.5e-5 solve went from +0.29% and
 /// +0.34% to +0.14% and +0.17% (seeds 1 and 2), for a third more exposure
-/// rays (113k -> 150k) and no change in the solve time (single runs). The built-in Cornell box's
-/// solutions are unchanged to the bit: the grazing rays from under its
-/// blocks meet their walls.
+/// rays (113k -> 150k) and no change in the solve time (single runs).
+/// The built-in Cornell box's solutions are unchanged to the bit: the
+/// grazing rays from under its blocks meet their walls.
 fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: &[u32], stream: &mut Stream) -> Sampled {
     let element = &h.elements[e as usize];
     let normal = h.normal(e);
