@@ -161,6 +161,23 @@ impl<'a> Senders<'a> {
         element
     }
 
+    /// The input triangles whose bounding boxes overlap `region`, sorted.
+    pub fn triangles_near(&self, region: &Aabb) -> Vec<u32> {
+        let (lo, hi) = (self.bin(region.min), self.bin(region.max));
+        let mut candidates = Vec::new();
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    candidates.extend_from_slice(&self.bins[(z * self.bin_n + y) * self.bin_n + x]);
+                }
+            }
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
+        candidates.retain(|&t| Aabb::around(self.triangles[t as usize].corners).overlaps(region));
+        candidates
+    }
+
     /// Link indices arriving at every receiver that overlaps `region`: the
     /// clusters overlapping it and the clusters above them (000 Sec. 4.3),
     /// and the elements overlapping it on the triangles overlapping it and
@@ -181,21 +198,7 @@ impl<'a> Senders<'a> {
                 }
             }
         }
-        let (lo, hi) = (self.bin(region.min), self.bin(region.max));
-        let mut candidates = Vec::new();
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    candidates.extend_from_slice(&self.bins[(z * self.bin_n + y) * self.bin_n + x]);
-                }
-            }
-        }
-        candidates.sort_unstable();
-        candidates.dedup();
-        for t in candidates {
-            if !Aabb::around(self.triangles[t as usize].corners).overlaps(region) {
-                continue;
-            }
+        for t in self.triangles_near(region) {
             let mut stack = vec![t];
             while let Some(e) = stack.pop() {
                 if !Aabb::around(self.element_corners(e)).overlaps(region) {
