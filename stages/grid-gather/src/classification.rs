@@ -370,7 +370,8 @@ impl FullGather<'_> {
         let (lo, hi) = self.around(v);
         let corners = (0..8).map(|m| self.grid.point(std::array::from_fn(|a| if (m >> a) & 1 == 0 { lo[a] } else { hi[a] })));
         let region = Aabb::around(corners);
-        let links = self.senders.links_near(&region);
+        let receivers = self.senders.triangles_near(&region);
+        let links = self.senders.links_near(&region, &receivers);
         let mut by_sender: BTreeMap<Node, SenderLinks> = BTreeMap::new();
         let (mut rho_area, mut area) = (0.0, 0.0);
         for &l in &links {
@@ -384,7 +385,6 @@ impl FullGather<'_> {
                 s.occluder = s.occluder.min(f64::from(link.occluder_distance));
             }
         }
-        let receivers = self.senders.triangles_near(&region);
         let normals = receiver_normals(receivers.iter().map(|&t| self.senders.triangles[t as usize].normal));
         for &t in &receivers {
             let a = self.senders.triangles[t as usize].area;

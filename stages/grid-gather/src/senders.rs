@@ -180,9 +180,10 @@ impl<'a> Senders<'a> {
 
     /// Link indices arriving at every receiver that overlaps `region`: the
     /// clusters overlapping it and the clusters above them (000 Sec. 4.3),
-    /// and the elements overlapping it on the triangles overlapping it and
-    /// their ancestors. Sorted, each once.
-    pub fn links_near(&self, region: &Aabb) -> Vec<usize> {
+    /// and the elements overlapping it on the triangles `near` (those
+    /// overlapping it, [`Self::triangles_near`], which the caller needs too)
+    /// and their ancestors. Sorted, each once.
+    pub fn links_near(&self, region: &Aabb, near: &[u32]) -> Vec<usize> {
         let mut out = Vec::new();
         if let Some(c) = self.clusters {
             let mut stack = vec![0u32];
@@ -198,7 +199,7 @@ impl<'a> Senders<'a> {
                 }
             }
         }
-        for t in self.triangles_near(region) {
+        for &t in near {
             let mut stack = vec![t];
             while let Some(e) = stack.pop() {
                 if !Aabb::around(self.element_corners(e)).overlaps(region) {
