@@ -78,23 +78,12 @@ stage_kit::knobs! {
 }
 
 
-/// The per-pixel threshold, row-major, top row first.
+/// The model's thresholds of an image, as the stage writes them, and the
+/// figures its report gives.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Thresholds {
-    /// Pixels per row.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// Display luminance `L_d`, cd/m².
-    pub luminance: Vec<f32>,
-    /// Adaptation luminance `L_a`, cd/m².
-    pub adaptation: Vec<f32>,
-    /// Masking threshold elevation `T_e >= 1`.
-    pub elevation: Vec<f32>,
-    /// `TVI(L_a) T_e`, cd/m².
-    pub threshold: Vec<f32>,
-    /// `threshold / max(L_d, L_black)`: the threshold as a contrast.
-    pub contrast: Vec<f32>,
+    /// The per-pixel threshold, row-major, top row first.
+    pub image: ThresholdImage,
     /// Work counters for the report.
     pub counters: BTreeMap<String, f64>,
 }
@@ -119,8 +108,8 @@ pub fn display_luminance(pixels: &[[u8; 3]], display_max_cd_m2: f64) -> Vec<f64>
 }
 
 /// Runs the model over a `width` x `height` image of display luminances
-/// (cd/m², row-major).
-pub fn thresholds(params: &Params, width: usize, height: usize, luminance: &[f64]) -> Result<Thresholds> {
+/// (cd/m², row-major); `header` heads the threshold image.
+pub fn thresholds(params: &Params, header: Header, width: usize, height: usize, luminance: &[f64]) -> Result<Thresholds> {
     params.check("")?;
     if width == 0 || height == 0 || luminance.len() != width * height {
         return Err(bad_parameter(format!("image of {width}x{height} pixels with {} values", luminance.len())));
@@ -133,7 +122,8 @@ pub fn thresholds(params: &Params, width: usize, height: usize, luminance: &[f64
     let pyramid = luminance_pyramid(width, height, &floored, depth);
     let elevation = elevation_image(&pyramid, params.levels as usize, params.pixels_per_degree, params.masking_slope);
     let adaptation = &pyramid[adaptation_level];
-    let mut out = Thresholds {
+    let mut image = ThresholdImage {
+        header,
         width,
         height,
         luminance: luminance.iter().map(|&l| l as f32).collect(),
@@ -141,42 +131,25 @@ pub fn thresholds(params: &Params, width: usize, height: usize, luminance: &[f64
         elevation: elevation.iter().map(|&e| e as f32).collect(),
         threshold: Vec::with_capacity(luminance.len()),
         contrast: Vec::with_capacity(luminance.len()),
-        counters: BTreeMap::new(),
     };
     for i in 0..luminance.len() {
         let threshold = tvi(adaptation[i].max(black)) * elevation[i];
-        out.threshold.push(threshold as f32);
-        out.contrast.push((threshold / floored[i]) as f32);
+        image.threshold.push(threshold as f32);
+        image.contrast.push((threshold / floored[i]) as f32);
     }
     let n = luminance.len() as f64;
     let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
-    out.counters.insert("pixels".into(), n);
-    out.counters.insert("bands".into(), f64::from(params.levels));
-    out.counters.insert("mean_elevation".into(), mean(&out.elevation));
-    out.counters.insert("max_elevation".into(), out.elevation.iter().fold(0.0f64, |m, &e| m.max(f64::from(e))));
-    out.counters.insert("mean_contrast_threshold".into(), mean(&out.contrast));
-    out.counters.insert("peak_band_cpd".into(), {
+    let mut counters = BTreeMap::new();
+    counters.insert("pixels".into(), n);
+    counters.insert("bands".into(), f64::from(params.levels));
+    counters.insert("mean_elevation".into(), mean(&image.elevation));
+    counters.insert("max_elevation".into(), image.elevation.iter().fold(0.0f64, |m, &e| m.max(f64::from(e))));
+    counters.insert("mean_contrast_threshold".into(), mean(&image.contrast));
+    counters.insert("peak_band_cpd".into(), {
         let bands: Vec<f64> = (0..params.levels as usize).map(|k| band_frequency_cpd(k, params.pixels_per_degree)).collect();
         bands.iter().copied().fold((0.0, 0.0), |(bf, bs), f| if contrast_sensitivity(f) > bs { (f, contrast_sensitivity(f)) } else { (bf, bs) }).0
     });
-    Ok(out)
-}
-
-impl Thresholds {
-    /// The `threshold` artifact ([`schemas::threshold::ThresholdImage`])
-    /// of these thresholds, with `header`.
-    pub fn into_artifact(self, header: Header) -> ThresholdImage {
-        ThresholdImage {
-            header,
-            width: self.width,
-            height: self.height,
-            luminance: self.luminance,
-            adaptation: self.adaptation,
-            elevation: self.elevation,
-            threshold: self.threshold,
-            contrast: self.contrast,
-        }
-    }
+    Ok(Thresholds { image, counters })
 }
 
 #[cfg(test)]

@@ -43,11 +43,9 @@ impl Stage for Args {
         let (width, height) = (decoded.width() as usize, decoded.height() as usize);
         let pixels: Vec<[u8; 3]> = decoded.pixels().map(|p| p.0).collect();
         let luminance = display_luminance(&pixels, params.display_max_cd_m2);
-        let t = thresholds(params, width, height, &luminance).map_err(|e| Error::invalid(input, None, e.to_string()))?;
-        let counters = t.counters.clone();
-        let artifact = t.into_artifact(ThresholdImage::header(run.provenance(params)));
-        outputs.write(required(&self.output, "-o")?, |p| artifact.write(p))?;
-        Ok(Done { counters, ..Done::default() })
+        let t = thresholds(params, ThresholdImage::header(run.provenance(params)), width, height, &luminance).map_err(|e| Error::invalid(input, None, e.to_string()))?;
+        outputs.write(required(&self.output, "-o")?, |p| t.image.write(p))?;
+        Ok(Done { counters: t.counters, ..Done::default() })
     }
 }
 

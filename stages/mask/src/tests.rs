@@ -1,7 +1,15 @@
 //! The model against closed forms and the published TVI curve.
 
 use crate::model::{band_frequency_cpd, contrast_sensitivity, tvi};
-use crate::{srgb_decode, thresholds, Params};
+use crate::{srgb_decode, Params};
+use schemas::header::{Provenance, Schema};
+use schemas::threshold::ThresholdImage;
+
+/// The model's threshold image of a `width` x `height` image of display
+/// luminances `luminance` under `params`.
+fn thresholds(params: &Params, width: usize, height: usize, luminance: &[f64]) -> schemas::Result<ThresholdImage> {
+    crate::thresholds(params, ThresholdImage::header(Provenance::in_memory("mask tests")), width, height, luminance).map(|t| t.image)
+}
 
 #[test]
 fn tvi_matches_ferwerda_1996_at_three_points_one_per_branch() {
