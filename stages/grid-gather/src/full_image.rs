@@ -334,7 +334,7 @@ pub fn render_full(params: &Params, scene: &FullScene, width: u32, height: u32, 
     let mut shading = Shading { params, scene, senders: &senders, rays: &rays, gather: &gather, grid: &grid, luminaires: &luminaires, lattice: None };
     let lattice = (params.mode == Mode::Full && params.lattice).then(|| {
         let spacing = params.lattice_spacing.unwrap_or_else(|| IrradianceLattice::default_spacing(params.spp));
-        IrradianceLattice::gather(width, height, spacing, params.crease_angle_deg, &|at, block, work| shading.lattice_point(at, block, work))
+        IrradianceLattice::gather(width, height, spacing, params.crease_angle_deg, params.lattice_spread, &|at, block, work| shading.lattice_point(at, block, work))
     });
     shading.lattice = lattice.as_ref();
     let lens = Lens { camera, triangles: scene.triangles, rays: Some(&rays), surfaces: scene.ids, crease_angle_deg: params.crease_angle_deg };

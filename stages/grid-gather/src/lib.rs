@@ -198,6 +198,8 @@ stage_kit::knobs! {
         lattice: bool = true, "", switch;
         /// Full: pixels between lattice points (16 points per pixel at most); none: min(1, 2 / sqrt(spp)), about 4 camera samples per lattice cell.
         lattice_spacing: Option<f64> = None, "pixels", optional(lattice::FINEST_SPACING..=64.0);
+        /// Full: a camera sample whose lattice points around it differ by more than this fraction of the brightest is gathered between the pixel centres where the lattice is coarser, else itself (a shadow's or a contact's edge in the cell); 1: never.
+        lattice_spread: f64 = 0.2, "", value(left_open(0.0, 1.0));
         /// Brute: visibility rays per link per camera sample.
         brute_samples: u32 = 64, "", value(at_least(1));
         /// Most mirror reflections and glass passages along a camera ray.
