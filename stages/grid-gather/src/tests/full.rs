@@ -248,7 +248,7 @@ fn the_surface_gather_checks_links_the_solver_called_fully_visible() {
 /// so what the lattice changes is all that differs: the full gather per
 /// sample matches it exactly; on the lattice, every pixel is within 0.5%
 /// (measured 0.20%) at one point per pixel and within 1.5% (0.71%) every
-/// 2 pixels, and most samples are interpolated (93.3%, 95.9%), the rest
+/// 2 pixels, and most samples are interpolated (93.3%, 95.8%), the rest
 /// (the floor's silhouette, the image's border) gathered.
 #[test]
 fn the_image_lattice_keeps_every_pixel_near_the_brute_force() {
