@@ -45,7 +45,8 @@
 //! 256 x 256, 4 samples per pixel) with the lattice every 1, 2 and 3
 //! pixels the relative RMSE went from 1.126%, 1.194% and 1.387% to
 //! 1.110%, 1.119% and 1.159%, for 4%, 16% and 23% more time: every 2
-//! pixels is now as accurate as every pixel was, in 0.70 of its time. `make bench-gather`'s unclustered box at `EPS` 2e-4, against its
+//! pixels is now as accurate as every pixel was, in 0.70 of its time.
+//! `make bench-gather`'s unclustered box at `EPS` 2e-4, against its
 //! brute-force reference: 5.72e-4 -> 4.66e-4 at contrast 0.02 and 4.26e-4
 //! -> 2.90e-4 at 0.005, for 21% and 19% more rays (the full gather's rays
 //! over brute force's at equal error, 0.39 -> 0.31 and 0.28 -> 0.15); its
