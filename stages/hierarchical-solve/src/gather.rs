@@ -259,7 +259,7 @@ pub fn solve(
     // Each link's visibility-weighted form factor, once per solve.
     let coupling: Vec<f64> = links.iter().map(|l| l.form_factor * f64::from(l.visibility.unwrap_or(1.0))).collect();
     let clusters = h.cluster_count();
-    let norm = max_norm(&topology, &coupling, offsets, specular, receivers, clusters);
+    let (caps, norm) = capped_norm(&topology, &coupling, offsets, specular, receivers, clusters);
     let mut h_down = vec![[0.0f64; 3]; n];
     let mut delta = vec![[0.0f64; 3]; n];
     let mut convergence =
@@ -281,25 +281,29 @@ pub fn solve(
             .map(|i| {
                 // Light through mirrors and glass (crate::mirrors).
                 let mut g = specular.map_or([0.0; 3], |s| s.gather(i, b));
+                // Each link's factor, capped where it exceeds what one
+                // sender can bring (capped_norm).
+                let factor = |l: usize| coupling[l] * caps[i].iter().find(|c| c.0 == l).map_or(1.0, |c| c.1);
                 // A cluster's links light its triangles, each by its own
                 // weight (crate::receivers).
                 let own = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l));
                 let distributed = i.checked_sub(clusters).into_iter().flat_map(|t| receivers.of_triangle(t));
                 for l in own {
-                    let sent = senders.radiosity(l, b);
+                    let (sent, f) = (senders.radiosity(l, b), factor(l));
                     for c in 0..3 {
-                        g[c] += coupling[l] * sent[c];
+                        g[c] += f * sent[c];
                     }
                 }
                 for (l, &(p, w)) in distributed {
+                    let f = w * factor(l);
                     for c in 0..3 {
-                        g[c] += w * coupling[l] * b[p][c];
+                        g[c] += f * b[p][c];
                     }
                 }
                 for (k, &w) in i.checked_sub(clusters).into_iter().flat_map(|e| receivers.of_element(e)) {
-                    let l = receivers.part_sources[k].link();
+                    let f = w * factor(receivers.part_sources[k].link());
                     for c in 0..3 {
-                        g[c] += w * coupling[l] * sent_to_parts[k][c];
+                        g[c] += f * sent_to_parts[k][c];
                     }
                 }
                 // The exposed part's irradiance (crate::exposure).
@@ -845,19 +849,69 @@ impl Rate {
     }
 }
 
-/// The max-norm of the iteration matrix per channel (see [`solve`]): the
-/// largest `rho_leaf sum V F` over the links into a leaf and its ancestors
-/// (a cluster's links counted on its input triangles, times their weights `w_tp`).
-fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: Option<&Couplings>, receivers: &ReceiverTerms, clusters: usize) -> [f64; 3] {
+/// Each link's total factor into node `i` (dense index), over the terms
+/// the gather sums: its own coupling `V F` where `i` is its receiver, its
+/// weights on `i` as an input triangle of a cluster receiver
+/// (`w_tp V F`, every part `p`) or as a part of an element receiver
+/// (`w_j V F` times what the part source's weights sum to), sorted by
+/// link.
+fn link_factors(i: usize, clusters: usize, coupling: &[f64], offsets: &[usize], receivers: &ReceiverTerms) -> Vec<(usize, f64)> {
+    let mut factors: Vec<(usize, f64)> = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| (l, coupling[l])).collect();
+    if let Some(e) = i.checked_sub(clusters) {
+        factors.extend(receivers.of_triangle(e).map(|(l, &(_, w))| (l, w * coupling[l])));
+        factors.extend(receivers.of_element(e).map(|(k, &w)| {
+            let source = &receivers.part_sources[k];
+            (source.link(), w * coupling[source.link()] * source.weight())
+        }));
+    }
+    factors.sort_by_key(|f| f.0);
+    factors.dedup_by(|next, kept| {
+        let same = next.0 == kept.0;
+        if same {
+            kept.1 += next.1;
+        }
+        same
+    });
+    factors
+}
+
+/// The links whose factor into a node exceeds what its exposed part can
+/// receive from one sender, each with the scale that brings it down to
+/// that, per node (dense index; mostly empty), and the max-norm of the
+/// iteration matrix so capped, per channel (see [`solve`]).
+///
+/// A point's factor to a sender is at most 1 (the sender covering its
+/// whole hemisphere), so the irradiance one link brings to node `i`'s
+/// exposed part is at most the sender's radiosity: the link's factor into
+/// `i`, averaged over all of `i`, at most `exposed(x_i)` before the gather
+/// divides by it ([`crate::exposure`]). Estimates can exceed it where a
+/// kernel is a step: a floor under a box's bottom face 0.1 mm above it
+/// (McGuire's `CornellBox-Glossy`) sees that face with factor 1 over the
+/// footprint and 0 beside it, the link's factor is right, and the parts
+/// that share it by their centroids' factors ([`crate::receivers`]) found
+/// an eighth of the footprint, so two floor leaves each took a factor of
+/// 2.08 from the face. With the face lighting them back, a leaf's row of
+/// the iteration matrix reached 1.5 and Jacobi diverged (radiosity 5e26
+/// after 2,000 iterations). Capped, every row is at most `rho` times the
+/// number of links at their cap; no such link is left on the built-in
+/// Cornell box, whose solutions keep every bit.
+///
+/// The norm is the largest `rho_leaf sum V F` over the links into a leaf
+/// and its ancestors, each term capped (a cluster's links counted on its
+/// input triangles, times their weights `w_tp`).
+fn capped_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: Option<&Couplings>, receivers: &ReceiverTerms, clusters: usize) -> (Vec<Vec<(usize, f64)>>, [f64; 3]) {
     let n = topology.parent.len();
+    let mut caps = vec![Vec::new(); n];
     // Visibility-weighted factor sum into each node and its ancestors
     // (parents come first, one forward sweep).
     let mut chain = vec![0.0f64; n];
     let mut norm = [0.0f64; 3];
     for i in 0..n {
-        let links: f64 = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| coupling[l]).sum();
-        let distributed: f64 = i.checked_sub(clusters).map_or(0.0, |t| receivers.of_triangle(t).map(|(l, &(_, w))| w * coupling[l]).sum::<f64>() + receivers.of_element(t).map(|(k, &w)| w * coupling[receivers.part_sources[k].link()] * receivers.part_sources[k].weight()).sum::<f64>());
-        let own = (links + distributed + specular.map_or(0.0, |s| s.row_sum(i))) / exposed(topology.exposure[i]);
+        let most = exposed(topology.exposure[i]);
+        let factors = link_factors(i, clusters, coupling, offsets, receivers);
+        caps[i] = factors.iter().filter(|f| f.1 > most).map(|&(l, f)| (l, most / f)).collect();
+        let links: f64 = factors.iter().map(|f| f.1.min(most)).sum();
+        let own = (links + specular.map_or(0.0, |s| s.row_sum(i))) / most;
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
             for c in 0..3 {
@@ -873,7 +927,7 @@ fn max_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specular: 
             }
         }
     }
-    norm
+    (caps, norm)
 }
 
 #[cfg(test)]

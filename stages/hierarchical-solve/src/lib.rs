@@ -555,6 +555,15 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     work.cluster_links = all_links.iter().filter(|l| matches!(l.receiver, Node::Cluster(_)) || matches!(l.sender, Node::Cluster(_))).count();
     work.elements = h.elements.len();
     work.leaves = h.elements.iter().filter(|e| e.is_leaf()).count();
+    // Changes that grow at the iteration cap mean the iterate is no
+    // solution at all (a row of the iteration matrix over 1 that the caps
+    // of crate::gather did not reach): refused rather than written.
+    if !work.converged && work.contraction >= 1.0 {
+        return Err(format!(
+            "the radiosity iteration diverges: at max_iterations = {} each change was {:.3} times the one before (a surface gathers more light than it can receive); no solution written",
+            params.max_iterations, work.contraction
+        ));
+    }
     // The solution stores 32-bit floats: a radiosity beyond their range
     // would be written as inf, and every reader would refuse the file.
     if let Some(v) = b.iter().flatten().find(|v| !(v.is_finite() && v.abs() <= f64::from(f32::MAX))) {
