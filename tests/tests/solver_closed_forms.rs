@@ -87,6 +87,12 @@ impl Solved {
             .filter(|(_, e)| e.first_child == u32::MAX)
             .map(|(i, e)| (self.object_of_element[i].as_str(), f64::from(e.area), f64::from(e.radiosity[0]), i))
     }
+
+    /// The area-mean radiosity of the leaves (channel 0).
+    fn mean(&self) -> f64 {
+        let (weighted, area) = self.leaves().fold((0.0, 0.0), |(w, a), (_, area, b, _)| (w + area * b, a + area));
+        weighted / area
+    }
 }
 
 const FINE: [&str; 4] = ["--eps", "1e-4", "--min-area", "1e-4"];
@@ -252,9 +258,8 @@ fn energy_balance(test: &str, rho: f64, clustered: bool) {
 fn energy_balance_with(test: &str, rho: f64, clustered: bool, args: &[&str], relative: f64) {
     let (size, emission) = (1.0, 10.0);
     let (solved, _) = solve(test, &closed_box(size, rho, emission), args, clustered);
-    let lamp_area = (size / 3.0) * (size / 3.0);
     let total_area = 6.0 * size * size;
-    let expected = emission * lamp_area / ((1.0 - rho) * total_area);
+    let expected = box_mean(size, rho, emission);
     let (mut weighted, mut area) = (0.0, 0.0);
     for (_, a, b, i) in solved.leaves() {
         let rgb = solved.solution.elements[i].radiosity;
@@ -272,11 +277,8 @@ fn energy_balance_with(test: &str, rho: f64, clustered: bool, args: &[&str], rel
 /// largest radiosity.
 #[test]
 fn iteration_cap_is_reported_with_an_honest_bound() {
-    let (size, rho, emission) = (1.0, 0.999, 10.0);
-    let dir = scratch("iteration_cap");
-    let scene_path = closed_box(size, rho, emission).write(&dir);
-    let (mesh, manifest, solution, report) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("solution.exr"), dir.join("solve.report.ron"));
-    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    let (size, rho, emission) = CAPPED_BOX;
+    let [mesh, manifest, solution, report] = prepared_box("iteration_cap", rho);
     let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--report", s(&report), "--eps", "1e-2", "--min-area", "1e-2"];
     let capped = [&args[..], &["--max-iterations", "12", "--max-passes", "1"]].concat();
     let out = run_ok("hierarchical-solve", &capped);
@@ -289,18 +291,52 @@ fn iteration_cap_is_reported_with_an_honest_bound() {
     eprintln!("capped: bound {bound:.3e}; {stderr}");
     let solved = load(&mesh, &manifest, &solution);
     let largest = solved.leaves().map(|(_, _, b, _)| b).fold(0.0, f64::max);
-    let (mut weighted, mut area) = (0.0, 0.0);
-    for (_, a, b, _) in solved.leaves() {
-        weighted += a * b;
-        area += a;
-    }
-    let expected = emission * (size / 3.0) * (size / 3.0) / ((1.0 - rho) * 6.0 * size * size);
-    let error = (weighted / area - expected).abs();
+    let error = (solved.mean() - box_mean(size, rho, emission)).abs();
     eprintln!("capped: mean off by {:.3e} of the largest radiosity, bound {bound:.3e}", error / largest);
     assert!(bound.is_finite() && error <= bound * largest, "error {error} over the bound {bound} x {largest}");
     // Uncapped, the same solve converges and says nothing.
     let out = run_ok("hierarchical-solve", &args);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// A solve that would need more links than `--max-links` keeps the links
+/// it would split, says so on stderr and in its report, and stays within
+/// the cap; the closed box's mean, which any set of links conserves up to
+/// their factors' sum, stays within 2% of the closed form.
+#[test]
+fn link_cap_is_kept_and_reported() {
+    let (size, _, emission) = CAPPED_BOX;
+    let rho = 0.9;
+    let [mesh, manifest, solution, report] = prepared_box("link_cap", rho);
+    let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--report", s(&report), "--eps", "1e-3", "--max-links", "3000"];
+    let out = run_ok("hierarchical-solve", &args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("warning: refinement stopped at max_links = 3000"), "no warning on stderr:\n{stderr}");
+    let report = read_ron::<Report>(&report).unwrap().value;
+    assert!(report.notes.iter().any(|n| n.contains("max_links")), "no note in the report: {:?}", report.notes);
+    let links = report.counters["links"];
+    assert!((1.0..=3000.0).contains(&links), "{links} links under a cap of 3000");
+    let (mean, expected) = (load(&mesh, &manifest, &solution).mean(), box_mean(size, rho, emission));
+    assert!((mean / expected - 1.0).abs() < 0.02, "mean {mean} against {expected}");
+}
+
+/// Size, reflectance and emission of the closed box the cap tests solve.
+const CAPPED_BOX: (f64, f64, f64) = (1.0, 0.999, 10.0);
+
+/// [`CAPPED_BOX`] at reflectance `rho`, prepared in the scratch directory
+/// of `test`: the paths of its mesh, manifest, solution and report.
+fn prepared_box(test: &str, rho: f64) -> [std::path::PathBuf; 4] {
+    let dir = scratch(test);
+    let scene_path = closed_box(CAPPED_BOX.0, rho, CAPPED_BOX.2).write(&dir);
+    let paths = ["mesh.exr", "manifest.ron", "solution.exr", "solve.report.ron"].map(|f| dir.join(f));
+    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&paths[0]), "--manifest", s(&paths[1])]);
+    paths
+}
+
+/// The closed box's mean radiosity, `P / ((1 - rho) A)`, its lamp a ninth
+/// of the ceiling.
+fn box_mean(size: f64, rho: f64, emission: f64) -> f64 {
+    emission * (size / 3.0) * (size / 3.0) / ((1.0 - rho) * 6.0 * size * size)
 }
 
 /// Issue 10, item 5: near `rho = 1` the old rule (stop when one iteration

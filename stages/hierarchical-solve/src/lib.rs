@@ -111,6 +111,8 @@ stage_kit::knobs! {
         max_iterations: usize = 2000, "", value(at_least(1));
         /// Refine-and-solve passes, at most.
         max_passes: usize = 8, "", value(at_least(1));
+        /// Links at most (about 600 bytes each in a solve): refinement keeps the links it would split once this many could result, says so, and runs no further pass.
+        max_links: usize = 16_000_000, "links", value(at_least(1));
         /// Seed of the visibility rays.
         seed: u64 = 1, "", value;
         /// Rays per coupling through a mirror or pane.
@@ -206,6 +208,8 @@ pub struct Work {
     pub converged: bool,
     /// Passes whose solve stopped at `max_iterations`.
     pub capped_passes: usize,
+    /// Whether refinement stopped at `max_links`.
+    pub links_capped: bool,
     /// Geometric extrapolations of the Jacobi iterates, all passes.
     pub extrapolations: usize,
     /// Seconds refining links (form factors, oracle).
@@ -410,6 +414,12 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // previous pass sorted them in: those it kept first (sort_links).
         let mut in_order = None;
         while !active.is_empty() {
+            // A split makes up to four links of one (crate::links::children_links).
+            if all_links.len() + 4 * active.len() > params.max_links {
+                work.links_capped = true;
+                all_links.append(&mut active);
+                break;
+            }
             let decisions: Vec<Split> = active.par_iter().map(|l| decide(&h, l, &b, &range, &dimmest, &allowance, floors)).collect();
             for (l, d) in active.iter().zip(&decisions) {
                 let node = match d {
@@ -492,7 +502,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         let mut receivers = receivers::ReceiverTerms::new(&h, &mut all_links, receivers::Build::Means, &mut receiver_weights);
         let mut convergence = gather::solve(&h, &all_links, &offsets, specular.as_ref(), &mut b, params.tolerance, params.max_iterations, rates, &senders, &receivers);
         let mut left = params.max_iterations - convergence.iterations;
-        if (pass == passes || (!refined_any && pass > 1)) && convergence.converged && left > 0 {
+        if (pass == passes || (!refined_any && pass > 1) || work.links_capped) && convergence.converged && left > 0 {
             let tracer = visibility::Tracer::new(&scene, &occluders, params.seed, params.visibility_rays);
             // Leaves a shadow edge crosses open into their children
             // (crate::shadowed), which a means' solve lights by their own
@@ -547,7 +557,7 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         work.gather_seconds += started.elapsed().as_secs_f64();
         work.passes = pass;
         progress(&Progress { pass, phase: Phase::Done, links: all_links.len(), elements: h.elements.len() });
-        if !refined_any && pass > 1 {
+        if (!refined_any && pass > 1) || work.links_capped {
             break;
         }
     }

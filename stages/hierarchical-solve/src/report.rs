@@ -47,6 +47,12 @@ pub fn done(work: &Work, params: &Params, mesh: &Mesh, manifest: &Manifest, surf
             count("specular_truncation_bound", w.specular_truncation);
         }
     }
+    if w.links_capped {
+        done.notes.push(format!(
+            "refinement stopped at max_links = {} ({} links kept): links the error bound would split were kept, so the solution errs by more than eps = {:e} allows; raise --max-links (about 600 bytes a link) or eps",
+            params.max_links, w.links, params.eps
+        ));
+    }
     if w.specular_windows_left_out > 0 {
         done.notes.push(format!(
             "specular light not simulated: the mirrors and panes lie in {} planes, more than the {} whose couplings a solve traces (a curved mirror or pane is one plane per facet); they reflect diffusely only",
