@@ -282,29 +282,12 @@ pub fn solve(
                 // Light through mirrors and glass (crate::mirrors).
                 let mut g = specular.map_or([0.0; 3], |s| s.gather(i, b));
                 // Each link's factor, capped where it exceeds what one
-                // sender can bring (capped_norm).
-                let factor = |l: usize| coupling[l] * caps[i].iter().find(|c| c.0 == l).map_or(1.0, |c| c.1);
-                // A cluster's links light its triangles, each by its own
-                // weight (crate::receivers).
-                let own = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l));
-                let distributed = i.checked_sub(clusters).into_iter().flat_map(|t| receivers.of_triangle(t));
-                for l in own {
-                    let (sent, f) = (senders.radiosity(l, b), factor(l));
-                    for c in 0..3 {
-                        g[c] += f * sent[c];
-                    }
-                }
-                for (l, &(p, w)) in distributed {
-                    let f = w * factor(l);
-                    for c in 0..3 {
-                        g[c] += f * b[p][c];
-                    }
-                }
-                for (k, &w) in i.checked_sub(clusters).into_iter().flat_map(|e| receivers.of_element(e)) {
-                    let f = w * factor(receivers.part_sources[k].link());
-                    for c in 0..3 {
-                        g[c] += f * sent_to_parts[k][c];
-                    }
+                // sender can bring (capped_norm); the plain loop where no
+                // link into the node is.
+                let lighting = Lighting { i, clusters, offsets, receivers, senders, b, sent_to_parts: &sent_to_parts };
+                match caps[i].as_slice() {
+                    [] => lighting.add(&mut g, |l| coupling[l]),
+                    capped => lighting.add(&mut g, |l| coupling[l] * capped.iter().find(|c| c.0 == l).map_or(1.0, |c| c.1)),
                 }
                 // The exposed part's irradiance (crate::exposure).
                 g.map(|x| x / exposed(topology.exposure[i]))
@@ -360,6 +343,41 @@ pub fn solve(
     }
     convergence.rates = rate.estimates();
     convergence
+}
+
+/// What lights node `i` in one iteration of [`solve`].
+struct Lighting<'a> {
+    i: usize,
+    clusters: usize,
+    offsets: &'a [usize],
+    receivers: &'a ReceiverTerms,
+    senders: &'a SenderTerms,
+    b: &'a [[f64; 3]],
+    sent_to_parts: &'a [[f64; 3]],
+}
+
+impl Lighting<'_> {
+    /// Adds to `g` the irradiance of the links into the node, each link
+    /// `l` taken with factor `factor(l)`: its own links by what their
+    /// senders send, a cluster's links on its triangles each by its own
+    /// weight (crate::receivers), and the links into the inner elements
+    /// above it on it as their part.
+    #[inline]
+    fn add(&self, g: &mut [f64; 3], factor: impl Fn(usize) -> f64) {
+        let (i, receivers, b) = (self.i, self.receivers, self.b);
+        for l in (self.offsets[i]..self.offsets[i + 1]).filter(|&l| !receivers.distributed(l)) {
+            let (sent, f) = (self.senders.radiosity(l, b), factor(l));
+            g.iter_mut().zip(sent).for_each(|(g, s)| *g += f * s);
+        }
+        for (l, &(p, w)) in i.checked_sub(self.clusters).into_iter().flat_map(|t| receivers.of_triangle(t)) {
+            let f = w * factor(l);
+            g.iter_mut().zip(b[p]).for_each(|(g, s)| *g += f * s);
+        }
+        for (k, &w) in i.checked_sub(self.clusters).into_iter().flat_map(|e| receivers.of_element(e)) {
+            let f = w * factor(receivers.part_sources[k].link());
+            g.iter_mut().zip(self.sent_to_parts[k]).for_each(|(g, s)| *g += f * s);
+        }
+    }
 }
 
 /// Parts a link's sender is first resolved into by [`SenderTerms`], level
@@ -849,6 +867,28 @@ impl Rate {
     }
 }
 
+/// The terms the gather sums into node `i` (dense index), each as its link
+/// and its factor ([`link_factors`]): its own links, then its weights as a
+/// cluster's triangle, then as a part.
+#[allow(clippy::type_complexity)]
+fn terms<'a>(i: usize, clusters: usize, coupling: &'a [f64], offsets: &[usize], receivers: &'a ReceiverTerms) -> (impl Iterator<Item = (usize, f64)> + 'a, impl Iterator<Item = (usize, f64)> + 'a, impl Iterator<Item = (usize, f64)> + 'a) {
+    let own = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| (l, coupling[l]));
+    let element = i.checked_sub(clusters);
+    let triangles = element.into_iter().flat_map(|e| receivers.of_triangle(e)).map(|(l, &(_, w))| (l, w * coupling[l]));
+    let parts = element.into_iter().flat_map(|e| receivers.of_element(e)).map(|(k, &w)| {
+        let source = &receivers.part_sources[k];
+        (source.link(), w * coupling[source.link()] * source.weight())
+    });
+    (own, triangles, parts)
+}
+
+/// The sum of [`terms`]: the own links' and the weights' apart.
+fn terms_sum(i: usize, clusters: usize, coupling: &[f64], offsets: &[usize], receivers: &ReceiverTerms) -> f64 {
+    let (own, triangles, parts) = terms(i, clusters, coupling, offsets, receivers);
+    let sum = |terms: &mut dyn Iterator<Item = (usize, f64)>| terms.map(|t| t.1).sum::<f64>();
+    sum(&mut { own }) + (sum(&mut { triangles }) + sum(&mut { parts }))
+}
+
 /// Each link's total factor into node `i` (dense index), over the terms
 /// the gather sums: its own coupling `V F` where `i` is its receiver, its
 /// weights on `i` as an input triangle of a cluster receiver
@@ -856,15 +896,9 @@ impl Rate {
 /// (`w_j V F` times what the part source's weights sum to), sorted by
 /// link.
 fn link_factors(i: usize, clusters: usize, coupling: &[f64], offsets: &[usize], receivers: &ReceiverTerms) -> Vec<(usize, f64)> {
-    let mut factors: Vec<(usize, f64)> = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| (l, coupling[l])).collect();
-    if let Some(e) = i.checked_sub(clusters) {
-        factors.extend(receivers.of_triangle(e).map(|(l, &(_, w))| (l, w * coupling[l])));
-        factors.extend(receivers.of_element(e).map(|(k, &w)| {
-            let source = &receivers.part_sources[k];
-            (source.link(), w * coupling[source.link()] * source.weight())
-        }));
-    }
-    factors.sort_by_key(|f| f.0);
+    let (own, triangles, parts) = terms(i, clusters, coupling, offsets, receivers);
+    let mut factors: Vec<(usize, f64)> = own.chain(triangles).chain(parts).collect();
+    factors.sort_unstable_by_key(|f| f.0);
     factors.dedup_by(|next, kept| {
         let same = next.0 == kept.0;
         if same {
@@ -909,9 +943,13 @@ fn capped_norm(topology: &Topology, coupling: &[f64], offsets: &[usize], specula
     let mut norm = [0.0f64; 3];
     for i in 0..n {
         let most = exposed(topology.exposure[i]);
-        let factors = link_factors(i, clusters, coupling, offsets, receivers);
-        caps[i] = factors.iter().filter(|f| f.1 > most).map(|&(l, f)| (l, most / f)).collect();
-        let links: f64 = factors.iter().map(|f| f.1.min(most)).sum();
+        let mut links = terms_sum(i, clusters, coupling, offsets, receivers);
+        // Terms that together stay under the cap leave every link under it.
+        if links > most {
+            let factors = link_factors(i, clusters, coupling, offsets, receivers);
+            caps[i] = factors.iter().filter(|f| f.1 > most).map(|&(l, f)| (l, most / f)).collect();
+            links = factors.iter().map(|f| f.1.min(most)).sum();
+        }
         let own = (links + specular.map_or(0.0, |s| s.row_sum(i))) / most;
         chain[i] = own + if topology.parent[i] == usize::MAX { 0.0 } else { chain[topology.parent[i]] };
         if let Some((rho, _)) = topology.leaf[i] {
