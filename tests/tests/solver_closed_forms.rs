@@ -4,7 +4,7 @@
 //! clustering (clusters of one triangle, so that cluster nodes really sit
 //! between the triangles and the root).
 
-use end_to_end::{pixel_points_on_ground, run_ok, s, scratch, solve_prepared};
+use end_to_end::{assert_refused, pixel_points_on_ground, run_ok, s, scratch, solve_prepared};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::report::Report;
 use schemas::ron_io::read_ron;
@@ -318,6 +318,17 @@ fn link_cap_is_kept_and_reported() {
     assert!((1.0..=3000.0).contains(&links), "{links} links under a cap of 3000");
     let (mean, expected) = (load(&mesh, &manifest, &solution).mean(), box_mean(size, rho, emission));
     assert!((mean / expected - 1.0).abs() < 0.02, "mean {mean} against {expected}");
+}
+
+/// A closed box of reflectance 1 never absorbs its lamp's light: there is
+/// no steady state, and the iteration's changes do not shrink. The solve
+/// refuses (one line, exit 2, no file) instead of writing its last iterate
+/// with a warning, as it did.
+#[test]
+fn a_closed_box_that_absorbs_nothing_is_refused() {
+    let [mesh, manifest, solution, report] = prepared_box("absorbs_nothing", 1.0);
+    let args = ["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&solution), "--report", s(&report), "--eps", "1e-2", "--min-area", "1e-2"];
+    assert_refused("hierarchical-solve", &args, &["diverges", "max_iterations = 2000", "no solution written"], &[&solution]);
 }
 
 /// Size, reflectance and emission of the closed box the cap tests solve.

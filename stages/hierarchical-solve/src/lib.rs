@@ -565,12 +565,13 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
     work.cluster_links = all_links.iter().filter(|l| matches!(l.receiver, Node::Cluster(_)) || matches!(l.sender, Node::Cluster(_))).count();
     work.elements = h.elements.len();
     work.leaves = h.elements.iter().filter(|e| e.is_leaf()).count();
-    // Changes that grow at the iteration cap mean the iterate is no
-    // solution at all (a row of the iteration matrix over 1 that the caps
-    // of crate::gather did not reach): refused rather than written.
+    // Changes that do not shrink at the iteration cap mean the iterate is
+    // no solution at all (a closed scene of reflectance 1, which never
+    // absorbs its light, or a row of the iteration matrix over 1 that the
+    // caps of crate::gather did not reach): refused rather than written.
     if !work.converged && work.contraction >= 1.0 {
         return Err(format!(
-            "the radiosity iteration diverges: at max_iterations = {} each change was {:.3} times the one before (a surface gathers more light than it can receive); no solution written",
+            "the radiosity iteration diverges: at max_iterations = {} each change was {:.3} times the one before (no steady state: light that is never absorbed, or a surface gathering more than it can receive); no solution written",
             params.max_iterations, work.contraction
         ));
     }
