@@ -312,12 +312,17 @@ fn link_cap_is_kept_and_reported() {
     let out = run_ok("hierarchical-solve", &args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("warning: refinement stopped at max_links = 3000"), "no warning on stderr:\n{stderr}");
-    let report = read_ron::<Report>(&report).unwrap().value;
-    assert!(report.notes.iter().any(|n| n.contains("max_links")), "no note in the report: {:?}", report.notes);
-    let links = report.counters["links"];
+    let noted = read_ron::<Report>(&report).unwrap().value;
+    assert!(noted.notes.iter().any(|n| n.contains("max_links")), "no note in the report: {:?}", noted.notes);
+    let links = noted.counters["links"];
     assert!((1.0..=3000.0).contains(&links), "{links} links under a cap of 3000");
     let (mean, expected) = (load(&mesh, &manifest, &solution).mean(), box_mean(size, rho, emission));
     assert!((mean / expected - 1.0).abs() < 0.02, "mean {mean} against {expected}");
+    // Clustered, where a split of a cluster makes more than four links of
+    // one, the cap holds too.
+    solve_prepared(mesh.parent().unwrap(), &args[6..], Some(4));
+    let links = read_ron::<Report>(&report).unwrap().value.counters["links"];
+    assert!((1.0..=3000.0).contains(&links), "clustered: {links} links under a cap of 3000");
 }
 
 /// A closed box of reflectance 1 never absorbs its lamp's light: there is

@@ -414,8 +414,9 @@ pub fn solve_with_surface(mesh: &Mesh, manifest: &Manifest, clusters: Option<Clu
         // previous pass sorted them in: those it kept first (sort_links).
         let mut in_order = None;
         while !active.is_empty() {
-            // A split makes up to four links of one (crate::links::children_links).
-            if all_links.len() + 4 * active.len() > params.max_links {
+            // Stop before a round of splits that could pass the cap.
+            let most: usize = active.par_iter().map(|l| links::most_children_links(&h, l)).sum();
+            if all_links.len() + most > params.max_links {
                 work.links_capped = true;
                 all_links.append(&mut active);
                 break;

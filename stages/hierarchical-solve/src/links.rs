@@ -892,6 +892,22 @@ fn leaf_bounds(h: &Hierarchy, radiosity: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f6
     (lo, hi)
 }
 
+/// The most links [`children_links`] can make of `link`, whatever the
+/// split: an end's children (four of an element, a cluster's children or
+/// its triangles), the larger end's, or their square for a cluster's
+/// self-link.
+pub fn most_children_links(h: &Hierarchy, link: &Link) -> usize {
+    let children = |n: Node| match n {
+        Node::Element(_) => 4,
+        Node::Cluster(_) => h.children(n).len(),
+    };
+    if link.receiver == link.sender {
+        children(link.receiver).pow(2)
+    } else {
+        children(link.receiver).max(children(link.sender))
+    }
+}
+
 /// The links replacing `link` after `split` (children already exist); they
 /// inherit its proof of being unoccluded ([`Link::clear`]).
 pub fn children_links(h: &Hierarchy, link: &Link, split: Split, linking: Linking) -> Vec<Link> {
