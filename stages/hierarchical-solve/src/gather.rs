@@ -882,7 +882,9 @@ fn terms<'a>(i: usize, clusters: usize, coupling: &'a [f64], offsets: &[usize], 
     (own, triangles, parts)
 }
 
-/// The sum of [`terms`]: the own links' and the weights' apart.
+/// The sum of [`terms`], added as the norm always added them (the own
+/// links' sum, then the two weights' sums together), so that where no link
+/// is capped the norm, the stopping rule and the solution keep every bit.
 fn terms_sum(i: usize, clusters: usize, coupling: &[f64], offsets: &[usize], receivers: &ReceiverTerms) -> f64 {
     let (own, triangles, parts) = terms(i, clusters, coupling, offsets, receivers);
     let sum = |terms: &mut dyn Iterator<Item = (usize, f64)>| terms.map(|t| t.1).sum::<f64>();
