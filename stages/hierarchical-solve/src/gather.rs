@@ -357,26 +357,19 @@ struct Lighting<'a> {
 }
 
 impl Lighting<'_> {
-    /// Adds to `g` the irradiance of the links into the node, each link
-    /// `l` taken with factor `factor(l)`: its own links by what their
-    /// senders send, a cluster's links on its triangles each by its own
-    /// weight (crate::receivers), and the links into the inner elements
-    /// above it on it as their part.
+    /// Adds to `g` the irradiance of the terms into the node
+    /// ([`for_each_term`]), each link `l` taken with factor `factor(l)`.
     #[inline]
     fn add(&self, g: &mut [f64; 3], factor: impl Fn(usize) -> f64) {
-        let (i, receivers, b) = (self.i, self.receivers, self.b);
-        for l in (self.offsets[i]..self.offsets[i + 1]).filter(|&l| !receivers.distributed(l)) {
-            let (sent, f) = (self.senders.radiosity(l, b), factor(l));
-            g.iter_mut().zip(sent).for_each(|(g, s)| *g += f * s);
-        }
-        for (l, &(p, w)) in i.checked_sub(self.clusters).into_iter().flat_map(|t| receivers.of_triangle(t)) {
+        for_each_term(self.i, self.clusters, self.offsets, self.receivers, |l, w, source| {
             let f = w * factor(l);
-            g.iter_mut().zip(b[p]).for_each(|(g, s)| *g += f * s);
-        }
-        for (k, &w) in i.checked_sub(self.clusters).into_iter().flat_map(|e| receivers.of_element(e)) {
-            let f = w * factor(receivers.part_sources[k].link());
-            g.iter_mut().zip(self.sent_to_parts[k]).for_each(|(g, s)| *g += f * s);
-        }
+            let sent = match source {
+                Source::Sender => self.senders.radiosity(l, self.b),
+                Source::Node(p) => self.b[p],
+                Source::Part(k) => self.sent_to_parts[k],
+            };
+            g.iter_mut().zip(sent).for_each(|(g, s)| *g += f * s);
+        });
     }
 }
 
@@ -867,40 +860,72 @@ impl Rate {
     }
 }
 
-/// The terms the gather sums into node `i` (dense index), each as its link
-/// and its factor ([`link_factors`]): its own links, then its weights as a
-/// cluster's triangle, then as a part.
-#[allow(clippy::type_complexity)]
-fn terms<'a>(i: usize, clusters: usize, coupling: &'a [f64], offsets: &[usize], receivers: &'a ReceiverTerms) -> (impl Iterator<Item = (usize, f64)> + 'a, impl Iterator<Item = (usize, f64)> + 'a, impl Iterator<Item = (usize, f64)> + 'a) {
-    let own = (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)).map(|l| (l, coupling[l]));
-    let element = i.checked_sub(clusters);
-    let triangles = element.into_iter().flat_map(|e| receivers.of_triangle(e)).map(|(l, &(_, w))| (l, w * coupling[l]));
-    let parts = element.into_iter().flat_map(|e| receivers.of_element(e)).map(|(k, &w)| {
-        let source = &receivers.part_sources[k];
-        (source.link(), w * coupling[source.link()] * source.weight())
-    });
-    (own, triangles, parts)
+/// Where the radiosity of a term of the gather comes from
+/// ([`for_each_term`]).
+#[derive(Clone, Copy)]
+enum Source {
+    /// What the term's link sends ([`SenderTerms`]).
+    Sender,
+    /// Node `p` (dense index): a part of the sender of a link into a
+    /// cluster above the node, which is one of the cluster's input
+    /// triangles.
+    Node(usize),
+    /// Part source `k` ([`ReceiverTerms::part_sources`]): the node is a
+    /// part of the receiver of a link into an inner element above it.
+    Part(usize),
 }
 
-/// The sum of [`terms`], added as the norm always added them (the own
-/// links' sum, then the two weights' sums together), so that where no link
-/// is capped the norm, the stopping rule and the solution keep every bit.
+/// Calls `visit(l, w, source)` for each term the gather sums into node `i`
+/// (dense index), link `l` bringing `w` times its factor `V F` of what
+/// `source` sends: the node's own links not distributed by weight (`w` 1),
+/// then its weights as an input triangle of a cluster receiver (`w_tp`),
+/// then as a part of an element receiver (`w_j`). The gather
+/// ([`Lighting::add`]) and the norm ([`terms_sum`], [`link_factors`]) see
+/// the same terms through it.
+#[inline]
+fn for_each_term(i: usize, clusters: usize, offsets: &[usize], receivers: &ReceiverTerms, mut visit: impl FnMut(usize, f64, Source)) {
+    for l in (offsets[i]..offsets[i + 1]).filter(|&l| !receivers.distributed(l)) {
+        visit(l, 1.0, Source::Sender);
+    }
+    let element = i.checked_sub(clusters);
+    for (l, &(p, w)) in element.into_iter().flat_map(|e| receivers.of_triangle(e)) {
+        visit(l, w, Source::Node(p));
+    }
+    for (k, &w) in element.into_iter().flat_map(|e| receivers.of_element(e)) {
+        visit(receivers.part_sources[k].link(), w, Source::Part(k));
+    }
+}
+
+/// Calls `visit(l, f, source)` with each term's total factor into node `i`
+/// ([`for_each_term`]): `w V F`, where a part source's `w_j` also takes
+/// what its own weights sum to ([`PartSource::weight`]).
+fn for_each_factor(i: usize, clusters: usize, coupling: &[f64], offsets: &[usize], receivers: &ReceiverTerms, mut visit: impl FnMut(usize, f64, Source)) {
+    for_each_term(i, clusters, offsets, receivers, |l, w, source| {
+        let f = w * coupling[l];
+        visit(l, if let Source::Part(k) = source { f * receivers.part_sources[k].weight() } else { f }, source);
+    });
+}
+
+/// The sum of the factors into node `i` ([`for_each_factor`]), added as
+/// the norm always added them (the own links' sum, then the two weights'
+/// sums together), so that where no link is capped the norm, the stopping
+/// rule and the solution keep every bit.
 fn terms_sum(i: usize, clusters: usize, coupling: &[f64], offsets: &[usize], receivers: &ReceiverTerms) -> f64 {
-    let (own, triangles, parts) = terms(i, clusters, coupling, offsets, receivers);
-    let sum = |terms: &mut dyn Iterator<Item = (usize, f64)>| terms.map(|t| t.1).sum::<f64>();
-    sum(&mut { own }) + (sum(&mut { triangles }) + sum(&mut { parts }))
+    let (mut own, mut triangles, mut parts) = (0.0, 0.0, 0.0);
+    for_each_factor(i, clusters, coupling, offsets, receivers, |_, f, source| match source {
+        Source::Sender => own += f,
+        Source::Node(_) => triangles += f,
+        Source::Part(_) => parts += f,
+    });
+    own + (triangles + parts)
 }
 
 /// Each link's total factor into node `i` (dense index), over the terms
-/// the gather sums: its own coupling `V F` where `i` is its receiver, its
-/// weights on `i` as an input triangle of a cluster receiver
-/// (`w_tp V F`, every part `p`) or as a part of an element receiver
-/// (`w_j V F` times what the part source's weights sum to), sorted by
-/// link.
+/// the gather sums ([`for_each_factor`]), sorted by link.
 fn link_factors(i: usize, clusters: usize, coupling: &[f64], offsets: &[usize], receivers: &ReceiverTerms) -> Vec<(usize, f64)> {
-    let (own, triangles, parts) = terms(i, clusters, coupling, offsets, receivers);
-    let mut factors: Vec<(usize, f64)> = own.chain(triangles).chain(parts).collect();
-    factors.sort_unstable_by_key(|f| f.0);
+    let mut factors = Vec::new();
+    for_each_factor(i, clusters, coupling, offsets, receivers, |l, f, _| factors.push((l, f)));
+    factors.sort_unstable_by_key(|f: &(usize, f64)| f.0);
     factors.dedup_by(|next, kept| {
         let same = next.0 == kept.0;
         if same {
