@@ -419,3 +419,28 @@ fn shadow_samples_lie_across_the_exact_penumbra_and_umbra() {
     assert!(lit > 20 && shadow_tagged > 20);
     assert!(ratio >= 3.0, "penumbra density {ratio:.2} x the floor's mean");
 }
+
+/// A closed cube room of reflectance 0.9 (the ceiling's middle ninth a
+/// lamp of exitance 10 that reflects too) keeps all its light: its
+/// surfaces reflect `R = rho (Phi + R)`, `R = rho Phi / (1 - rho)` = 10 W,
+/// and the secondary emitters must shoot that power between them (the sum
+/// of area times radiosity shot, within 3%; -1.9% measured, the shooting
+/// stopping at a thousandth of the emitted power unshot). Before the
+/// samples on a surface's edges took the neighbouring surfaces' factors
+/// as their limit and each polygon passed on what its area received,
+/// 39% of it was lost (`structured_sample::shooting`).
+#[test]
+fn a_closed_room_shoots_all_the_light_it_reflects() {
+    let dir = scratch("structured_closed_room");
+    let (rho, exitance) = (0.9, 10.0);
+    let scene_path = test_support::scenes::closed_box(1.0, rho, exitance).write(&dir);
+    let (mesh, manifest, samples, image) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("samples.exr"), dir.join("image.exr"));
+    run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
+    run_ok("structured-sample", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&samples), "--image", s(&image)]);
+    let emitters = Samples::read(&samples).unwrap().0.emitters;
+    let reflected = rho * exitance / 9.0 / (1.0 - rho);
+    for c in 0..3 {
+        let shot: f64 = emitters.iter().map(|e| e.area * e.shot[c]).sum();
+        assert!((shot / reflected - 1.0).abs() < 0.03, "channel {c}: {shot} W shot against {reflected} W reflected");
+    }
+}

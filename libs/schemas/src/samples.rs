@@ -124,7 +124,7 @@ pub struct SecondaryEmitter {
     /// Area, m².
     pub area: f64,
     /// Radiosity it shot in all, W/m², RGB: the sum over its shots of its
-    /// vertices' averaged unshot radiosity.
+    /// unshot radiosity (the mean over its area of what it received).
     pub shot: [f64; 3],
     /// Its triangles, as sample indices (counter-clockwise seen from the
     /// front).

@@ -3,8 +3,9 @@
 //! Cohen, Chen, Wallace, Greenberg 1988):
 //!
 //! - each secondary emitter polygon `P` holds unshot radiosity `dB_P`, the
-//!   average over its vertices of what they received and have not yet
-//!   passed on ("the values at the vertices of each polygon are averaged");
+//!   average over its area of what it received and has not yet passed on
+//!   ("the values at the vertices of each polygon are averaged": here
+//!   weighted by area, linear over its triangles between their corners);
 //! - the polygon of highest unshot power `A_P Y(dB_P)` shoots next, to
 //!   every sample `x` of the other surfaces, with Lambert's formula over
 //!   its triangles:
@@ -13,15 +14,21 @@
 //!   dE(x) = dB_P F_{dx->P} V_P(x),   V_P(x) = (clear rays from P's vertices to x) / (P's vertices)
 //!   ```
 //!
-//!   the paper's occlusion: "a ray is cast from each v_i to every display
+//!   (`F` at a sample on the sender's plane is the limit from inside its
+//!   own surface, [`Sender::unoccluded`]), the paper's occlusion: "a ray
+//!   is cast from each v_i to every display
 //!   sample ... the result at each display sample is weighted based on the
 //!   ray intersection count". The paper's polygons are coarse (a few
 //!   vertices); a merged region here may have a hundred, so at most
 //!   `occlusion_vertices` of them cast rays, evenly spread over the
 //!   vertex list (all of them where there are fewer);
-//! - a sample of reflectance `rho` gains `rho dE` of radiosity, and every
-//!   polygon it is a vertex of gains the vertex average of those gains as
-//!   unshot radiosity;
+//! - a sample of reflectance `rho` gains `rho dE` of radiosity (what the
+//!   display shows), and every polygon `Q` gains as unshot radiosity the
+//!   mean of `rho dE` over its area, integrated over its triangles
+//!   ([`Sender::received`]), so that the power a shot leaves on the
+//!   polygons is the power their samples' light stands for (a closed room
+//!   of reflectance 0.9 shot 39% too little before, 1.9% now: README,
+//!   Structured sampling, **Energy**);
 //! - shooting stops when the unshot power of all polygons together is
 //!   under `threshold` of the power the light sources emit, or after
 //!   `max_shots`.
@@ -94,21 +101,14 @@ pub fn shoot(polygons: &[Polygon], samples: &mut [Collector], rays: &SceneRays, 
     let generations = params.bounces.max(1) as usize;
     let mut unshot = vec![vec![[0.0; 3]; generations]; polygons.len()];
     for (p, polygon) in polygons.iter().enumerate() {
-        unshot[p][0] = vertex_mean(polygon, |s| samples[s].direct);
-    }
-    let mut member_of: Vec<Vec<usize>> = vec![Vec::new(); samples.len()];
-    for (p, polygon) in polygons.iter().enumerate() {
-        for &v in &polygon.vertices {
-            member_of[v as usize].push(p);
-        }
+        unshot[p][0] = area_mean(polygon, samples, |s| samples[s].direct);
     }
     let mut work = ShootingWork { shot: vec![[0.0; 3]; polygons.len()], ..Default::default() };
     let power = |p: usize, g: usize, unshot: &[Vec<[f64; 3]>]| polygons[p].area * luminance(unshot[p][g]);
-    // Each polygon's transfer factors, kept from its first shot for the
-    // next ones (its geometry and occlusion do not change).
-    let mut transfer: Vec<Option<Vec<f64>>> = vec![None; polygons.len()];
+    // Each polygon's transfer, kept from its first shot for the next ones
+    // (its geometry and occlusion do not change).
+    let mut transfer: Vec<Option<Transfer>> = polygons.iter().map(|_| None).collect();
     let mut cached = 0usize;
-    let mut gains: Vec<[f64; 3]> = Vec::with_capacity(samples.len());
     loop {
         let best = (0..polygons.len()).flat_map(|p| (0..generations).map(move |g| (p, g))).max_by(|a, b| power(a.0, a.1, &unshot).total_cmp(&power(b.0, b.1, &unshot)));
         let Some((p, g)) = best else {
@@ -128,29 +128,70 @@ pub fn shoot(polygons: &[Polygon], samples: &mut [Collector], rays: &SceneRays, 
         for (s, d) in work.shot[p].iter_mut().zip(db) {
             *s += d;
         }
-        if transfer[p].is_none() {
-            let (factors, rays_cast) = transfer_factors(&polygons[p], samples, rays, params.occlusion_vertices);
-            work.rays += rays_cast;
-            // Over the cache's bound, the factors serve this shot only.
-            let keep = cached + factors.len() <= CACHE_ENTRIES;
-            cached += if keep { factors.len() } else { 0 };
-            transfer[p] = Some(factors);
-            shoot_with(transfer[p].as_deref().expect("just set"), &db, samples, &mut gains);
-            if !keep {
-                transfer[p] = None;
+        let fresh = transfer[p].is_none().then(|| Transfer::of(p, polygons, samples, rays, params.occlusion_vertices));
+        let t = match &fresh {
+            Some(fresh) => {
+                work.rays += fresh.rays;
+                fresh
             }
-        } else {
-            shoot_with(transfer[p].as_deref().expect("cached"), &db, samples, &mut gains);
+            None => transfer[p].as_ref().expect("cached"),
+        };
+        shoot_with(&t.factors, &db, samples);
+        spread(&t.received, &db, g, generations, params.bounces, polygons, samples, &mut unshot);
+        if let Some(fresh) = fresh {
+            // Over the cache's bound, the transfer serves this shot only.
+            let entries = fresh.factors.len() + fresh.received.len();
+            if cached + entries <= CACHE_ENTRIES {
+                cached += entries;
+                transfer[p] = Some(fresh);
+            }
         }
-        spread(&gains, g, generations, params.bounces, &member_of, polygons, &mut unshot);
         work.shots += 1;
         shot(work.remaining);
     }
     work
 }
 
-/// Most transfer factors kept between shots (8 bytes each).
+/// Most transfer factors kept between shots (8 to 16 bytes each).
 const CACHE_ENTRIES: usize = 1 << 25;
+
+/// What a shot of one polygon brings, per unit of radiosity shot.
+struct Transfer {
+    /// Per sample, `F_{dx->P} V_P(x)` ([`Sender::factor`]).
+    factors: Vec<f64>,
+    /// `(q, mean over polygon q of F V)` for the polygons it reaches
+    /// ([`Sender::received`]).
+    received: Vec<(usize, f64)>,
+    /// Visibility rays cast.
+    rays: u64,
+}
+
+impl Transfer {
+    /// The transfer of polygon `p` to `samples` and `polygons`.
+    fn of(p: usize, polygons: &[Polygon], samples: &[Collector], rays: &SceneRays, occlusion_vertices: usize) -> Self {
+        let sender = Sender::new(&polygons[p], samples, occlusion_vertices);
+        let factors: Vec<(f64, u64)> = samples.par_iter().map(|x| sender.factor(rays, x.position, x.normal, x.surface, x.triangle)).collect();
+        let rays_cast = factors.iter().map(|f| f.1).sum();
+        let factors: Vec<f64> = factors.into_iter().map(|f| f.0).collect();
+        let received = polygons.par_iter().map(|q| sender.received(q, samples, &factors)).collect::<Vec<f64>>();
+        let received = received.into_iter().enumerate().filter(|r| r.1 > 0.0).collect();
+        Transfer { factors, received, rays: rays_cast }
+    }
+}
+
+/// How near (in lengths of its longest edge) a receiving polygon's
+/// triangle must come to the sender's bounding box for
+/// [`Sender::received`] to integrate the factor over it point by point.
+pub const NEAR_TRIANGLE: f64 = 2.0;
+
+/// Subdivisions along each edge of such a triangle: the factor is taken at
+/// the centroids of its `NEAR_SUBDIVISION²` congruent parts.
+pub const NEAR_SUBDIVISION: usize = 4;
+
+/// How near (a fraction of the sender's extent) a receiving point must lie
+/// to the sender's plane to take the factor's limit from inside its
+/// surface ([`Sender::unoccluded`]).
+pub const ON_PLANE: f64 = 1e-6;
 
 /// A polygon as a sender: its triangles' corners, its normal, and the
 /// vertices that cast its occlusion rays (at most `occlusion_vertices`,
@@ -160,6 +201,8 @@ pub struct Sender {
     corners: Vec<[DVec3; 3]>,
     normal: DVec3,
     vertices: Vec<(DVec3, u32)>,
+    /// Its bounding box.
+    bounds: (DVec3, DVec3),
 }
 
 impl Sender {
@@ -167,12 +210,111 @@ impl Sender {
     pub fn new(polygon: &Polygon, samples: &[Collector], occlusion_vertices: usize) -> Self {
         let n = polygon.vertices.len();
         let casting = n.min(occlusion_vertices.max(1));
+        let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect();
+        let bounds = corners.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)));
         Sender {
             surface: polygon.surface,
-            corners: polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect(),
+            corners,
             normal: samples[polygon.vertices[0] as usize].normal,
             vertices: (0..casting).map(|k| polygon.vertices[k * n / casting] as usize).map(|v| (samples[v].position, samples[v].triangle)).collect(),
+            bounds,
         }
+    }
+
+    /// `F_{dx->P}` at `position` (unit `normal`, on `surface`), unoccluded:
+    /// Lambert's formula summed over the triangles, 0 on the sender's own
+    /// surface.
+    ///
+    /// Where the point lies on the sender's plane (within [`ON_PLANE`] of
+    /// its extent) and its surface leaves that plane (their normals not
+    /// parallel), the factor is its limit from inside the receiving
+    /// surface: taken a millionth of the sender's extent into it, along
+    /// the surface, to the sender's front. On the plane itself Lambert's
+    /// formula gives 0 (the sender seen edge-on), but where the receiving
+    /// surface meets the sender along an edge the factor jumps there: a
+    /// point of a wall just above a floor polygon that reaches the wall
+    /// sees the floor fill up to half its hemisphere. The samples along a
+    /// surface's edges lie on the neighbouring surfaces' planes; taken on
+    /// the plane they received nothing from those neighbours, the nearest
+    /// and strongest exchange of a room, and the surface between them and
+    /// the next samples was reconstructed from that nothing. A closed box
+    /// of reflectance 0.9 was 35% dark in its mean, McGuire's empty white
+    /// box 29% against the other solvers (module docs, issue 10).
+    pub fn unoccluded(&self, position: DVec3, normal: DVec3, surface: u32) -> f64 {
+        if surface == self.surface {
+            return 0.0;
+        }
+        let position = self.off_plane(position, normal);
+        self.corners.iter().map(|c| point_to_one_sided_polygon(position, normal, c, self.normal)).sum()
+    }
+
+    /// `position`, or where it lies on the sender's plane, the point a
+    /// millionth of the sender's extent from it along its own surface
+    /// (unit `normal`) to the sender's front ([`Self::unoccluded`]).
+    fn off_plane(&self, position: DVec3, normal: DVec3) -> DVec3 {
+        let extent = (self.bounds.1 - self.bounds.0).length();
+        let height = (position - self.corners[0][0]).dot(self.normal);
+        let along = self.normal - self.normal.dot(normal) * normal;
+        let rise = along.length();
+        if height.abs() > ON_PLANE * extent || rise <= ON_PLANE {
+            return position;
+        }
+        // Along the surface, the height above the plane grows by `rise`
+        // per unit length.
+        position + along / rise * ((ON_PLANE * extent - height) / rise)
+    }
+
+    /// The mean over polygon `q`'s area of `F_{dx->P} V_P(x)`, given its
+    /// value at every sample (`factors`, [`Self::factor`]): over each of
+    /// `q`'s triangles the linear interpolation of its corners' values
+    /// (their mean times its area), but over a triangle within
+    /// [`NEAR_TRIANGLE`] of its own size from the sender, the factor at
+    /// the centroids of its [`NEAR_SUBDIVISION`]² parts ([`Self::unoccluded`]),
+    /// times the visible fraction interpolated between its corners.
+    ///
+    /// The samples are placed where the direct light varies; the factor to
+    /// a sender varies most near it, steeply and not linearly (a wall's
+    /// factor to a floor polygon at its foot falls from up to 1/2 at the
+    /// edge within the polygon's width), and there the samples'
+    /// interpolation lost up to half of what a polygon receives. The
+    /// shot's light on the samples is exact point by point; this is what
+    /// the polygons pass on. A closed box of reflectance 0.9, whose
+    /// polygons must receive all they shoot between them, went from 6.2%
+    /// dark in its mean to 0.8% (module docs).
+    fn received(&self, q: &Polygon, samples: &[Collector], factors: &[f64]) -> f64 {
+        if q.surface == self.surface {
+            return 0.0;
+        }
+        let (mut integral, mut area) = (0.0, 0.0);
+        for t in &q.triangles {
+            let x = t.map(|v| &samples[v as usize]);
+            let at = t.map(|v| factors[v as usize]);
+            let a = 0.5 * (x[1].position - x[0].position).cross(x[2].position - x[0].position).length();
+            area += a;
+            if !self.is_near(x.map(|x| x.position)) {
+                integral += a * (at[0] + at[1] + at[2]) / 3.0;
+                continue;
+            }
+            let visible = visible_at_corners(x.map(|x| self.unoccluded(x.position, x.normal, x.surface)), at);
+            let m = NEAR_SUBDIVISION;
+            let mut sum = 0.0;
+            for (u, v) in subtriangle_centroids(m) {
+                let point = x[0].position + (x[1].position - x[0].position) * u + (x[2].position - x[0].position) * v;
+                let seen = visible[0] * (1.0 - u - v) + visible[1] * u + visible[2] * v;
+                sum += self.unoccluded(point, x[0].normal, x[0].surface) * seen;
+            }
+            integral += a * sum / (m * m) as f64;
+        }
+        if area > 0.0 { integral / area } else { 0.0 }
+    }
+
+    /// Whether a triangle with `corners` lies within [`NEAR_TRIANGLE`]
+    /// lengths of its longest edge of the sender's bounding box.
+    fn is_near(&self, corners: [DVec3; 3]) -> bool {
+        let longest = (0..3).map(|i| (corners[(i + 1) % 3] - corners[i]).length()).fold(0.0, f64::max);
+        let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let gap = (self.bounds.0 - centroid).max(centroid - self.bounds.1).max(DVec3::ZERO).length();
+        gap <= NEAR_TRIANGLE * longest
     }
 
     /// `F_{dx->P} V_P(x)` at `position` (unit `normal`, on `surface` and
@@ -180,62 +322,116 @@ impl Sender {
     /// Lambert's formula summed over the triangles, the visible fraction
     /// by one ray from each casting vertex.
     pub fn factor(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32) -> (f64, u64) {
-        if surface == self.surface {
-            return (0.0, 0);
-        }
-        let factor: f64 = self.corners.iter().map(|c| point_to_one_sided_polygon(position, normal, c, self.normal)).sum();
+        let factor = self.unoccluded(position, normal, surface);
         if factor <= 0.0 {
             return (0.0, 0);
         }
+        let position = self.off_plane(position, normal);
         let clear = self.vertices.iter().filter(|(v, t)| rays.segment_clear(*v, position, [*t, triangle])).count();
         (factor * clear as f64 / self.vertices.len() as f64, self.vertices.len() as u64)
     }
 }
 
-/// Per sample, [`Sender::factor`] of `polygon`, and the rays cast.
-fn transfer_factors(polygon: &Polygon, samples: &[Collector], rays: &SceneRays, occlusion_vertices: usize) -> (Vec<f64>, u64) {
-    let sender = Sender::new(polygon, samples, occlusion_vertices);
-    let factors: Vec<(f64, u64)> = samples.par_iter().map(|x| sender.factor(rays, x.position, x.normal, x.surface, x.triangle)).collect();
-    let rays_cast = factors.iter().map(|f| f.1).sum();
-    (factors.into_iter().map(|f| f.0).collect(), rays_cast)
+/// The visible fraction at a triangle's corners, from their factors
+/// without (`unoccluded`) and with occlusion (`factors`): where a corner
+/// does not see the sender at all, the mean of the others' (1 where none
+/// does).
+fn visible_at_corners(unoccluded: [f64; 3], factors: [f64; 3]) -> [f64; 3] {
+    let known: Vec<f64> = (0..3).filter(|&i| unoccluded[i] > 0.0).map(|i| (factors[i] / unoccluded[i]).clamp(0.0, 1.0)).collect();
+    let fill = if known.is_empty() { 1.0 } else { known.iter().sum::<f64>() / known.len() as f64 };
+    std::array::from_fn(|i| if unoccluded[i] > 0.0 { (factors[i] / unoccluded[i]).clamp(0.0, 1.0) } else { fill })
 }
 
-/// Adds `rho dB F V` to every sample's `indirect` and leaves it in `gains`.
-fn shoot_with(factors: &[f64], db: &[f64; 3], samples: &mut [Collector], gains: &mut Vec<[f64; 3]>) {
-    gains.clear();
+/// The barycentric coordinates `(u, v)` (of the second and third corner)
+/// of the centroids of the `m²` congruent triangles that cut each edge of
+/// a triangle into `m`.
+fn subtriangle_centroids(m: usize) -> impl Iterator<Item = (f64, f64)> {
+    let m = m as f64;
+    let cells = (0..m as usize).flat_map(move |i| (0..m as usize - i).map(move |j| (i as f64, j as f64)));
+    cells.flat_map(move |(i, j)| {
+        let upright = Some(((i + 1.0 / 3.0) / m, (j + 1.0 / 3.0) / m));
+        let inverted = (i + j + 2.0 <= m).then_some(((i + 2.0 / 3.0) / m, (j + 2.0 / 3.0) / m));
+        upright.into_iter().chain(inverted)
+    })
+}
+
+/// Adds `rho dB F V` to every sample's `indirect`.
+fn shoot_with(factors: &[f64], db: &[f64; 3], samples: &mut [Collector]) {
     for (x, f) in samples.iter_mut().zip(factors) {
-        let gain = [0, 1, 2].map(|k| x.reflectance[k] * db[k] * f);
-        for (i, d) in x.indirect.iter_mut().zip(gain) {
-            *i += d;
+        let rho = x.reflectance;
+        for ((i, r), d) in x.indirect.iter_mut().zip(rho).zip(db) {
+            *i += r * d * f;
         }
-        gains.push(gain);
     }
 }
 
-/// Passes the samples' `gains` from a shot of generation `g` on to the
-/// unshot radiosity of the polygons they are vertices of: generation
-/// `g + 1`, or none past the last one `bounces` allows.
-fn spread(gains: &[[f64; 3]], g: usize, generations: usize, bounces: u32, member_of: &[Vec<usize>], polygons: &[Polygon], unshot: &mut [Vec<[f64; 3]>]) {
+/// Passes a shot of radiosity `db`, generation `g`, on to the unshot
+/// radiosity of the polygons it reaches (`received`, [`Transfer`]):
+/// generation `g + 1`, or none past the last one `bounces` allows.
+#[allow(clippy::too_many_arguments)]
+fn spread(received: &[(usize, f64)], db: &[f64; 3], g: usize, generations: usize, bounces: u32, polygons: &[Polygon], samples: &[Collector], unshot: &mut [Vec<[f64; 3]>]) {
     let next = if bounces == 0 { Some(0) } else { (g + 1 < generations).then_some(g + 1) };
     let Some(next) = next else { return };
-    let mut touched: Vec<usize> = gains.iter().enumerate().filter(|(_, g)| **g != [0.0; 3]).flat_map(|(s, _)| member_of[s].iter().copied()).collect();
-    touched.sort_unstable();
-    touched.dedup();
-    for q in touched {
-        let mean = vertex_mean(&polygons[q], |s| gains[s]);
-        for (u, m) in unshot[q][next].iter_mut().zip(mean) {
-            *u += m;
+    for &(q, r) in received {
+        let rho = samples[polygons[q].vertices[0] as usize].reflectance;
+        for ((u, p), d) in unshot[q][next].iter_mut().zip(rho).zip(db) {
+            *u += p * d * r;
         }
     }
 }
 
-/// The mean over `polygon`'s vertices of `value`.
-fn vertex_mean(polygon: &Polygon, value: impl Fn(usize) -> [f64; 3]) -> [f64; 3] {
-    let mut sum = [0.0; 3];
-    for &v in &polygon.vertices {
-        for (s, x) in sum.iter_mut().zip(value(v as usize)) {
-            *s += x;
+/// The mean of `value` over `polygon`'s area, linear over each of its
+/// triangles between the samples at its corners (`samples`' positions).
+fn area_mean(polygon: &Polygon, samples: &[Collector], value: impl Fn(usize) -> [f64; 3]) -> [f64; 3] {
+    let (mut sum, mut area) = ([0.0; 3], 0.0);
+    for t in &polygon.triangles {
+        let [a, b, c] = t.map(|v| samples[v as usize].position);
+        let w = 0.5 * (b - a).cross(c - a).length();
+        area += w;
+        let v = t.map(|v| value(v as usize));
+        for (k, s) in sum.iter_mut().enumerate() {
+            *s += w * (v[0][k] + v[1][k] + v[2][k]) / 3.0;
         }
     }
-    sum.map(|s| s / polygon.vertices.len() as f64)
+    if area > 0.0 { sum.map(|s| s / area) } else { sum }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::dvec3;
+    use test_support::closed_form::perpendicular_rectangles;
+
+    /// A rectangle as a polygon of surface `surface` whose only samples are
+    /// its four corners (appended to `samples`), two triangles.
+    fn rectangle(samples: &mut Vec<Collector>, surface: u32, corners: [DVec3; 4], normal: DVec3) -> Polygon {
+        let first = samples.len() as u32;
+        for position in corners {
+            samples.push(Collector { position, normal, surface, triangle: surface, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3] });
+        }
+        let area = (corners[1] - corners[0]).cross(corners[3] - corners[0]).length();
+        Polygon { surface, triangles: vec![[first, first + 1, first + 2], [first, first + 2, first + 3]], vertices: (first..first + 4).collect(), area }
+    }
+
+    /// A floor `w x l` (z = 0, facing up) and a wall `h x l` (y = 0,
+    /// facing +y) that meet along their edges of length `l`, each sampled
+    /// at its corners only: what the wall receives from the floor, the
+    /// mean over it of the floor's factor, is Howell's C-14 factor from
+    /// the wall to the floor, within 1.5% for two shapes (-0.2% and
+    /// -1.1%). The wall's bottom corners lie on the floor's plane, where
+    /// Lambert's formula gives 0; taken there and interpolated between the
+    /// corners, as before, the wall received 14% and 4% of it.
+    #[test]
+    fn a_wall_receives_from_the_floor_it_meets_howells_factor() {
+        for (w, h, l) in [(1.0, 1.0, 1.0), (0.3, 1.0, 2.0)] {
+            let mut samples = Vec::new();
+            let floor = rectangle(&mut samples, 0, [dvec3(0.0, 0.0, 0.0), dvec3(l, 0.0, 0.0), dvec3(l, w, 0.0), dvec3(0.0, w, 0.0)], DVec3::Z);
+            let wall = rectangle(&mut samples, 1, [dvec3(0.0, 0.0, 0.0), dvec3(0.0, 0.0, h), dvec3(l, 0.0, h), dvec3(l, 0.0, 0.0)], DVec3::Y);
+            let sender = Sender::new(&floor, &samples, 16);
+            let factors: Vec<f64> = samples.iter().map(|x| sender.unoccluded(x.position, x.normal, x.surface)).collect();
+            let received = sender.received(&wall, &samples, &factors);
+            let howell = perpendicular_rectangles(h, w, l);
+            assert!((received / howell - 1.0).abs() < 0.015, "w {w} h {h} l {l}: {received} against {howell}");
+        }
+    }
 }
