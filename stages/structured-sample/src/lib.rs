@@ -91,6 +91,9 @@ stage_kit::knobs! {
         /// Least area of a secondary emitter, as a fraction of its surface's:
         /// smaller isolux regions are merged into a neighbour.
         emitter_min_area: f64 = 0.02, "fraction of surface area", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
+        /// Secondary emitters are also cut along a grid of this many cells
+        /// along the surface's longer side (1: by isolux band alone).
+        emitter_cells: usize = 4, "cells", value(1..=256);
         /// At most this many of a secondary emitter's vertices cast its
         /// occlusion rays.
         occlusion_vertices: usize = 16, "vertices", value(1..=4096);
@@ -264,7 +267,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         let uv: Vec<DVec2> = members.iter().map(|&i| placed[i as usize].1.uv).collect();
         let grid = &grids[s];
         let min_area = params.emitter_min_area * surface.area;
-        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area));
+        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area, params.emitter_cells));
     }
     // 5. Progressive shooting.
     (progress.phase)("shooting", params.max_shots as u64);
