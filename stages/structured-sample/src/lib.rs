@@ -91,9 +91,11 @@ stage_kit::knobs! {
         /// Least area of a secondary emitter, as a fraction of its surface's:
         /// smaller isolux regions are merged into a neighbour.
         emitter_min_area: f64 = 0.02, "fraction of surface area", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
-        /// Secondary emitters are also cut along a grid of this many cells
-        /// along the surface's longer side (1: by isolux band alone).
-        emitter_cells: usize = 4, "cells", value(1..=256);
+        /// Largest side of the grid cells that also cut secondary emitters
+        /// (each sends its mean radiosity from all of it), as a fraction of
+        /// the scene's bounding-box diagonal (at 1 or more, no surface is
+        /// cut: by isolux band alone).
+        emitter_cell: f64 = 0.15, "fraction of the scene's diagonal", value(left_open(0.0, 10.0));
         /// At most this many of a secondary emitter's vertices cast its
         /// occlusion rays.
         occlusion_vertices: usize = 16, "vertices", value(1..=4096);
@@ -106,9 +108,10 @@ stage_kit::knobs! {
         bounces: u32 = 0, "", value;
         /// Display grid cells along a surface's longer side.
         display_resolution: usize = 64, "cells", value(1..=4096);
-        /// The display filter: `conical` (paper 002's cone) or
-        /// `conical-linear` (the cone with a first-order correction).
-        filter: display::Filter = display::Filter::ConicalLinear, "", value;
+        /// The display filter: `conical` (paper 002's cone),
+        /// `conical-linear` or `conical-quadratic` (the cone with a first- or
+        /// second-order correction).
+        filter: display::Filter = display::Filter::ConicalQuadratic, "", value;
         /// Radius `r` of the conical filter.
         filter_radius: f64 = 0.2, "fraction of extent", value(left_open(0.0, 10.0));
         /// Radius of the cone near shadow-boundary samples.
@@ -258,6 +261,8 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
 
     // 4. Secondary emitter polygons per reflecting surface.
     let clock = std::time::Instant::now();
+    let (lo, hi) = mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let diagonal = (hi - lo).length();
     let mut polygons = Vec::new();
     for (s, surface) in surfaces.iter().enumerate() {
         if luminance(surface.reflectance) <= 0.0 {
@@ -267,7 +272,8 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         let uv: Vec<DVec2> = members.iter().map(|&i| placed[i as usize].1.uv).collect();
         let grid = &grids[s];
         let min_area = params.emitter_min_area * surface.area;
-        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area, params.emitter_cells));
+        let cells = (surface.extent() / (params.emitter_cell * diagonal)).ceil().clamp(1.0, 256.0) as usize;
+        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area, cells));
     }
     // 5. Progressive shooting.
     (progress.phase)("shooting", params.max_shots as u64);
