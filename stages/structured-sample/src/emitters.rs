@@ -67,8 +67,9 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
 /// `emitter_min_area` and merge again, did no better. The stage sizes the
 /// cells by the scene, not the surface (its `emitter_cell`), so that a
 /// small surface is not cut: McGuire's glossy box, whose sphere has a
-/// thousand facets, cut into 4 x 4 cells each, did not finish its
-/// shooting in 10,000 shots.
+/// thousand facets, cut into 4 x 4 cells each, stopped at the 10,000-shot
+/// cap with 2.2% of its power unshot (0.27% with the cells sized by the
+/// scene; 9,512 shots to converge before the shooting kept its energy).
 #[allow(clippy::too_many_arguments)]
 pub fn isolux_polygons(surface_index: u32, surface: &Surface, indices: &[u32], uv: &[DVec2], illuminance: impl Fn(DVec2) -> f64, levels: &[f64], min_area: f64, cells: usize) -> Vec<Polygon> {
     let centroid = |t: &[usize; 3]| (uv[t[0]] + uv[t[1]] + uv[t[2]]) / 3.0;
