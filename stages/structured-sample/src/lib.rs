@@ -96,9 +96,9 @@ stage_kit::knobs! {
         /// the scene's bounding-box diagonal (at 1 or more, no surface is
         /// cut: by isolux band alone).
         emitter_cell: f64 = 0.15, "fraction of the scene's diagonal", value(left_open(0.0, 10.0));
-        /// At most this many of a secondary emitter's vertices cast its
-        /// occlusion rays.
-        occlusion_vertices: usize = 16, "vertices", value(1..=4096);
+        /// Points spread over a secondary emitter's area that cast its
+        /// occlusion rays (as many as it has vertices where it has fewer).
+        occlusion_points: usize = 16, "points", value(1..=4096);
         /// Stop shooting when the unshot power (all polygons together) is
         /// under this fraction of the emitted power.
         threshold: f64 = 1e-3, "fraction of emitted power", value(open(0.0, 1.0));
@@ -277,7 +277,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     }
     // 5. Progressive shooting.
     (progress.phase)("shooting", params.max_shots as u64);
-    let shooting_params = ShootingParams { threshold: params.threshold, max_shots: params.max_shots, bounces: params.bounces, occlusion_vertices: params.occlusion_vertices };
+    let shooting_params = ShootingParams { threshold: params.threshold, max_shots: params.max_shots, bounces: params.bounces, occlusion_points: params.occlusion_points };
     work.shooting = shoot(&polygons, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
     work.shooting_seconds = clock.elapsed().as_secs_f64();
 
@@ -290,7 +290,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     // what the emitters shot.
     let clock = std::time::Instant::now();
     let mut placed = placed;
-    let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_vertices)).collect();
+    let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_points)).collect();
     let gather = |point: DVec3, normal: DVec3, surface: u32, triangle: u32| -> ([f64; 3], u64) {
         let (mut e, mut rays_cast) = ([0.0; 3], 0);
         for (sender, shot) in senders.iter().zip(&work.shooting.shot) {
