@@ -93,7 +93,8 @@ pub struct ShootingParams {
     pub max_shots: usize,
     /// Reflections off secondary emitters; 0 for all of them.
     pub bounces: u32,
-    /// At most this many of a polygon's vertices cast occlusion rays.
+    /// At most this many points of a polygon, spread over its area, cast
+    /// its occlusion rays ([`Sender::new`]).
     pub occlusion_points: usize,
 }
 
@@ -220,7 +221,9 @@ pub struct Sender {
 }
 
 impl Sender {
-    /// The sender of `polygon`, whose vertices are `samples`.
+    /// The sender of `polygon`, whose vertices are `samples`, with as many
+    /// casting points ([`casting_points`]) as it has vertices, at most
+    /// `occlusion_points`.
     pub fn new(polygon: &Polygon, samples: &[Collector], occlusion_points: usize) -> Self {
         let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect();
         let bounds = corners.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)));
@@ -337,7 +340,7 @@ impl Sender {
     /// `F_{dx->P} V_P(x)` at `position` (unit `normal`, on `surface` and
     /// mesh `triangle`; 0 on the sender's own surface), and the rays cast:
     /// Lambert's formula summed over the triangles, the visible fraction
-    /// by one ray from each casting vertex.
+    /// by one ray from each casting point.
     pub fn factor(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32) -> (f64, u64) {
         let factor = self.unoccluded(position, normal, surface);
         if factor <= 0.0 {
@@ -480,7 +483,7 @@ mod tests {
             samples.push(Collector { position, normal: DVec3::Z, surface: 0, triangle: 0, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3] });
         }
         // Triangle (0, 1, 2): area 3; triangle (0, 2, 3): area 1.
-        let fan = Polygon { surface: 0, triangles: vec![[0, 1, 2], [0, 2, 3]], vertices: (0..16).map(|v| v % 4).collect(), area: 4.0 };
+        let fan = Polygon { surface: 0, triangles: vec![[0, 1, 2], [0, 2, 3]], vertices: (0..4).collect(), area: 4.0 };
         let points = casting_points(&fan, &samples, 16);
         let larger = points.iter().filter(|(p, _)| p.x >= 0.0).count();
         assert_eq!((points.len(), larger), (16, 12), "{points:?}");
