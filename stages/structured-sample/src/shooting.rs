@@ -218,6 +218,8 @@ pub struct Sender {
     casting: Vec<(DVec3, u32)>,
     /// Its bounding box.
     bounds: (DVec3, DVec3),
+    /// The length of the box's diagonal: what [`ON_PLANE`] is a fraction of.
+    extent: f64,
 }
 
 impl Sender {
@@ -225,7 +227,7 @@ impl Sender {
     /// casting points ([`casting_points`]) as it has vertices, at most
     /// `occlusion_points`.
     pub fn new(polygon: &Polygon, samples: &[Collector], occlusion_points: usize) -> Self {
-        let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| t.map(|s| samples[s as usize].position)).collect();
+        let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| triangle(samples, t).0).collect();
         let bounds = corners.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)));
         let (normal, extent) = (samples[polygon.vertices[0] as usize].normal, (bounds.1 - bounds.0).length());
         Sender {
@@ -238,6 +240,7 @@ impl Sender {
             // would cross the surface's own triangles.
             casting: casting_points(polygon, samples, polygon.vertices.len().min(occlusion_points.max(1))).into_iter().map(|(p, t)| (p + normal * (ON_PLANE * extent), t)).collect(),
             bounds,
+            extent,
         }
     }
 
@@ -264,7 +267,12 @@ impl Sender {
         if surface == self.surface {
             return 0.0;
         }
-        let position = self.off_plane(position, normal);
+        self.lambert(self.off_plane(position, normal), normal)
+    }
+
+    /// Lambert's formula summed over the triangles at `position` (unit
+    /// `normal`), taken as it is.
+    fn lambert(&self, position: DVec3, normal: DVec3) -> f64 {
         self.corners.iter().map(|c| point_to_one_sided_polygon(position, normal, c, self.normal)).sum()
     }
 
@@ -272,7 +280,7 @@ impl Sender {
     /// millionth of the sender's extent from it along its own surface
     /// (unit `normal`) to the sender's front ([`Self::unoccluded`]).
     fn off_plane(&self, position: DVec3, normal: DVec3) -> DVec3 {
-        let extent = (self.bounds.1 - self.bounds.0).length();
+        let extent = self.extent;
         let height = (position - self.corners[0][0]).dot(self.normal);
         let along = self.normal - self.normal.dot(normal) * normal;
         let rise = along.length();
@@ -309,7 +317,7 @@ impl Sender {
         for t in &q.triangles {
             let x = t.map(|v| &samples[v as usize]);
             let at = t.map(|v| factors[v as usize]);
-            let a = 0.5 * (x[1].position - x[0].position).cross(x[2].position - x[0].position).length();
+            let a = triangle(samples, t).1;
             area += a;
             if !self.is_near(x.map(|x| x.position)) {
                 integral += a * (at[0] + at[1] + at[2]) / 3.0;
@@ -342,14 +350,18 @@ impl Sender {
     /// Lambert's formula summed over the triangles, the visible fraction
     /// by one ray from each casting point.
     pub fn factor(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32) -> (f64, u64) {
-        let factor = self.unoccluded(position, normal, surface);
+        if surface == self.surface {
+            return (0.0, 0);
+        }
+        let position = self.off_plane(position, normal);
+        let factor = self.lambert(position, normal);
         if factor <= 0.0 {
             return (0.0, 0);
         }
         // Off its own plane to its front too, and each ray stopped short
         // of it by RAY_END_MARGIN, so that a ray that reaches it at a
         // grazing angle does not meet a surface it lies on short of it.
-        let position = self.off_plane(position, normal) + normal * (ON_PLANE * (self.bounds.1 - self.bounds.0).length());
+        let position = position + normal * (ON_PLANE * self.extent);
         let clear = self.casting.iter().filter(|(v, t)| rays.segment_clear(*v, position + (*v - position) * RAY_END_MARGIN, [*t, triangle])).count();
         (factor * clear as f64 / self.casting.len() as f64, self.casting.len() as u64)
     }
@@ -360,9 +372,10 @@ impl Sender {
 /// does not see the sender at all, the mean of the others' (1 where none
 /// does).
 fn visible_at_corners(unoccluded: [f64; 3], factors: [f64; 3]) -> [f64; 3] {
-    let known: Vec<f64> = (0..3).filter(|&i| unoccluded[i] > 0.0).map(|i| (factors[i] / unoccluded[i]).clamp(0.0, 1.0)).collect();
-    let fill = if known.is_empty() { 1.0 } else { known.iter().sum::<f64>() / known.len() as f64 };
-    std::array::from_fn(|i| if unoccluded[i] > 0.0 { (factors[i] / unoccluded[i]).clamp(0.0, 1.0) } else { fill })
+    let known: [Option<f64>; 3] = std::array::from_fn(|i| (unoccluded[i] > 0.0).then(|| (factors[i] / unoccluded[i]).clamp(0.0, 1.0)));
+    let seen = known.iter().flatten().count();
+    let fill = if seen == 0 { 1.0 } else { known.iter().flatten().sum::<f64>() / seen as f64 };
+    known.map(|v| v.unwrap_or(fill))
 }
 
 /// The barycentric coordinates `(u, v)` (of the second and third corner)
@@ -403,13 +416,18 @@ fn spread(received: &[(usize, f64)], db: &[f64; 3], g: usize, generations: usize
     }
 }
 
+/// A polygon's triangle (sample indices): its corners and its area.
+fn triangle(samples: &[Collector], t: &[u32; 3]) -> ([DVec3; 3], f64) {
+    let c = t.map(|v| samples[v as usize].position);
+    (c, 0.5 * (c[1] - c[0]).cross(c[2] - c[0]).length())
+}
+
 /// The mean of `value` over `polygon`'s area, linear over each of its
 /// triangles between the samples at its corners (`samples`' positions).
 fn area_mean(polygon: &Polygon, samples: &[Collector], value: impl Fn(usize) -> [f64; 3]) -> [f64; 3] {
     let (mut sum, mut area) = ([0.0; 3], 0.0);
     for t in &polygon.triangles {
-        let [a, b, c] = t.map(|v| samples[v as usize].position);
-        let w = 0.5 * (b - a).cross(c - a).length();
+        let w = triangle(samples, t).1;
         area += w;
         let v = t.map(|v| value(v as usize));
         for (k, s) in sum.iter_mut().enumerate() {
@@ -427,14 +445,7 @@ fn area_mean(polygon: &Polygon, samples: &[Collector], value: impl Fn(usize) -> 
 /// count`, at the `k`-th point of the plastic-number sequence (a
 /// low-discrepancy sequence in the unit square, folded into the triangle).
 fn casting_points(polygon: &Polygon, samples: &[Collector], count: usize) -> Vec<(DVec3, u32)> {
-    let triangles: Vec<([DVec3; 3], f64)> = polygon
-        .triangles
-        .iter()
-        .map(|t| {
-            let c = t.map(|v| samples[v as usize].position);
-            (c, 0.5 * (c[1] - c[0]).cross(c[2] - c[0]).length())
-        })
-        .collect();
+    let triangles: Vec<([DVec3; 3], f64)> = polygon.triangles.iter().map(|t| triangle(samples, t)).collect();
     let total: f64 = triangles.iter().map(|t| t.1).sum();
     // The plastic number's reciprocal powers (Roberts' R2 sequence).
     const G: f64 = 1.324_717_957_244_746;
