@@ -160,10 +160,9 @@ fn every_leaf_of_an_integrating_sphere_has_the_closed_form_radiosity_and_filteri
     // at a crease of angle alpha sees it over a half-plane, F = (1 - cos
     // alpha) / 2, which the smooth sphere lacks. So the reference is B = rho
     // (E_direct + rho Phi / ((1 - rho) A)): the direct part from Lambert's
-    // polygon formula over the lamp's facets (the test's own), at each
-    // corner with the area-weighted mean normal of the leaves around it
-    // (Lambert's factor is linear in the normal: this is the mean over
-    // those leaves' planes, the vertex value photon-trace documents), the
+    // polygon formula over the lamp's facets (the test's own), averaged
+    // over the leaf ([`leaf_mean`]) with the leaf's own normal (a facet
+    // is lit as its plane is), the
     // indirect part the closed form (a sphere spreads any emission evenly;
     // the facets change that by far less than the tolerance). Leaves with
     // a corner on the lamp are left out (there the direct light changes by
@@ -182,35 +181,14 @@ fn every_leaf_of_an_integrating_sphere_has_the_closed_form_radiosity_and_filteri
     let on_lamp = |p: &[f64; 3]| lamp_facets.iter().flatten().any(|q| (0..3).all(|k| (p[k] - q[k]).abs() < 1e-6));
     let radius = |p: &[f64; 3]| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
     let off_lamp = |l: &Leaf| mesh.triangles[l.triangle as usize].material != lamp;
-    // Sum of area x unit normal and of area of the shell leaves at each
-    // corner point.
-    let key = |p: &[f64; 3]| p.map(|x| (x * 1e6).round() as i64);
-    let mut normals: std::collections::HashMap<[i64; 3], ([f64; 3], f64)> = std::collections::HashMap::new();
-    for l in leaves.iter().filter(|l| off_lamp(l)) {
+    let (mut worst, mut checked) = (0.0f64, 0);
+    for l in leaves.iter().filter(|l| off_lamp(l) && l.corners.iter().all(|c| (radius(c) - 1.0).abs() < 1e-4 && !on_lamp(c))) {
         let [a, b, c] = l.corners;
         let (u, v) = ([0, 1, 2].map(|k| b[k] - a[k]), [0, 1, 2].map(|k| c[k] - a[k]));
         let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
-        let twice_area = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        for corner in &l.corners {
-            let entry = normals.entry(key(corner)).or_insert(([0.0; 3], 0.0));
-            for (sum, x) in entry.0.iter_mut().zip(n) {
-                *sum += 0.5 * x; // area x unit normal = n / 2
-            }
-            entry.1 += 0.5 * twice_area;
-        }
-    }
-    let (mut worst, mut checked) = (0.0f64, 0);
-    for l in leaves.iter().filter(|l| off_lamp(l) && l.corners.iter().all(|c| (radius(c) - 1.0).abs() < 1e-4 && !on_lamp(c))) {
-        let direct = l
-            .corners
-            .iter()
-            .map(|c| {
-                let (sum, area) = normals[&key(c)];
-                let normal = sum.map(|x| x / area);
-                m * lamp_facets.iter().map(|f| lambert_polygon(*c, normal, f)).sum::<f64>()
-            })
-            .sum::<f64>()
-            / 3.0;
+        let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let normal = n.map(|x| x / length);
+        let direct = leaf_mean(&l.corners, |p| m * lamp_facets.iter().map(|f| lambert_polygon(p, normal, f)).sum::<f64>());
         let reference = rho * (direct + rho * phi / ((1.0 - rho) * manifest.statistics.total_area));
         let error = (l.b - reference).abs() / reference;
         worst = worst.max(error);
@@ -260,6 +238,24 @@ fn every_leaf_of_an_integrating_sphere_has_the_closed_form_radiosity_and_filteri
 /// 0.4 x 0.4 m square at z = 0.5 shifted off-centre. The emitter and
 /// occluder are black and the floor is flat, so the floor receives no
 /// indirect light: its radiosity is 0.5 x its direct irradiance.
+/// The mean of `f` over the triangle `corners`: its values at the
+/// centroids of the triangle's 256 sub-triangles (16 to an edge, upright
+/// and inverted), the midpoint rule, far finer than a leaf's light bends.
+fn leaf_mean(corners: &[[f64; 3]; 3], f: impl Fn([f64; 3]) -> f64) -> f64 {
+    let n = 16;
+    let at = |u: f64, v: f64| f(std::array::from_fn(|k| corners[0][k] + u / n as f64 * (corners[1][k] - corners[0][k]) + v / n as f64 * (corners[2][k] - corners[0][k])));
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n - i {
+            sum += at(i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0);
+            if i + j + 1 < n {
+                sum += at(i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0);
+            }
+        }
+    }
+    sum / (n * n) as f64
+}
+
 fn floor_under_lamp(occluder: bool) -> QuadScene {
     let mut scene = QuadScene { camera: ([1.0, -2.0, 2.0], [0.0, 0.0, 0.0]), ..Default::default() };
     scene.material("floor", 0.5, 0.0).material("lamp", 0.0, 10.0).material("black", 0.0, 0.0);
@@ -276,20 +272,28 @@ fn floor_under_lamp(occluder: bool) -> QuadScene {
 #[test]
 fn the_direct_pass_matches_lamberts_formula_at_every_leaf() {
     // Direct light only (see floor_under_lamp): every floor leaf is the
-    // mean of its corners' 0.5 x 10 x F, F from Howell's B-3 rectangle
-    // factor (independent of the stage's kernel). Nothing is random here
-    // but the photons, which deposit nothing on the floor.
+    // mean over its area of 0.5 x 10 x F, F from Howell's B-3 rectangle
+    // factor (independent of the stage's kernel), by [`leaf_mean`]. Nothing is random here but the photons,
+    // which deposit nothing on the floor. The mean of the leaf's corners,
+    // which the stage wrote before, errs by the light's curvature:
+    // measured up to 3.3% on these leaves, against 0.09% now.
     let dir = scratch("photon_direct");
     prepare(&dir, &[s(&floor_under_lamp(false).write(&dir))]);
     let solution = trace(&dir, "solution", &["--max-photons", "65536"]);
     let (manifest, mesh, leaves) = read_leaves(&dir, &solution);
     let floor = manifest.materials.iter().position(|m| m.name == "floor").unwrap() as u32;
-    let mut checked = 0;
+    let b = |p: [f64; 3]| 5.0 * point_to_rectangle(p[0], p[1], [-0.25, 0.25, -0.25, 0.25], 1.0);
+    let (mut checked, mut worst, mut worst_corners) = (0, 0.0f64, 0.0f64);
     for l in leaves.iter().filter(|l| mesh.triangles[l.triangle as usize].material == floor) {
-        let expected = l.corners.iter().map(|c| 5.0 * point_to_rectangle(c[0], c[1], [-0.25, 0.25, -0.25, 0.25], 1.0)).sum::<f64>() / 3.0;
-        assert!((l.b / expected - 1.0).abs() < 0.005, "leaf at {:?}: {} vs Lambert {expected}", l.corners, l.b);
+        let exact = leaf_mean(&l.corners, b);
+        let corners = l.corners.iter().map(|&c| b(c)).sum::<f64>() / 3.0;
+        worst = worst.max((l.b / exact - 1.0).abs());
+        worst_corners = worst_corners.max((corners / exact - 1.0).abs());
         checked += 1;
     }
+    eprintln!("{checked} floor leaves: worst {worst:.2e}, the corners' mean {worst_corners:.2e}");
+    assert!(worst < 0.002, "a leaf {worst} off its mean");
+    assert!(worst_corners > 0.005, "the corners' mean would pass too ({worst_corners}): the test sees nothing");
     assert!(checked > 50, "{checked} floor leaves");
 }
 
@@ -365,18 +369,16 @@ fn the_perceptual_splitter_refines_along_the_shadow_edge_and_not_in_the_smooth_i
 
 #[test]
 fn photon_trace_and_hierarchical_solve_agree_on_the_cornell_box() {
-    // Per object, the power the two solutions' leaves reflect (area times
-    // radiosity, summed) must agree within the photon estimate's reported
-    // error, its largest vertex error (1 sigma of a vertex; an object's
-    // mean over many vertices is better), which then also covers
-    // hierarchical-solve's own error at its defaults (about 1% per surface
-    // against Mitsuba) and the difference in discretisation (vertex-sampled
-    // direct light against element averages). Power, not the area mean:
-    // hierarchical-solve's leaf areas leave out the floor under the blocks,
-    // and a leaf crossing a block's footprint shows its open part's
-    // radiosity, while photon-trace's leaves spread their photons over
-    // their whole area (the floor's area means differ by its buried 18%).
-    // Measured: every object within 1.1% at sigma 2%.
+    // Per object, the two solutions' mean radiosity over the area open to
+    // the scene (each leaf's `area` leaves out what lies buried under a
+    // block, and its radiosity is its open part's) must agree within the
+    // photon estimate's reported error, its largest vertex error (1 sigma
+    // of a vertex; an object's mean over many vertices is better), which
+    // then also covers hierarchical-solve's own error at its defaults
+    // (about 1% per surface against Mitsuba). Before photon-trace measured
+    // burial, its floor spread the light of its open part over the 18%
+    // under the blocks: -18% here. Measured: every object within 0.2% at
+    // sigma 2%.
     let dir = scratch("photon_cornell");
     prepare(&dir, &["--builtin", "cornell-box"]);
     let photon = trace(&dir, "photon", &["--target-error", "0.02"]);
@@ -387,9 +389,12 @@ fn photon_trace_and_hierarchical_solve_agree_on_the_cornell_box() {
     let (_, _, h) = read_leaves(&dir, &hierarchical);
     for (k, object) in manifest.objects.iter().enumerate() {
         let of = |l: &Leaf| mesh.triangles[l.triangle as usize].object == k as u32;
-        let power = |leaves: &[Leaf]| leaves.iter().filter(|l| of(l)).map(|l| l.area * l.b).sum::<f64>();
-        let (bp, bh) = (power(&p), power(&h));
-        eprintln!("{object}: photon {bp:.4} W, hierarchical {bh:.4} W ({:+.2}%)", 100.0 * (bp / bh - 1.0));
+        let mean = |leaves: &[Leaf]| {
+            let area: f64 = leaves.iter().filter(|l| of(l)).map(|l| l.area).sum();
+            leaves.iter().filter(|l| of(l)).map(|l| l.area * l.b).sum::<f64>() / area
+        };
+        let (bp, bh) = (mean(&p), mean(&h));
+        eprintln!("{object}: photon {bp:.4} W/m², hierarchical {bh:.4} W/m² ({:+.2}%)", 100.0 * (bp / bh - 1.0));
         assert!((bp / bh - 1.0).abs() < sigma, "{object}: photon-trace {bp} vs hierarchical-solve {bh} (reported error {sigma})");
     }
 }

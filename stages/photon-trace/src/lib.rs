@@ -34,9 +34,10 @@
 //! functions those sums project onto.
 //!
 //! Radiosity at a vertex is `B = M + rho (E_direct + E_indirect)` (stage 1:
-//! `M + rho E`), per channel; an element's radiosity in `solution.exr` is
-//! the mean of its corners' (the mean of the linear interpolant), so
-//! grid-gather renders it as any solution.
+//! `M + rho E`), per channel; a leaf's radiosity in `solution.exr` is its
+//! mean over its part open to the scene ([`exposure`]): the direct light's
+//! by its edge midpoints ([`mean_points`]), the indirect light's the mean
+//! of its linear interpolant, so grid-gather renders it as any solution.
 //!
 //! Reproducible: photons come in rounds of `batches_per_round` batches of
 //! `batch_photons`; batch `i` of stage `s` draws from its own stream
@@ -48,6 +49,7 @@
 //! reports the work and the error against time ([`report`]).
 
 pub mod direct;
+pub mod exposure;
 pub mod filter;
 pub mod mesh;
 pub mod perceptual;
@@ -57,6 +59,7 @@ pub mod tally;
 pub mod tracing;
 
 use direct::{AreaLight, DirectScene, Query};
+use exposure::Exposure;
 use filter::{Estimates, VertexTree};
 use glam::DVec3;
 use mesh::{Elements, PointKey, Vertices};
@@ -66,6 +69,7 @@ use stage_kit::scene::{luminaires, mesh_triangles};
 use radiometry::photometry::{DirectLight, Luminaire};
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
+use radiometry::subdivision::to_triangle_uv;
 use rayon::prelude::*;
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::Element;
@@ -176,6 +180,8 @@ pub struct Work {
     pub photon_rays: u64,
     /// Shadow rays of the direct pass.
     pub direct_rays: u64,
+    /// Rays that tested the leaves' points for burial ([`exposure`]).
+    pub exposure_rays: u64,
     /// Photons dropped at the bounce limit.
     pub capped_photons: u64,
     /// Leaves split by the perceptual criterion.
@@ -237,18 +243,29 @@ struct Setup<'a> {
     diagonal: f64,
 }
 
+impl Setup<'_> {
+    /// Where rays start: past the rounding of their f32 origins.
+    fn t_min(&self) -> f32 {
+        (1e-6 * self.diagonal) as f32
+    }
+}
+
 /// The leaf mesh in its current state, with everything per vertex.
 struct State {
     elements: Elements,
+    exposure: Exposure,
     vertices: Vertices,
     tree: VertexTree,
 }
 
 impl State {
-    fn new(setup: &Setup, elements: Elements, cos_crease: f64) -> Self {
-        let vertices = Vertices::new(setup.mesh, &setup.geometry, &elements, cos_crease);
+    /// The state of `elements`, whose leaves created since `exposure` was
+    /// measured are measured now.
+    fn new(setup: &Setup, elements: Elements, mut exposure: Exposure, params: &Params, work: &mut Work) -> Self {
+        work.exposure_rays += exposure.extend(&setup.geometry, &setup.rays, &elements, setup.t_min(), params.seed);
+        let vertices = Vertices::new(setup.mesh, &setup.geometry, &elements, &exposure.open, params.crease_angle_deg.to_radians().cos());
         let tree = VertexTree::new(&vertices.position);
-        State { elements, vertices, tree }
+        State { elements, exposure, vertices, tree }
     }
 
     fn material<'a>(&self, setup: &Setup<'a>, v: usize) -> &'a schemas::mesh::Material {
@@ -290,7 +307,6 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         emitters,
         area_lights,
     };
-    let cos_crease = params.crease_angle_deg.to_radians().cos();
     let mut work = Work::default();
     let clock = || started.elapsed().as_secs_f64();
 
@@ -304,7 +320,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         }
         e += 1;
     }
-    let coarse = State::new(&setup, elements, cos_crease);
+    let coarse = State::new(&setup, elements, Exposure::default(), params, &mut work);
 
     // Stage 1: every hit.
     let mut all = Tally::new(&coarse.vertices.hat_area, params.batch_photons);
@@ -326,8 +342,8 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         let p = progress(Stage::Stochastic, all.photons(), clock(), &coarse, &errors);
         report_round(&mut work, observer, &p, round, done);
         if snapshot_due(observer, params, round, done) || done {
-            let b = vertex_radiosity(&setup, &coarse, &no_direct, &filtered(&setup, &coarse, &mean, &errors, params));
-            let elements = element_radiosity(&coarse, &b);
+            let e = interpolate(&coarse, &coarse, &filtered(&setup, &coarse, &mean, &errors, params));
+            let elements = element_radiosity(&setup, &coarse, &vec![[0.0; 3]; e.len()], &e);
             (observer.snapshot)(&Snapshot { stage: Stage::Stochastic, photons: all.photons(), seconds: clock(), max_error: p.max_error, elements })?;
         }
         if done {
@@ -351,10 +367,10 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     let coarse_direct = direct_at_vertices(&direct_scene, &coarse.vertices, &mut cache, &mut work);
     let (mean, errors) = estimate(&setup, &coarse, &coarse_direct, &indirect, params);
     let coarse_indirect = filtered(&setup, &coarse, &mean, &errors, params);
-    let mut fine = State::new(&setup, coarse.elements.clone(), cos_crease);
-    let mut direct = direct_at_vertices(&direct_scene, &fine.vertices, &mut cache, &mut work);
+    let mut fine = State::new(&setup, coarse.elements.clone(), coarse.exposure.clone(), params, &mut work);
     let smallest = params.min_area * setup.total_area;
     for _ in 0..params.max_splits {
+        let direct = direct_at_vertices(&direct_scene, &fine.vertices, &mut cache, &mut work);
         let corner_indirect = interpolate(&coarse, &fine, &coarse_indirect);
         let vertex_indirect = vertex_values(&fine, &corner_indirect);
         let luminance_of = |v: usize, e: [f64; 3], i: [f64; 3]| {
@@ -367,20 +383,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         // The direct light at the edge midpoints, the vertices a split
         // would make: a leaf is judged on how far their brightness departs
         // from its corners' interpolation ([`perceptual`]).
-        let mut queries = Vec::new();
-        let mut queued = std::collections::HashSet::new();
-        for &e in &candidates {
-            for (key, query) in midpoints(&setup, &fine.elements, e) {
-                if !cache.contains_key(&key) && queued.insert(key) {
-                    queries.push(query);
-                }
-            }
-        }
-        let (values, rays) = direct_scene.at(&queries);
-        work.direct_rays += rays;
-        for (q, value) in queries.iter().zip(values) {
-            cache.insert(direct_key(q), value);
-        }
+        cache_direct(&direct_scene, candidates.iter().flat_map(|&e| midpoints(&setup, &fine.elements, e)), &mut cache, &mut work);
         let to_split: Vec<usize> = candidates
             .into_iter()
             .filter(|&e| {
@@ -402,16 +405,13 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
             elements.split(e);
         }
         work.splits += to_split.len() as u64;
-        fine = State::new(&setup, elements, cos_crease);
-        direct = direct_at_vertices(&direct_scene, &fine.vertices, &mut cache, &mut work);
+        fine = State::new(&setup, elements, fine.exposure, params, &mut work);
     }
-    let fine_radiosity = |indirect: &[[f64; 3]]| {
-        let i = vertex_values(&fine, &interpolate(&coarse, &fine, indirect));
-        vertex_radiosity(&setup, &fine, &direct, &i)
-    };
+    let leaf_direct = direct_means(&direct_scene, &setup, &fine, &mut cache, &mut work);
+    let fine_radiosity = |indirect: &[[f64; 3]]| element_radiosity(&setup, &fine, &leaf_direct, &interpolate(&coarse, &fine, indirect));
     work.direct_s = clock();
     (observer.progress)(&Progress { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, mean_error: f64::NAN });
-    let elements = element_radiosity(&fine, &fine_radiosity(&coarse_indirect));
+    let elements = fine_radiosity(&coarse_indirect);
     (observer.snapshot)(&Snapshot { stage: Stage::Direct, photons: 0, seconds: work.direct_s, max_error: f64::NAN, elements })?;
 
     // Stage 3: indirect light only, added to the stage-1 indirect tally on
@@ -441,14 +441,14 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
             break (mean, errors);
         }
         if snapshot_due(observer, params, round, false) {
-            let elements = element_radiosity(&fine, &fine_radiosity(&filtered(&setup, &coarse, &mean, &errors, params)));
+            let elements = fine_radiosity(&filtered(&setup, &coarse, &mean, &errors, params));
             (observer.snapshot)(&Snapshot { stage: Stage::Indirect, photons: indirect.photons(), seconds: clock(), max_error: p.max_error, elements })?;
         }
     };
     work.stage3_photons = indirect.photons() - work.stage1_photons;
     work.final_s = clock();
     let smoothed = filtered(&setup, &coarse, &mean, &errors, params);
-    let elements = element_radiosity(&fine, &fine_radiosity(&smoothed));
+    let elements = fine_radiosity(&smoothed);
     work.elements = elements.len();
     work.leaves = elements.iter().filter(|e| e.is_leaf()).count();
     work.vertices = fine.vertices.len();
@@ -497,7 +497,7 @@ fn trace_round(setup: &Setup, state: &State, params: &Params, stage: u64, round:
         elements: &state.elements,
         vertices: &state.vertices,
         max_bounces: params.max_bounces,
-        t_min: (1e-6 * setup.diagonal) as f32,
+        t_min: setup.t_min(),
     };
     let n = params.batches_per_round as u64;
     let batches: Vec<tracing::Batch> = (0..n)
@@ -546,11 +546,6 @@ fn filtered(setup: &Setup, state: &State, mean: &[[f64; 3]], errors: &[f64], par
     filter::filter(&state.tree, &estimates, params.crease_angle_deg.to_radians().cos())
 }
 
-/// Per vertex: radiosity from `direct` plus the irradiance `e`.
-fn vertex_radiosity(setup: &Setup, state: &State, direct: &[[f64; 3]], e: &[[f64; 3]]) -> Vec<[f64; 3]> {
-    (0..state.vertices.len()).map(|v| radiosity(state.material(setup, v), [0, 1, 2].map(|c| direct[v][c] + e[v][c]))).collect()
-}
-
 /// The direct irradiance of every vertex, from `cache` where known.
 fn direct_at_vertices(scene: &DirectScene, vertices: &Vertices, cache: &mut HashMap<DirectKey, [f64; 3]>, work: &mut Work) -> Vec<[f64; 3]> {
     let all: Vec<Query> = (0..vertices.len())
@@ -582,13 +577,70 @@ fn midpoints(setup: &Setup, elements: &Elements, e: usize) -> [(DirectKey, Query
     let g = &setup.geometry[t];
     let c = elements.corners[e];
     let centroid = g.point([(c[0][0] + c[1][0] + c[2][0]) / 3.0, (c[0][1] + c[1][1] + c[2][1]) / 3.0]);
-    [(0, 1), (1, 2), (2, 0)].map(|(a, b)| {
-        let uv = [0.5 * (c[a][0] + c[b][0]), 0.5 * (c[a][1] + c[b][1])];
-        let key = (mesh::point_key(setup.mesh, t, uv), t as u32);
-        let p = g.point(uv);
-        let query = Query { point: p + 1e-4 * (centroid - p), normal: g.normal, triangle: t as u32, key };
-        (direct_key(&query), query)
-    })
+    [(0, 1), (1, 2), (2, 0)].map(|(a, b)| query(setup, t, [0.5 * (c[a][0] + c[b][0]), 0.5 * (c[a][1] + c[b][1])], Some(centroid)))
+}
+
+/// The direct-light query at the point `uv` of mesh triangle `t`, with its
+/// identity, moved a ten-thousandth of the way towards `towards` if given.
+fn query(setup: &Setup, t: usize, uv: [f64; 2], towards: Option<DVec3>) -> (DirectKey, Query) {
+    let g = &setup.geometry[t];
+    let key = (mesh::point_key(setup.mesh, t, uv), t as u32);
+    let p = g.point(uv);
+    let query = Query { point: towards.map_or(p, |c| p + 1e-4 * (c - p)), normal: g.normal, triangle: t as u32, key };
+    (direct_key(&query), query)
+}
+
+/// Caches the direct irradiance at `points` (those not cached yet).
+fn cache_direct(scene: &DirectScene, points: impl Iterator<Item = (DirectKey, Query)>, cache: &mut HashMap<DirectKey, [f64; 3]>, work: &mut Work) {
+    let mut queries = Vec::new();
+    let mut queued = std::collections::HashSet::new();
+    for (key, query) in points {
+        if !cache.contains_key(&key) && queued.insert(key) {
+            queries.push(query);
+        }
+    }
+    let (values, rays) = scene.at(&queries);
+    work.direct_rays += rays;
+    for (q, value) in queries.iter().zip(values) {
+        cache.insert(direct_key(q), value);
+    }
+}
+
+/// Where a leaf's mean direct irradiance is taken: the edge midpoints of
+/// a leaf open all over, the rule exact for a quadratic over a triangle;
+/// the open burial points of one partly buried ([`exposure`]); none for
+/// an inner or a wholly buried element. The mean of the corners is exact
+/// for a linear function only, and direct light is not linear over a leaf
+/// the brightness criterion kept whole: `1/r²` and the cosines bend it,
+/// so on the Cornell box's tall block, whose faces the lamp lights at a
+/// slant, the mean of the corners made the block 4% too bright against a
+/// path-traced reference.
+fn mean_points(setup: &Setup, state: &State, e: usize) -> Vec<(DirectKey, Query)> {
+    let open = state.exposure.open[e];
+    if !state.elements.elements[e].is_leaf() {
+        Vec::new()
+    } else if open == exposure::ALL_OPEN {
+        midpoints(setup, &state.elements, e).to_vec()
+    } else {
+        let t = state.elements.elements[e].triangle as usize;
+        let points = exposure::points();
+        let open_points = points.iter().enumerate().filter(|(k, _)| open & (1 << k) != 0);
+        open_points.map(|(_, &local)| query(setup, t, to_triangle_uv(&state.elements.corners[e], local), None)).collect()
+    }
+}
+
+/// Per element: a leaf's mean direct irradiance over its open part, the
+/// mean at its [`mean_points`]; zeros for the others.
+fn direct_means(scene: &DirectScene, setup: &Setup, state: &State, cache: &mut HashMap<DirectKey, [f64; 3]>, work: &mut Work) -> Vec<[f64; 3]> {
+    let points: Vec<Vec<(DirectKey, Query)>> = (0..state.elements.elements.len()).map(|e| mean_points(setup, state, e)).collect();
+    cache_direct(scene, points.iter().flatten().copied(), cache, work);
+    points
+        .iter()
+        .map(|p| match p.len() {
+            0 => [0.0; 3],
+            n => [0, 1, 2].map(|c| p.iter().map(|(key, _)| cache[key][c]).sum::<f64>() / n as f64),
+        })
+        .collect()
 }
 
 /// Per vertex, the mean of the values its leaves' corners hold.
@@ -639,26 +691,39 @@ fn snapshot_due(observer: &Observer, params: &Params, round: u64, last: bool) ->
     round.is_multiple_of(every)
 }
 
-/// The elements with radiosity: a leaf's is the mean of its corners'
-/// vertex radiosity (the mean of their linear interpolant), an inner
-/// element's the area-weighted mean of its children's.
-fn element_radiosity(state: &State, b: &[[f64; 3]]) -> Vec<Element> {
+/// The elements with radiosity and area of their open part
+/// ([`exposure`]): a leaf's radiosity is `M + rho E` with `E` its mean
+/// direct irradiance `direct` plus the mean of the indirect irradiance's
+/// linear interpolant from `indirect` at its corners over its open burial
+/// points (all open: the mean of the corners), an inner element's the
+/// open-area-weighted mean of its children's.
+fn element_radiosity(setup: &Setup, state: &State, direct: &[[f64; 3]], indirect: &[[[f64; 3]; 3]]) -> Vec<Element> {
     let mut elements = state.elements.elements.clone();
     let mut value = vec![[0.0f64; 3]; elements.len()];
-    for (e, corners) in state.vertices.of_element.iter().enumerate() {
-        if elements[e].is_leaf() {
-            value[e] = [0, 1, 2].map(|c| corners.iter().map(|&v| b[v as usize][c]).sum::<f64>() / 3.0);
+    let mut area = vec![0.0f64; elements.len()];
+    let points = exposure::points();
+    for (e, el) in elements.iter().enumerate() {
+        let open = state.exposure.open[e];
+        if el.is_leaf() && open != 0 {
+            let m = &setup.manifest.materials[setup.mesh.triangles[el.triangle as usize].material as usize];
+            let open_points: Vec<&[f64; 3]> = points.iter().enumerate().filter(|(k, _)| open & (1 << k) != 0).map(|(_, l)| l).collect();
+            let interpolated = |c: usize| open_points.iter().map(|l| (0..3).map(|k| l[k] * indirect[e][k][c]).sum::<f64>()).sum::<f64>() / open_points.len() as f64;
+            value[e] = radiosity(m, [0, 1, 2].map(|c| direct[e][c] + interpolated(c)));
+            area[e] = setup.geometry[el.triangle as usize].area / 4f64.powi(el.level as i32) * exposure::fraction(open);
         }
     }
     for e in (0..elements.len()).rev() {
         if !elements[e].is_leaf() {
             let first = elements[e].first_child as usize;
-            // The four children have equal areas (1:4 rule).
-            value[e] = [0, 1, 2].map(|c| (first..first + 4).map(|k| value[k][c]).sum::<f64>() / 4.0);
+            area[e] = (first..first + 4).map(|k| area[k]).sum();
+            if area[e] > 0.0 {
+                value[e] = [0, 1, 2].map(|c| (first..first + 4).map(|k| area[k] * value[k][c]).sum::<f64>() / area[e]);
+            }
         }
     }
-    for (el, v) in elements.iter_mut().zip(value) {
+    for (el, (v, a)) in elements.iter_mut().zip(value.into_iter().zip(area)) {
         el.radiosity = v.map(|x| x as f32);
+        el.area = a as f32;
     }
     elements
 }

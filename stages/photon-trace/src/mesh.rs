@@ -24,6 +24,7 @@
 //! by more than the crease angle, or whose materials differ, are different
 //! vertices: a wall and the floor it meets have their own irradiance.
 
+use crate::exposure;
 use glam::DVec3;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, locate_child, Corners, ROOT};
@@ -124,8 +125,9 @@ pub struct Vertices {
     /// averages too (a tessellated sphere's vertex is lit as its facets
     /// are, on average, not as the first facet alone).
     pub mean_normal: Vec<DVec3>,
-    /// Integral of the vertex's hat function, `sum A_leaf / 3` over its
-    /// leaves, m².
+    /// Integral of the vertex's hat function over the open part of its
+    /// leaves ([`crate::exposure`]), m²: `sum A_leaf / 3` where nothing is
+    /// buried.
     pub hat_area: Vec<f64>,
     /// Material index.
     pub material: Vec<u32>,
@@ -155,8 +157,10 @@ impl Vertices {
     /// The vertices of the leaves of `elements`: corners matched by their
     /// exact key, then grouped by material and by normal within
     /// `cos_crease` of the group's first leaf, in element order (so the
-    /// numbering is reproducible).
-    pub fn new(mesh: &Mesh, geometry: &[TriangleGeometry], elements: &Elements, cos_crease: f64) -> Self {
+    /// numbering is reproducible). `open` is each element's mask of open
+    /// burial points ([`crate::exposure::Exposure`]).
+    pub fn new(mesh: &Mesh, geometry: &[TriangleGeometry], elements: &Elements, open: &[u16], cos_crease: f64) -> Self {
+        let points = exposure::points();
         let mut v = Vertices { of_element: vec![[u32::MAX; 3]; elements.elements.len()], ..Default::default() };
         let mut at_point: HashMap<PointKey, Vec<u32>> = HashMap::new();
         let mut inside_sum: Vec<DVec3> = Vec::new();
@@ -194,7 +198,8 @@ impl Vertices {
                         id
                     }
                 };
-                v.hat_area[id as usize] += area / 3.0;
+                let open_points = points.iter().enumerate().filter(|(p, _)| open[e] & (1 << p) != 0);
+                v.hat_area[id as usize] += open_points.map(|(_, l)| l[k]).sum::<f64>() * area / exposure::POINTS as f64;
                 inside_sum[id as usize] += area * centroid;
                 normal_sum[id as usize] += area * g.normal;
                 v.of_element[e][k] = id;
@@ -243,7 +248,7 @@ mod tests {
         let mut elements = Elements::new(&mesh);
         elements.split(0);
         elements.split(1);
-        let v = Vertices::new(&mesh, &geometry, &elements, 0.5);
+        let v = Vertices::new(&mesh, &geometry, &elements, &vec![exposure::ALL_OPEN; elements.elements.len()], 0.5);
         // Floor: 4 square corners + 4 edge midpoints + the centre = 9
         // points; the wall: its 3 corners on its own.
         assert_eq!(v.len(), 12);

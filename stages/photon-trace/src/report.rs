@@ -44,6 +44,7 @@ pub fn summarise(w: &Work, params: &Params, skipped: Vec<String>, snapshots: Vec
         ("stage3_photons", w.stage3_photons as f64),
         ("photon_rays", w.photon_rays as f64),
         ("direct_rays", w.direct_rays as f64),
+        ("exposure_rays", w.exposure_rays as f64),
         ("capped_photons", w.capped_photons as f64),
         ("splits", w.splits as f64),
         ("elements", w.elements as f64),
