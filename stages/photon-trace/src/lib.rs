@@ -36,7 +36,7 @@
 //! Radiosity at a vertex is `B = M + rho (E_direct + E_indirect)` (stage 1:
 //! `M + rho E`), per channel; a leaf's radiosity in `solution.exr` is its
 //! mean over its part open to the scene ([`exposure`]): the direct light's
-//! by its edge midpoints ([`mean_points`]), the indirect light's the mean
+//! by its edge midpoints (`mean_points`), the indirect light's the mean
 //! of its linear interpolant, so grid-gather renders it as any solution.
 //!
 //! Reproducible: photons come in rounds of `batches_per_round` batches of
