@@ -10,7 +10,7 @@
 
 PHOTON_OUT := $(OUT)/photon
 PHOTON_TARGET ?= 0.01
-PHOTON_MAX ?= 16777216
+PHOTON_MAX ?= 67108864
 PHOTON_FLAGS ?=
 
 .PHONY: photon bench-photon

@@ -397,6 +397,25 @@ fn photon_trace_and_hierarchical_solve_agree_on_the_cornell_box() {
         eprintln!("{object}: photon {bp:.4} W/m², hierarchical {bh:.4} W/m² ({:+.2}%)", 100.0 * (bp / bh - 1.0));
         assert!((bp / bh - 1.0).abs() < sigma, "{object}: photon-trace {bp} vs hierarchical-solve {bh} (reported error {sigma})");
     }
+    // Per input triangle, where an object's mean hides errors of opposite
+    // sign (the two triangles of a block's face): within twice the
+    // reported error. The lumped vertex estimate put the short block's
+    // faces' triangles up to 18% apart from hierarchical-solve's, one
+    // above and one below; the projection within 2.7% (the ceiling beside
+    // the lamp) at sigma 2%.
+    let mut worst = (0.0f64, 0usize);
+    for t in 0..mesh.triangles.len() {
+        let mean = |leaves: &[Leaf]| {
+            let area: f64 = leaves.iter().filter(|l| l.triangle as usize == t).map(|l| l.area).sum();
+            leaves.iter().filter(|l| l.triangle as usize == t).map(|l| l.area * l.b).sum::<f64>() / area
+        };
+        let error = (mean(&p) / mean(&h) - 1.0).abs();
+        if error > worst.0 {
+            worst = (error, t);
+        }
+    }
+    eprintln!("worst input triangle: {} ({:.2}%)", worst.1, 100.0 * worst.0);
+    assert!(worst.0 < 2.0 * sigma, "input triangle {}: {:.2}% off hierarchical-solve's mean (reported error {sigma})", worst.1, 100.0 * worst.0);
 }
 
 #[test]

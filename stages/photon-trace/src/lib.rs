@@ -53,6 +53,7 @@ pub mod exposure;
 pub mod filter;
 pub mod mesh;
 pub mod perceptual;
+pub mod projection;
 pub mod report;
 pub mod snapshot;
 pub mod tally;
@@ -63,6 +64,7 @@ use exposure::Exposure;
 use filter::{Estimates, VertexTree};
 use glam::DVec3;
 use mesh::{Elements, PointKey, Vertices};
+use projection::MassMatrix;
 use radiometry::color::luminance;
 use radiometry::geometry::TriangleGeometry;
 use stage_kit::scene::{luminaires, mesh_triangles};
@@ -92,7 +94,7 @@ stage_kit::knobs! {
         /// Stage 3 stops once every vertex's estimated relative standard error of radiosity is under this (see `relative_floor`).
         target_error: f64 = 0.005, "", value(positive());
         /// Stage 3 stops once the indirect estimate holds this many photons (stage 1's included), whatever the error.
-        max_photons: u64 = 1 << 24, "photons", value(at_least(1));
+        max_photons: u64 = 1 << 26, "photons", value(at_least(1));
         /// Stage 3 stops after this many seconds of the whole run (makes the result depend on the machine).
         time_budget_s: Option<f64> = None, "s", optional(positive());
         /// A vertex's error is relative to its radiosity, or to this fraction of the scene's area-mean radiosity where that is larger (dark corners would otherwise never converge).
@@ -321,6 +323,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         e += 1;
     }
     let coarse = State::new(&setup, elements, Exposure::default(), params, &mut work);
+    let mass = MassMatrix::new(&setup.geometry, &coarse.elements, &coarse.vertices, &coarse.exposure.open);
 
     // Stage 1: every hit.
     let mut all = Tally::new(&coarse.vertices.hat_area, params.batch_photons);
@@ -330,8 +333,8 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     loop {
         let batch = trace_round(&setup, &coarse, params, 1, round, Deposit::All, &mut work);
         for b in &batch {
-            all.add(b, true);
-            indirect.add(b, false);
+            all.add(b, true, &mass);
+            indirect.add(b, false, &mass);
         }
         round += 1;
         if round == 1 {
@@ -342,7 +345,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         let p = progress(Stage::Stochastic, all.photons(), clock(), &coarse, &errors);
         report_round(&mut work, observer, &p, round, done);
         if snapshot_due(observer, params, round, done) || done {
-            let e = interpolate(&coarse, &coarse, &filtered(&setup, &coarse, &mean, &errors, params));
+            let e = interpolate(&coarse, &coarse, &filtered(&setup, &coarse, &mass, &mean, &errors, params));
             let elements = element_radiosity(&setup, &coarse, &vec![[0.0; 3]; e.len()], &e);
             (observer.snapshot)(&Snapshot { stage: Stage::Stochastic, photons: all.photons(), seconds: clock(), max_error: p.max_error, elements })?;
         }
@@ -366,7 +369,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     let mut cache: HashMap<DirectKey, [f64; 3]> = HashMap::new();
     let coarse_direct = direct_at_vertices(&direct_scene, &coarse.vertices, &mut cache, &mut work);
     let (mean, errors) = estimate(&setup, &coarse, &coarse_direct, &indirect, params);
-    let coarse_indirect = filtered(&setup, &coarse, &mean, &errors, params);
+    let coarse_indirect = filtered(&setup, &coarse, &mass, &mean, &errors, params);
     let mut fine = State::new(&setup, coarse.elements.clone(), coarse.exposure.clone(), params, &mut work);
     let smallest = params.min_area * setup.total_area;
     for _ in 0..params.max_splits {
@@ -420,7 +423,7 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
     let (mean, errors) = loop {
         let batch = trace_round(&setup, &coarse, params, 3, round, Deposit::Indirect, &mut work);
         for b in &batch {
-            indirect.add(b, false);
+            indirect.add(b, false, &mass);
         }
         round += 1;
         let (mean, errors) = estimate(&setup, &coarse, &coarse_direct, &indirect, params);
@@ -441,13 +444,13 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
             break (mean, errors);
         }
         if snapshot_due(observer, params, round, false) {
-            let elements = fine_radiosity(&filtered(&setup, &coarse, &mean, &errors, params));
+            let elements = fine_radiosity(&filtered(&setup, &coarse, &mass, &mean, &errors, params));
             (observer.snapshot)(&Snapshot { stage: Stage::Indirect, photons: indirect.photons(), seconds: clock(), max_error: p.max_error, elements })?;
         }
     };
     work.stage3_photons = indirect.photons() - work.stage1_photons;
     work.final_s = clock();
-    let smoothed = filtered(&setup, &coarse, &mean, &errors, params);
+    let smoothed = filtered(&setup, &coarse, &mass, &mean, &errors, params);
     let elements = fine_radiosity(&smoothed);
     work.elements = elements.len();
     work.leaves = elements.iter().filter(|e| e.is_leaf()).count();
@@ -537,13 +540,14 @@ fn estimate(setup: &Setup, state: &State, direct: &[[f64; 3]], tally: &Tally, pa
 }
 
 /// The irradiance `mean` filtered with each vertex's radius from its error
-/// ([`filter`]).
-fn filtered(setup: &Setup, state: &State, mean: &[[f64; 3]], errors: &[f64], params: &Params) -> Vec<[f64; 3]> {
+/// ([`filter`]), then projected onto the hat functions of mass matrix
+/// `mass` ([`projection`]).
+fn filtered(setup: &Setup, state: &State, mass: &MassMatrix, mean: &[[f64; 3]], errors: &[f64], params: &Params) -> Vec<[f64; 3]> {
     let v = &state.vertices;
     let max_radius = params.filter_radius * setup.diagonal;
     let radius: Vec<f64> = (0..v.len()).map(|i| filter::radius(v.hat_area[i], errors[i], params.target_error, max_radius)).collect();
     let estimates = Estimates { position: &v.position, normal: &v.normal, hat_area: &v.hat_area, irradiance: mean, radius: &radius };
-    filter::filter(&state.tree, &estimates, params.crease_angle_deg.to_radians().cos())
+    mass.project(&v.hat_area, &filter::filter(&state.tree, &estimates, params.crease_angle_deg.to_radians().cos()))
 }
 
 /// The direct irradiance of every vertex, from `cache` where known.
