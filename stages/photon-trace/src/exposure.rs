@@ -7,8 +7,8 @@
 //! received by the hat's whole area, and a display leaf showed the mean
 //! over its whole area: both spread the light of the open part over the
 //! buried one. On the built-in Cornell box, whose floor is one quad under
-//! both blocks, the floor came out 1.7% too dark against a path-traced
-//! reference, most of it along the blocks' bases.
+//! both blocks, the floor's mean over its open part came out 18% under
+//! hierarchical-solve's, which leaves the buried part out.
 //!
 //! So each leaf tests [`POINTS`] fixed points for burial
 //! ([`radiometry::burial::buried`]): the centroids of its sixteen
@@ -49,6 +49,12 @@ pub fn points() -> [[f64; 3]; POINTS] {
         })
         .collect();
     std::array::from_fn(|k| centroids[k])
+}
+
+/// The barycentric coordinates of the open [`points`] of a leaf with
+/// open mask `mask`.
+pub fn open_points(mask: u16) -> impl Iterator<Item = [f64; 3]> {
+    points().into_iter().enumerate().filter(move |(k, _)| mask & (1 << k) != 0).map(|(_, l)| l)
 }
 
 /// The open fraction of a leaf with open mask `mask`.

@@ -627,9 +627,7 @@ fn mean_points(setup: &Setup, state: &State, e: usize) -> Vec<(DirectKey, Query)
         midpoints(setup, &state.elements, e).to_vec()
     } else {
         let t = state.elements.elements[e].triangle as usize;
-        let points = exposure::points();
-        let open_points = points.iter().enumerate().filter(|(k, _)| open & (1 << k) != 0);
-        open_points.map(|(_, &local)| query(setup, t, to_triangle_uv(&state.elements.corners[e], local), None)).collect()
+        exposure::open_points(open).map(|local| query(setup, t, to_triangle_uv(&state.elements.corners[e], local), None)).collect()
     }
 }
 
@@ -705,12 +703,11 @@ fn element_radiosity(setup: &Setup, state: &State, direct: &[[f64; 3]], indirect
     let mut elements = state.elements.elements.clone();
     let mut value = vec![[0.0f64; 3]; elements.len()];
     let mut area = vec![0.0f64; elements.len()];
-    let points = exposure::points();
     for (e, el) in elements.iter().enumerate() {
         let open = state.exposure.open[e];
         if el.is_leaf() && open != 0 {
             let m = &setup.manifest.materials[setup.mesh.triangles[el.triangle as usize].material as usize];
-            let open_points: Vec<&[f64; 3]> = points.iter().enumerate().filter(|(k, _)| open & (1 << k) != 0).map(|(_, l)| l).collect();
+            let open_points: Vec<[f64; 3]> = exposure::open_points(open).collect();
             let interpolated = |c: usize| open_points.iter().map(|l| (0..3).map(|k| l[k] * indirect[e][k][c]).sum::<f64>()).sum::<f64>() / open_points.len() as f64;
             value[e] = radiosity(m, [0, 1, 2].map(|c| direct[e][c] + interpolated(c)));
             area[e] = setup.geometry[el.triangle as usize].area / 4f64.powi(el.level as i32) * exposure::fraction(open);

@@ -160,7 +160,6 @@ impl Vertices {
     /// numbering is reproducible). `open` is each element's mask of open
     /// burial points ([`crate::exposure::Exposure`]).
     pub fn new(mesh: &Mesh, geometry: &[TriangleGeometry], elements: &Elements, open: &[u16], cos_crease: f64) -> Self {
-        let points = exposure::points();
         let mut v = Vertices { of_element: vec![[u32::MAX; 3]; elements.elements.len()], ..Default::default() };
         let mut at_point: HashMap<PointKey, Vec<u32>> = HashMap::new();
         let mut inside_sum: Vec<DVec3> = Vec::new();
@@ -198,8 +197,7 @@ impl Vertices {
                         id
                     }
                 };
-                let open_points = points.iter().enumerate().filter(|(p, _)| open[e] & (1 << p) != 0);
-                v.hat_area[id as usize] += open_points.map(|(_, l)| l[k]).sum::<f64>() * area / exposure::POINTS as f64;
+                v.hat_area[id as usize] += exposure::open_points(open[e]).map(|l| l[k]).sum::<f64>() * area / exposure::POINTS as f64;
                 inside_sum[id as usize] += area * centroid;
                 normal_sum[id as usize] += area * g.normal;
                 v.of_element[e][k] = id;

@@ -64,7 +64,6 @@ impl MassMatrix {
     /// points' rule `A/16 sum_open l_u l_v` for one partly buried.
     pub fn new(geometry: &[TriangleGeometry], elements: &Elements, vertices: &Vertices, open: &[u16]) -> Self {
         let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); vertices.len()];
-        let points = exposure::points();
         for (e, element) in elements.elements.iter().enumerate() {
             if !element.is_leaf() || open[e] == 0 {
                 continue;
@@ -76,8 +75,7 @@ impl MassMatrix {
                     let m = if open[e] == exposure::ALL_OPEN {
                         area / 12.0 * if a == b { 2.0 } else { 1.0 }
                     } else {
-                        let open_points = points.iter().enumerate().filter(|(k, _)| open[e] & (1 << k) != 0);
-                        open_points.map(|(_, l)| l[a] * l[b]).sum::<f64>() * area / exposure::POINTS as f64
+                        exposure::open_points(open[e]).map(|l| l[a] * l[b]).sum::<f64>() * area / exposure::POINTS as f64
                     };
                     rows[corners[a] as usize].push((corners[b], m));
                 }
