@@ -547,7 +547,7 @@ fn filtered(setup: &Setup, state: &State, mass: &MassMatrix, mean: &[[f64; 3]], 
     let max_radius = params.filter_radius * setup.diagonal;
     let radius: Vec<f64> = (0..v.len()).map(|i| filter::radius(v.hat_area[i], errors[i], params.target_error, max_radius)).collect();
     let estimates = Estimates { position: &v.position, normal: &v.normal, hat_area: &v.hat_area, irradiance: mean, radius: &radius };
-    mass.project(&v.hat_area, &filter::filter(&state.tree, &estimates, params.crease_angle_deg.to_radians().cos()))
+    mass.project(&filter::filter(&state.tree, &estimates, params.crease_angle_deg.to_radians().cos()))
 }
 
 /// The direct irradiance of every vertex, from `cache` where known.
@@ -710,7 +710,7 @@ fn element_radiosity(setup: &Setup, state: &State, direct: &[[f64; 3]], indirect
             let open_points: Vec<[f64; 3]> = exposure::open_points(open).collect();
             let interpolated = |c: usize| open_points.iter().map(|l| (0..3).map(|k| l[k] * indirect[e][k][c]).sum::<f64>()).sum::<f64>() / open_points.len() as f64;
             value[e] = radiosity(m, [0, 1, 2].map(|c| direct[e][c] + interpolated(c)));
-            area[e] = setup.geometry[el.triangle as usize].area / 4f64.powi(el.level as i32) * exposure::fraction(open);
+            area[e] = state.elements.area(&setup.geometry, e) * exposure::fraction(open);
         }
     }
     for e in (0..elements.len()).rev() {

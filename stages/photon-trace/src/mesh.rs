@@ -53,6 +53,13 @@ impl Elements {
         Elements { elements, corners: vec![ROOT; mesh.triangles.len()] }
     }
 
+    /// The area of element `e`, m²: its triangle's (`geometry`) over 4 per
+    /// level (the 1:4 rule), in f64.
+    pub fn area(&self, geometry: &[TriangleGeometry], e: usize) -> f64 {
+        let element = &self.elements[e];
+        geometry[element.triangle as usize].area / 4f64.powi(element.level as i32)
+    }
+
     /// Splits leaf `e` 1:4; returns its first child.
     pub fn split(&mut self, e: usize) -> usize {
         let first = self.elements.len();
@@ -176,7 +183,7 @@ impl Vertices {
             let material = mesh.triangles[t].material;
             let world = g.element(&elements.corners[e]);
             let centroid = (world[0] + world[1] + world[2]) / 3.0;
-            let area = g.area / 4f64.powi(element.level as i32);
+            let area = elements.area(geometry, e);
             for (k, &corner) in world.iter().enumerate() {
                 let key = elements.point_key(mesh, e, k);
                 let candidates = at_point.entry(key).or_default();

@@ -68,7 +68,7 @@ impl MassMatrix {
             if !element.is_leaf() || open[e] == 0 {
                 continue;
             }
-            let area = geometry[element.triangle as usize].area / 4f64.powi(element.level as i32);
+            let area = elements.area(geometry, e);
             let corners = vertices.of_element[e];
             for a in 0..3 {
                 for b in 0..3 {
@@ -120,13 +120,14 @@ impl MassMatrix {
     }
 
     /// The projection of the irradiance whose lumped estimates are
-    /// `lumped` (vertex values over hats of areas `hat_area`): `M^-1 (H
-    /// lumped)`, each channel, negative values set to 0 (module docs).
-    /// Vertices without a hat (`M`'s empty rows) get 0.
-    pub fn project(&self, hat_area: &[f64], lumped: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    /// `lumped`: `M^-1 (H lumped)`, `H` the hat areas, which are `M`'s row
+    /// sums (so a constant maps to itself), each channel, negative values
+    /// set to 0 (module docs). Vertices without a hat (`M`'s empty rows)
+    /// get 0.
+    pub fn project(&self, lumped: &[[f64; 3]]) -> Vec<[f64; 3]> {
         let mut out = vec![[0.0; 3]; lumped.len()];
         for c in 0..3 {
-            let load: Vec<f64> = (0..lumped.len()).map(|v| hat_area[v] * lumped[v][c]).collect();
+            let load: Vec<f64> = (0..lumped.len()).map(|v| self.row_sum[v] * lumped[v][c]).collect();
             for (o, x) in out.iter_mut().zip(self.solve(&load, TOLERANCE)) {
                 o[c] = x.max(0.0);
             }
@@ -222,7 +223,7 @@ mod tests {
             }
         }
         let lumped: Vec<[f64; 3]> = (0..vertices.len()).map(|v| [load[v] / vertices.hat_area[v]; 3]).collect();
-        let projected = m.project(&vertices.hat_area, &lumped);
+        let projected = m.project(&lumped);
         let corner = (0..vertices.len()).find(|&v| vertices.position[v].length() < 1e-12).unwrap();
         for (v, (value, &p)) in projected.iter().zip(&vertices.position).enumerate() {
             assert!((value[0] - e(p)).abs() < 1e-9, "vertex {v}: {} vs {}", value[0], e(p));

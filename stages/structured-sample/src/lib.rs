@@ -56,6 +56,7 @@ use display::{DisplayGrid, FilterSample};
 use glam::{DVec2, DVec3};
 use placement::{isolux_levels, light_candidates, Candidate, Thinning};
 use probes::ProbeGrid;
+use radiometry::bounds::Aabb;
 use radiometry::color::luminance;
 use stage_kit::scene::{mesh_triangles, pinhole};
 use radiometry::rays::SceneRays;
@@ -261,8 +262,8 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
 
     // 4. Secondary emitter polygons per reflecting surface.
     let clock = std::time::Instant::now();
-    let (lo, hi) = mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    let diagonal = (hi - lo).length();
+    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
+    let diagonal = (scene.max - scene.min).length();
     let mut polygons = Vec::new();
     for (s, surface) in surfaces.iter().enumerate() {
         if luminance(surface.reflectance) <= 0.0 {

@@ -49,6 +49,7 @@
 use crate::emitters::Polygon;
 use glam::DVec3;
 use radiometry::color::luminance;
+use radiometry::bounds::Aabb;
 use radiometry::form_factor::point_to_one_sided_polygon;
 use radiometry::rays::SceneRays;
 use rayon::prelude::*;
@@ -221,7 +222,7 @@ pub struct Sender {
     normal: DVec3,
     casting: Vec<(DVec3, u32)>,
     /// Its bounding box.
-    bounds: (DVec3, DVec3),
+    bounds: Aabb,
     /// The length of the box's diagonal: what [`ON_PLANE`] is a fraction of.
     extent: f64,
 }
@@ -232,8 +233,8 @@ impl Sender {
     /// `occlusion_points`.
     pub fn new(polygon: &Polygon, samples: &[Collector], occlusion_points: usize) -> Self {
         let corners: Vec<[DVec3; 3]> = polygon.triangles.iter().map(|t| triangle(samples, t).0).collect();
-        let bounds = corners.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)));
-        let (normal, extent) = (samples[polygon.vertices[0] as usize].normal, (bounds.1 - bounds.0).length());
+        let bounds = Aabb::around(corners.iter().flatten().copied());
+        let (normal, extent) = (samples[polygon.vertices[0] as usize].normal, (bounds.max - bounds.min).length());
         Sender {
             surface: polygon.surface,
             corners,
@@ -345,7 +346,7 @@ impl Sender {
     fn is_near(&self, corners: [DVec3; 3]) -> bool {
         let longest = (0..3).map(|i| (corners[(i + 1) % 3] - corners[i]).length()).fold(0.0, f64::max);
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let gap = (self.bounds.0 - centroid).max(centroid - self.bounds.1).max(DVec3::ZERO).length();
+        let gap = (self.bounds.min - centroid).max(centroid - self.bounds.max).max(DVec3::ZERO).length();
         gap <= NEAR_TRIANGLE * longest
     }
 
@@ -381,20 +382,23 @@ impl Sender {
             let r2 = d.length_squared();
             if r2 > 0.0 { d.dot(normal).max(0.0) * (-d.dot(self.normal)).max(0.0) / (r2 * r2) } else { 0.0 }
         };
-        let weights: Vec<f64> = self.casting.iter().map(|(v, _)| kernel(*v)).collect();
-        let total: f64 = weights.iter().sum();
-        let (mut clear, mut cast) = (0.0, 0);
-        for ((v, t), &w) in self.casting.iter().zip(&weights) {
-            let weight = if total > 0.0 { w } else { 1.0 };
-            if weight > 0.0 {
+        let clear = |(v, t): &(DVec3, u32)| rays.segment_clear(*v, position + (*v - position) * RAY_END_MARGIN, [*t, triangle]);
+        let (mut seen, mut total, mut cast) = (0.0, 0.0, 0);
+        for point in &self.casting {
+            let w = kernel(point.0);
+            total += w;
+            if w > 0.0 {
                 cast += 1;
-                if rays.segment_clear(*v, position + (*v - position) * RAY_END_MARGIN, [*t, triangle]) {
-                    clear += weight;
+                if clear(point) {
+                    seen += w;
                 }
             }
         }
-        let visible = if total > 0.0 { clear / total } else { clear / self.casting.len() as f64 };
-        (factor * visible, cast)
+        if total > 0.0 {
+            return (factor * (seen / total), cast);
+        }
+        let clear_count = self.casting.iter().filter(|p| clear(p)).count();
+        (factor * (clear_count as f64 / self.casting.len() as f64), self.casting.len() as u64)
     }
 }
 
