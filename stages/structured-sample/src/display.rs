@@ -80,7 +80,7 @@ pub fn conical(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> 
 /// the samples within `r` (per channel): a plane fitted across a steep
 /// shadow edge would otherwise overshoot it, even below zero.
 pub fn conical_linear(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> {
-    fitted(samples, at, r, |d| [1.0, d.x, d.y]).or_else(|| conical(samples, at, r))
+    Fit::of(samples, at, r, |d| [1.0, d.x, d.y]).value().or_else(|| conical(samples, at, r))
 }
 
 /// The conical filter with a second-order correction: the quadric
@@ -90,57 +90,84 @@ pub fn conical_linear(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f6
 /// over a curved luminance misses its value at `at` by the cone-weighted
 /// mean of the curvature term; a quadric does not. Falls back to
 /// [`conical_linear`] where fewer than six samples lie within `r` or they
-/// do not determine a quadric.
+/// do not determine a quadric: the plane's normal equations are the
+/// quadric's leading block, so the samples are read once.
 pub fn conical_quadratic(samples: &[FilterSample], at: DVec2, r: f64) -> Option<[f64; 3]> {
-    fitted(samples, at, r, |d| [1.0, d.x, d.y, d.x * d.x, d.x * d.y, d.y * d.y]).or_else(|| conical_linear(samples, at, r))
+    let quadric = Fit::of(samples, at, r, |d| [1.0, d.x, d.y, d.x * d.x, d.x * d.y, d.y * d.y]);
+    quadric.value().or_else(|| quadric.leading::<3>().value()).or_else(|| conical(samples, at, r))
 }
 
-/// The least pivot of a fit's normal equations ([`fitted`]), as a
+/// The least pivot of a fit's normal equations ([`Fit::value`]), as a
 /// fraction of its weights' sum: below it the samples do not determine
 /// the fit. At 1e-9 a quadric fitted to samples that barely spread across
 /// a surface's edge put a few of paper 002's B's pixels 75% off at 100 x
 /// 100 (`bench/tests/structured.rs`); at 1e-4 none is 5% off.
 pub const FIT_PIVOT: f64 = 1e-4;
 
-/// The value at `at` of the function of the `N` functions `basis` (of the
-/// offset in units of `r`, the first one constant) fitted to the samples
-/// within `r` by least squares with the cone's weights `1 - d_i / r`,
-/// clamped to the range of those samples (per channel: a fit across a
-/// steep shadow edge would otherwise overshoot it, even below zero);
-/// `None` where fewer than `N` samples lie within `r` or they do not
-/// determine the fit ([`FIT_PIVOT`]).
-fn fitted<const N: usize>(samples: &[FilterSample], at: DVec2, r: f64, basis: impl Fn(DVec2) -> [f64; N]) -> Option<[f64; 3]> {
-    // Normal equations of the weighted fit.
-    let mut m = [[0.0; N]; N];
-    let mut rhs = [[0.0; N]; 3];
-    let mut count = 0;
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for s in samples {
-        let d = (s.uv - at) / r;
-        let distance = d.length();
-        if distance < 1.0 {
-            let w = 1.0 - distance;
-            let basis = basis(d);
-            for a in 0..N {
-                for b in 0..N {
-                    m[a][b] += w * basis[a] * basis[b];
+/// The weighted least-squares fit of the `N` functions `basis` (of the
+/// offset in units of `r`, the first one constant) to the samples within
+/// `r` of a point, with the cone's weights `1 - d_i / r`: its normal
+/// equations, and the count and range of those samples.
+struct Fit<const N: usize> {
+    m: [[f64; N]; N],
+    rhs: [[f64; N]; 3],
+    count: usize,
+    lo: [f64; 3],
+    hi: [f64; 3],
+}
+
+impl<const N: usize> Fit<N> {
+    /// The fit at `at` (module docs).
+    fn of(samples: &[FilterSample], at: DVec2, r: f64, basis: impl Fn(DVec2) -> [f64; N]) -> Self {
+        let mut fit = Fit { m: [[0.0; N]; N], rhs: [[0.0; N]; 3], count: 0, lo: [f64::INFINITY; 3], hi: [f64::NEG_INFINITY; 3] };
+        for s in samples {
+            let d = (s.uv - at) / r;
+            let distance = d.length();
+            if distance < 1.0 {
+                let w = 1.0 - distance;
+                let basis = basis(d);
+                for a in 0..N {
+                    for b in 0..N {
+                        fit.m[a][b] += w * basis[a] * basis[b];
+                    }
+                    for (k, l) in s.luminance.iter().enumerate() {
+                        fit.rhs[k][a] += w * basis[a] * l;
+                    }
                 }
-                for (k, l) in s.luminance.iter().enumerate() {
-                    rhs[k][a] += w * basis[a] * l;
+                for k in 0..3 {
+                    fit.lo[k] = fit.lo[k].min(s.luminance[k]);
+                    fit.hi[k] = fit.hi[k].max(s.luminance[k]);
                 }
+                fit.count += 1;
             }
-            for k in 0..3 {
-                lo[k] = lo[k].min(s.luminance[k]);
-                hi[k] = hi[k].max(s.luminance[k]);
-            }
-            count += 1;
+        }
+        fit
+    }
+
+    /// The fit of the first `K` functions alone: the leading block of the
+    /// normal equations.
+    fn leading<const K: usize>(&self) -> Fit<K> {
+        Fit {
+            m: std::array::from_fn(|a| std::array::from_fn(|b| self.m[a][b])),
+            rhs: self.rhs.map(|y| std::array::from_fn(|a| y[a])),
+            count: self.count,
+            lo: self.lo,
+            hi: self.hi,
         }
     }
-    if count < N {
-        return None;
+
+    /// The fitted function's value at the point, clamped to the range of
+    /// the samples within `r` (per channel: a fit across a steep shadow
+    /// edge would otherwise overshoot it, even below zero); `None` where
+    /// fewer than `N` samples lie within `r` or they do not determine the
+    /// fit ([`FIT_PIVOT`]).
+    fn value(&self) -> Option<[f64; 3]> {
+        if self.count < N {
+            return None;
+        }
+        let c = solve_first(self.m, self.rhs, FIT_PIVOT * self.m[0][0])?;
+        Some([0, 1, 2].map(|k| c[k].clamp(self.lo[k], self.hi[k])))
     }
-    let c = solve_first(m, rhs, FIT_PIVOT * m[0][0])?;
-    Some([0, 1, 2].map(|k| c[k].clamp(lo[k], hi[k])))
 }
 
 /// The first unknown of `m x = b` for each right-hand side `b` of `rhs`,
