@@ -65,6 +65,7 @@ use filter::{Estimates, VertexTree};
 use glam::DVec3;
 use mesh::{Elements, PointKey, Vertices};
 use projection::MassMatrix;
+use radiometry::bounds::Aabb;
 use radiometry::color::luminance;
 use radiometry::geometry::TriangleGeometry;
 use stage_kit::scene::{luminaires, mesh_triangles};
@@ -297,12 +298,12 @@ pub fn solve(mesh: &Mesh, manifest: &Manifest, params: &Params, observer: &mut O
         .filter(|(t, tri)| geometry[*t].area > 0.0 && manifest.materials[tri.material as usize].emission.iter().any(|&m| m > 0.0))
         .map(|(t, tri)| AreaLight { triangle: t as u32, exitance: manifest.materials[tri.material as usize].emission })
         .collect();
-    let (lo, hi) = corners.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let scene = Aabb::around(corners.iter().flatten().copied());
     let setup = Setup {
         mesh,
         manifest,
         total_area: geometry.iter().map(|g| g.area).sum(),
-        diagonal: (hi - lo).length(),
+        diagonal: (scene.max - scene.min).length(),
         rays: SceneRays::new(&corners),
         geometry,
         luminaires,
