@@ -6,7 +6,7 @@
 GPU_OUT := $(OUT)/gpu
 GPU_TEXELS ?= 32768
 GPU_VISIBILITY ?= hemicube
-GPU_CONVERGENCE ?= 0.99
+GPU_CONVERGENCE ?= 0.999
 GPU_SHOOT_LEVEL ?= 3
 GPU_RESOLUTION ?= 128
 # Ambient overshooting is off by default: by the unshot magnitude

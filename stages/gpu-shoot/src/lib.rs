@@ -104,7 +104,7 @@ stage_kit::knobs! {
         /// Stop when the unshot power, `sum |dB| A` (negative residuals
         /// left by overshooting count by magnitude), is at most 1 - this of
         /// the emitted power.
-        convergence_target: f64 = 0.99, "fraction of emitted power", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
+        convergence_target: f64 = 0.999, "fraction of emitted power", value(custom("in [0, 1]", |v: &f64| (0.0..=1.0).contains(v)));
         /// Stop after this many shots.
         max_shots: usize = 100_000, "shots", value;
         /// Add rho x ambient to the solution's radiosity (004 Eq. 2.4): a
