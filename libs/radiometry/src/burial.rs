@@ -73,6 +73,43 @@ pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3,
     (walls.buried(), 1 + cast)
 }
 
+/// The roofs ([`roof`]) that [`walled_in`] found a solid's over some
+/// point of one element: the element's other points under one of them
+/// are buried too, for one ray each. A roof alone proves nothing (under a
+/// sheet facing up a ray meets its back too), but under a solid the
+/// points of one element share a few roofs, and each buried point cast
+/// all [`EXPOSURE_RAYS`] without them (on the built-in Cornell box at
+/// `EPS` 1e-3 hierarchical-solve's exposure was a sixth of its solve,
+/// 283k rays, most of them along the blocks' bases and under them).
+///
+/// A point buried under a sheet ([`Walls::Sheet`]: a lamp hung 1 cm under
+/// a ceiling) proves nothing for the points beside it, which may see out
+/// under the sheet's edge.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ProvenRoofs(pub Vec<u32>);
+
+impl ProvenRoofs {
+    /// [`buried`], with the roofs proven so far: the ray along the normal
+    /// first, which settles an open point or one under a proven roof; the
+    /// rest cast the grazing rays ([`walled_in`], which draws the one
+    /// number of `stream` a point takes), and a roof over a point they find
+    /// inside a solid ([`Walls::Solid`]) joins the proven ones.
+    #[allow(clippy::too_many_arguments)]
+    pub fn buried(&mut self, scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, stream: &mut Stream) -> (bool, u64) {
+        match roof(scene, normal_of, point, normal, triangle, t_min) {
+            None => (false, 1),
+            Some(over) if self.0.contains(&over) => (true, 1),
+            Some(over) => {
+                let (walls, cast) = walled_in(scene, normal_of, point, normal, triangle, over, t_min, stream);
+                if walls == Walls::Solid {
+                    self.0.push(over);
+                }
+                (walls.buried(), 1 + cast)
+            }
+        }
+    }
+}
+
 /// What the grazing rays of a point under a roof found ([`walled_in`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Walls {
@@ -214,6 +251,20 @@ mod tests {
         // whose roof holds every point under it.
         let (walls, _) = walled_in(&scene, &normal_of, dvec3(0.5, 0.5, 0.0), DVec3::Z, floor, 2, 1e-6, &mut Stream::new(7, 8, 9));
         assert_eq!(walls, Walls::Solid);
+        // So the first point under the cube's top triangle 2 casts every
+        // ray and proves that roof; the next under it casts one ray and is
+        // buried, one under the other triangle proves that one, and the
+        // points beside the cube and in the open stay open, as `buried`
+        // has them.
+        let mut proven = ProvenRoofs::default();
+        let mut bury = |p: DVec3| proven.buried(&scene, &normal_of, p, DVec3::Z, floor, 1e-6, &mut stream);
+        assert_eq!(bury(dvec3(0.5, 0.2, 0.0)), (true, EXPOSURE_RAYS as u64));
+        assert_eq!(bury(dvec3(0.8, 0.3, 0.0)), (true, 1));
+        assert_eq!(bury(dvec3(0.2, 0.8, 0.0)), (true, EXPOSURE_RAYS as u64));
+        assert_eq!(bury(dvec3(0.3, 0.9, 0.0)), (true, 1));
+        assert!(!bury(dvec3(1.03, 0.5, 0.0)).0, "beside the cube");
+        assert_eq!(bury(dvec3(-2.0, 2.0, 0.0)), (false, 1), "in the open");
+        assert_eq!(proven.0.len(), 2, "{proven:?}");
     }
 
     /// A sheet facing up 1 cm over a floor, 2 m wide (a lamp hung just

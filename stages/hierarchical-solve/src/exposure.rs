@@ -42,7 +42,7 @@
 
 use crate::elements::Hierarchy;
 use crate::nodes::key;
-use radiometry::burial::Walls;
+use radiometry::burial::ProvenRoofs;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::{Strata, Stream};
 use rayon::prelude::*;
@@ -71,7 +71,7 @@ fn t_min(element: &crate::elements::Element) -> f32 {
 /// disagree, one ray each where a roof is known (`sampled`).
 fn of_element(h: &Hierarchy, scene: &SceneRays, e: u32, seed: u64) -> (f64, u64) {
     let mut stream = Stream::new(seed ^ 0xe790_5ed0, key(Node::Element(e)), 0xb0);
-    let first = sampled(h, scene, e, EXPOSURE_POINTS, &[], &mut stream);
+    let first = sampled(h, scene, e, EXPOSURE_POINTS, &ProvenRoofs::default(), &mut stream);
     if first.exposure > 0.0 && first.exposure < 1.0 {
         let more = sampled(h, scene, e, STRADDLING_POINTS, &first.roofs, &mut stream);
         return (more.exposure, first.rays + more.rays);
@@ -85,29 +85,16 @@ struct Sampled {
     exposure: f64,
     /// Rays cast.
     rays: u64,
-    /// The roofs ([`radiometry::burial::roof`]) over its points that
-    /// [`radiometry::burial::walled_in`] found inside a solid.
-    roofs: Vec<u32>,
+    /// The roofs over its points proven a solid's.
+    roofs: ProvenRoofs,
 }
 
 /// The exposed fraction of `n` stratified points of element `e` (those
-/// that exist; 1 where none does), the rays cast, and the roofs proven.
-/// Each point first casts its ray along the normal
-/// ([`radiometry::burial::roof`]): one that meets no back face is open,
-/// as [`radiometry::burial::buried`] decides it, and one that meets first
-/// a roof already proven (given in `roofs`, or found earlier in this
-/// call) is buried; only the rest cast the grazing rays
-/// ([`radiometry::burial::walled_in`]), and a roof over a point they
-/// find inside a solid ([`Walls::Solid`]) is proven. A roof alone proves
-/// nothing (under a sheet facing up a ray meets its back too), but under a
-/// solid the points of one element share a few roofs. Each buried point
-/// cast 17 rays before: on the built-in Cornell box at `EPS` 1e-3 exposure
-/// was a sixth of the solve (283k rays), most of it along the blocks'
-/// bases and under them.
+/// that exist; 1 where none does), the rays cast, and the roofs proven
+/// ([`ProvenRoofs`]: given in `roofs`, or found earlier in this call).
 ///
-/// A point buried under a sheet ([`Walls::Sheet`]: a lamp hung 1 cm under
-/// a ceiling) proves nothing for the points beside it, which may see out
-/// under the sheet's edge. When it did, every point under the sheet's
+/// A point buried under a sheet proves nothing for the points beside it
+/// ([`radiometry::burial::Walls::Sheet`]). When it did, every point under the sheet's
 /// triangles was buried once one was, and the leaves over the sheet's
 /// edge took exposures a quarter of their open part: in
 /// `tests/tests/hung_sheet.rs` two of them showed 0.70 where no point of
@@ -120,12 +107,12 @@ struct Sampled {
 /// rays (113k -> 150k) and no change in the solve time (single runs).
 /// The built-in Cornell box's solutions are unchanged to the bit: the
 /// grazing rays from under its blocks meet their walls.
-fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: &[u32], stream: &mut Stream) -> Sampled {
+fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: &ProvenRoofs, stream: &mut Stream) -> Sampled {
     let element = &h.elements[e as usize];
     let normal = h.normal(e);
     let normal_of = |t: u32| h.triangles[t as usize].normal;
     let t_min = t_min(element);
-    let (mut existing, mut exposed, mut rays, mut proven) = (0usize, 0usize, 0u64, roofs.to_vec());
+    let (mut existing, mut exposed, mut rays, mut proven) = (0usize, 0usize, 0u64, roofs.clone());
     let strata = Strata::of(n);
     for k in 0..n {
         let point = strata.point(&element.points, k, stream);
@@ -133,19 +120,8 @@ fn sampled(h: &Hierarchy, scene: &SceneRays, e: u32, n: usize, roofs: &[u32], st
             continue;
         }
         existing += 1;
-        rays += 1;
-        let is_buried = match radiometry::burial::roof(scene, &normal_of, point, normal, element.triangle, t_min) {
-            None => false,
-            Some(roof) if proven.contains(&roof) => true,
-            Some(roof) => {
-                let (walls, cast) = radiometry::burial::walled_in(scene, &normal_of, point, normal, element.triangle, roof, t_min, stream);
-                rays += cast;
-                if walls == Walls::Solid {
-                    proven.push(roof);
-                }
-                walls.buried()
-            }
-        };
+        let (is_buried, cast) = proven.buried(scene, &normal_of, point, normal, element.triangle, t_min, stream);
+        rays += cast;
         exposed += usize::from(!is_buried);
     }
     Sampled { exposure: if existing == 0 { 1.0 } else { exposed as f64 / existing as f64 }, rays, roofs: proven }

@@ -11,7 +11,9 @@
 //! hierarchical-solve's, which leaves the buried part out.
 //!
 //! So each leaf tests [`POINTS`] fixed points for burial
-//! ([`radiometry::burial::buried`]): the centroids of its sixteen
+//! ([`radiometry::burial::ProvenRoofs::buried`]: a roof that one point
+//! proves a solid's buries the leaf's other points under it for one ray
+//! each): the centroids of its sixteen
 //! sub-triangles two 1:4 levels down, which weigh each corner's hat
 //! function equally (their barycentric coordinates average `1/3`). A
 //! vertex's hat area is then the integral of its hat over the open points
@@ -24,7 +26,7 @@
 
 use crate::mesh::Elements;
 use glam::DVec3;
-use radiometry::burial::buried;
+use radiometry::burial::ProvenRoofs;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
@@ -90,10 +92,10 @@ impl Exposure {
                 let t = element.triangle as usize;
                 let g = &geometry[t];
                 let mut stream = Stream::new(seed, 0xb0_71ed, e as u64);
-                let (mut mask, mut cast) = (0u16, 0u64);
+                let (mut mask, mut cast, mut roofs) = (0u16, 0u64, ProvenRoofs::default());
                 for (k, local) in points.iter().enumerate() {
                     let point: DVec3 = g.point(to_triangle_uv(&elements.corners[e], *local));
-                    let (is_buried, n) = buried(rays, &normal_of, point, g.normal, t as u32, t_min, &mut stream);
+                    let (is_buried, n) = roofs.buried(rays, &normal_of, point, g.normal, t as u32, t_min, &mut stream);
                     cast += n;
                     if !is_buried {
                         mask |= 1 << k;
