@@ -27,6 +27,7 @@
 //! deterministic.
 
 use glam::{DVec3, Vec3};
+use radiometry::bounds::Aabb;
 use radiometry::geometry::TriangleGeometry;
 use schemas::cluster::ClusterNode;
 use schemas::solution::NONE;
@@ -88,10 +89,8 @@ fn split(slice: &mut [u32], first: usize, c: usize, centroids: &[DVec3], leaf_si
     if slice.len() <= leaf_size {
         return;
     }
-    let (lo, hi) = slice.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &t| {
-        (lo.min(centroids[t as usize]), hi.max(centroids[t as usize]))
-    });
-    let extent = hi - lo;
+    let bounds = Aabb::around(slice.iter().map(|&t| centroids[t as usize]));
+    let extent = bounds.max - bounds.min;
     let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
     let middle = slice.len() / 2;
     // Ties broken by index, so the split does not depend on the input order.
@@ -110,9 +109,9 @@ fn split(slice: &mut [u32], first: usize, c: usize, centroids: &[DVec3], leaf_si
 fn bound(h: &mut Hierarchy, triangles: &[TriangleGeometry]) {
     for node in &mut h.nodes {
         let range = &h.order[node.triangle_range()];
-        let (lo, hi) = range.iter().flat_map(|&t| triangles[t as usize].corners).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        node.bounds_min = lo.as_vec3().to_array();
-        node.bounds_max = hi.as_vec3().to_array();
+        let bounds = Aabb::around(range.iter().flat_map(|&t| triangles[t as usize].corners));
+        node.bounds_min = bounds.min.as_vec3().to_array();
+        node.bounds_max = bounds.max.as_vec3().to_array();
     }
 }
 

@@ -23,6 +23,7 @@
 //! since mesh.exr holds f32 positions.
 
 use glam::DVec3;
+use radiometry::bounds::Aabb;
 use schemas::mesh::{Manifest, Mesh};
 
 /// Distances to a plane under this fraction of the scene's size count as
@@ -96,8 +97,8 @@ impl Configuration {
             return Err(format!("the scene has {what}; exact images take plain diffuse planar surfaces lit by emitting surfaces"));
         }
         let points: Vec<DVec3> = mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))).collect();
-        let (lo, hi) = points.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        let tolerance = PLANE_TOLERANCE * (hi - lo).length().max(f64::MIN_POSITIVE);
+        let bounds = Aabb::around(points.iter().copied());
+        let tolerance = PLANE_TOLERANCE * (bounds.max - bounds.min).length().max(f64::MIN_POSITIVE);
         let object_name = |o: u32| manifest.objects.get(o as usize).cloned().unwrap_or_else(|| format!("#{o}"));
         let mut surfaces: Vec<Surface> = Vec::new();
         let mut surface_of = Vec::with_capacity(mesh.triangles.len());

@@ -20,6 +20,7 @@
 //! ([`clear`]) shoots from finer groups.
 
 use glam::DVec3;
+use radiometry::bounds::Aabb;
 use schemas::mesh::{Manifest, Mesh};
 use stage_kit::scene::triangle_corners;
 
@@ -69,13 +70,8 @@ pub fn shoot_levels(mesh: &Mesh, manifest: &Manifest, sizes: &[u32], level: u32)
 /// [`MOST_PAIRS`] pairs (after a bounding-box test), else says no.
 pub fn clear(mesh: &Mesh, own: &[usize], distance: f64) -> bool {
     let corners = |t: usize| triangle_corners(mesh, t);
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for &e in own {
-        for p in corners(e) {
-            (lo, hi) = (lo.min(p), hi.max(p));
-        }
-    }
-    let (lo, hi) = (lo - DVec3::splat(distance), hi + DVec3::splat(distance));
+    let bounds = Aabb::around(own.iter().flat_map(|&e| corners(e)));
+    let (lo, hi) = (bounds.min - DVec3::splat(distance), bounds.max + DVec3::splat(distance));
     let mut is_own = vec![false; mesh.triangles.len()];
     own.iter().for_each(|&t| is_own[t] = true);
     let near: Vec<usize> = (0..mesh.triangles.len())

@@ -51,6 +51,7 @@ pub mod transmission;
 use atlas::{Atlas, HIDDEN_CORNERS};
 use detail::{Detail, TexelDetail};
 use glam::DVec3;
+use radiometry::bounds::Aabb;
 use radiometry::geometry::frame_with_normal;
 pub use radiometry::photometry::Luminaire;
 use gpu::{Gpu, GpuGroup, GpuParams, GpuSample, GpuTexel, GpuTri, Setup};
@@ -553,17 +554,8 @@ pub fn solve(
         return Err("the mesh has no triangles".into());
     }
     // Scene size: near plane, far distance, and the sample offset.
-    let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
-    for p in &mesh.positions {
-        let p = DVec3::from(p.map(f64::from));
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    for l in lights {
-        lo = lo.min(l.position);
-        hi = hi.max(l.position);
-    }
-    let diagonal = (hi - lo).length().max(1e-6);
+    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))).chain(lights.iter().map(|l| l.position)));
+    let diagonal = (scene.max - scene.min).length().max(1e-6);
     let hemicube = params.visibility == Visibility::Hemicube;
     let layers_per_sample = if hemicube { 6 } else { 1 };
     // Visibility layers per batch: at most 256 (WebGPU's default array

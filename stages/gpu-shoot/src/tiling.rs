@@ -9,6 +9,7 @@
 //! levels finer along its edge is split too.
 
 use glam::DVec3;
+use radiometry::bounds::Aabb;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Mesh, Triangle};
 use schemas::surface::Surface;
@@ -127,11 +128,8 @@ pub fn split(mesh: &Mesh, tiles: &[Tile], split: &[bool]) -> (Vec<Tile>, Vec<usi
 /// corners on the edge.
 fn unbalanced(mesh: &Mesh, tiles: &[Tile]) -> Vec<bool> {
     let corners: Vec<[DVec3; 3]> = tiles.iter().map(|t| t.corners.map(|c| point(mesh, t.root as usize, c))).collect();
-    let (lo, hi) = mesh.positions.iter().fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), p| {
-        let p = DVec3::from(p.map(f64::from));
-        (lo.min(p), hi.max(p))
-    });
-    let eps = 1e-7 * (hi - lo).length().max(1e-30);
+    let bounds = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
+    let eps = 1e-7 * (bounds.max - bounds.min).length().max(1e-30);
     let key = |p: DVec3| ((p / eps).round().as_i64vec3()).to_array();
     let mut at: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
     for (k, c) in corners.iter().enumerate() {

@@ -31,6 +31,7 @@
 //! single-precision arithmetic grazed a surface that touches the shaft).
 
 use glam::DVec3;
+use radiometry::bounds::Aabb;
 use radiometry::rays::SceneRays;
 
 /// Overlap of projections that counts as touching, as a fraction of the
@@ -78,7 +79,8 @@ impl Occluders {
     }
 
     fn bounds(&self, range: std::ops::Range<usize>) -> (DVec3, DVec3) {
-        self.order[range].iter().flat_map(|&t| self.corners[t as usize]).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
+        let b = Aabb::around(self.order[range].iter().flat_map(|&t| self.corners[t as usize]));
+        (b.min, b.max)
     }
 
     /// Adds the node of `order[first..first + count]` and its subtree
@@ -91,8 +93,8 @@ impl Occluders {
             return;
         }
         let centroid = |t: u32| self.corners[t as usize].iter().sum::<DVec3>() / 3.0;
-        let (clo, chi) = self.order[first..first + count].iter().map(|&t| centroid(t)).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)));
-        let extent = chi - clo;
+        let centroids = Aabb::around(self.order[first..first + count].iter().map(|&t| centroid(t)));
+        let extent = centroids.max - centroids.min;
         let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
         let half = count / 2;
         let corners = &self.corners;
@@ -199,8 +201,8 @@ const AXES: usize = 2 + 18;
 impl Shaft {
     fn new(receiver: &[DVec3; 3], sender: &[DVec3; 3], touch: f64) -> Self {
         let ends = [*receiver, *sender];
-        let (lo, hi) = ends.as_flattened().iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let mut shaft = Shaft { ends, lo: lo + DVec3::splat(touch), hi: hi - DVec3::splat(touch), axes: Vec::with_capacity(AXES), touch };
+        let b = Aabb::around(ends.as_flattened().iter().copied());
+        let mut shaft = Shaft { ends, lo: b.min + DVec3::splat(touch), hi: b.max - DVec3::splat(touch), axes: Vec::with_capacity(AXES), touch };
         for t in ends {
             shaft.push((t[1] - t[0]).cross(t[2] - t[0]));
         }

@@ -11,6 +11,7 @@ use crate::text::locate;
 use crate::scene::{Light, MeshFile, Scene};
 use glam::DVec3;
 use stage_kit::scene::pinhole;
+use radiometry::bounds::Aabb;
 use radiometry::geometry::TriangleGeometry;
 use schemas::mesh::{cyclic, reversed, Camera, Effects, GoniometricLight, Material, MeshStatistics, Triangle};
 use schemas::Error;
@@ -349,13 +350,9 @@ struct Built {
 /// same vertices wound the other way, appended after the input's
 /// triangles. `None` if none is left.
 fn build_mesh(raw: &[RawTriangle], two_sided: &[bool], params: &Params) -> Option<Built> {
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for p in raw.iter().flat_map(|t| t.corners) {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    let origin = 0.5 * (lo + hi);
-    let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
+    let bounds = Aabb::around(raw.iter().flat_map(|t| t.corners));
+    let origin = 0.5 * (bounds.min + bounds.max);
+    let diagonal = (bounds.max - bounds.min).length().max(f64::MIN_POSITIVE);
     let cell = params.weld_tolerance * diagonal;
     let mut statistics = MeshStatistics::default();
     let mut index_of: HashMap<[i64; 3], u32> = HashMap::new();
@@ -418,8 +415,8 @@ fn build_mesh(raw: &[RawTriangle], two_sided: &[bool], params: &Params) -> Optio
     attributes.extend(twin_attributes);
     statistics.triangles = triangles.len();
     statistics.vertices = positions.len();
-    statistics.bounds_min = (lo - origin).to_array();
-    statistics.bounds_max = (hi - origin).to_array();
+    statistics.bounds_min = (bounds.min - origin).to_array();
+    statistics.bounds_max = (bounds.max - origin).to_array();
     Some(Built { origin, positions, triangles, attributes, statistics })
 }
 
