@@ -14,7 +14,8 @@
 //!    curvature, across penumbrae densely and umbrae sparsely, a coarse
 //!    lattice in smooth regions, and view-dependent display samples one per
 //!    block of screen pixels ([`render::screen_candidates`]);
-//! 3. exact direct light at every sample;
+//! 3. exact direct light at every sample, and whether it lies buried
+//!    inside a solid ([`burial`]: the floor under a block);
 //! 4. [`emitters`]: secondary emitter polygons of light-transfer samples,
 //!    one per isolux region (Delaunay triangles merged by band,
 //!    [`delaunay`]);
@@ -40,6 +41,7 @@
 
 #![warn(missing_docs)]
 
+pub mod burial;
 pub mod delaunay;
 pub mod direct;
 pub mod display;
@@ -137,6 +139,8 @@ pub struct Work {
     pub probes: usize,
     /// Rays cast for the direct light's visibility (probes and samples).
     pub direct_rays: u64,
+    /// Rays cast testing the samples for burial ([`burial`]).
+    pub burial_rays: u64,
     /// Samples per reason, in [`Reason::ALL`] order.
     pub samples_by_reason: [usize; 6],
     /// The shooting.
@@ -250,6 +254,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
                     reflectance: surface.reflectance,
                     direct: [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]),
                     indirect: [0.0; 3],
+                    buried: false,
                 };
                 (progress.step)();
                 (collector, luminance(e.rgb), e.rays)
@@ -258,12 +263,14 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     };
     work.direct_rays += evaluated.iter().map(|e| e.2).sum::<u64>();
     let mut collectors: Vec<Collector> = evaluated.iter().map(|e| e.0).collect();
+    let normals: Vec<DVec3> = geometry.iter().map(|g| g.normal).collect();
+    let t_min = (1e-6 * scene_diagonal(mesh)) as f32;
+    work.burial_rays = mark_buried(&mut collectors, &rays, &normals, t_min, params.seed, 0);
     work.direct_seconds = clock.elapsed().as_secs_f64();
 
     // 4. Secondary emitter polygons per reflecting surface.
     let clock = std::time::Instant::now();
-    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
-    let diagonal = (scene.max - scene.min).length();
+    let diagonal = scene_diagonal(mesh);
     let mut polygons = Vec::new();
     for (s, surface) in surfaces.iter().enumerate() {
         if luminance(surface.reflectance) <= 0.0 {
@@ -274,7 +281,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         let grid = &grids[s];
         let min_area = params.emitter_min_area * surface.area;
         let cells = (surface.extent() / (params.emitter_cell * diagonal)).ceil().clamp(1.0, 256.0) as usize;
-        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area, cells));
+        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area, cells, &|i| collectors[i as usize].buried));
     }
     // 5. Progressive shooting.
     (progress.phase)("shooting", params.max_shots as u64);
@@ -331,10 +338,13 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
                 reflectance: surface.reflectance,
                 direct: [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]),
                 indirect: [0, 1, 2].map(|k| surface.reflectance[k] * indirect[k]),
+                buried: false,
             });
             placed.push((s as u32, *c));
         }
     }
+    let first = evaluated.len();
+    work.burial_rays += mark_buried(&mut collectors[first..], &rays, &normals, t_min, params.seed, 1);
     work.indirect_placement_seconds = clock.elapsed().as_secs_f64();
 
     let mut emitter_of = vec![NO_EMITTER; placed.len()];
@@ -376,7 +386,9 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
             let filter: Vec<FilterSample> = placed
                 .iter()
                 .zip(&samples)
-                .filter(|((owner, _), _)| *owner == s as u32)
+                .zip(&collectors)
+                .filter(|(((owner, _), _), x)| *owner == s as u32 && !x.buried)
+                .map(|(sample, _)| sample)
                 .map(|((_, c), sample)| FilterSample { uv: c.uv, luminance: [0, 1, 2].map(|k| sample.luminance[k] - surface.emission[k] / PI), tag: c.reason.tag() })
                 .collect();
             let extent = surface.extent();
@@ -393,6 +405,22 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         .map(|(p, shot)| SecondaryEmitter { surface: p.surface, area: p.area, shot: *shot, triangles: p.triangles.clone() })
         .collect();
     Ok(Structured { samples, surfaces: sampled_surfaces, emitters: secondary, film, size, work })
+}
+
+/// Marks the buried ones of `samples` ([`burial::buried`], its `pass`);
+/// returns the rays cast.
+fn mark_buried(samples: &mut [Collector], rays: &SceneRays, normals: &[DVec3], t_min: f32, seed: u64, pass: u64) -> u64 {
+    let (buried, cast) = burial::buried(samples, rays, normals, t_min, seed, pass);
+    for (x, b) in samples.iter_mut().zip(buried) {
+        x.buried = b;
+    }
+    cast
+}
+
+/// The length of the diagonal of `mesh`'s bounding box.
+fn scene_diagonal(mesh: &Mesh) -> f64 {
+    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
+    (scene.max - scene.min).length()
 }
 
 /// The triangle of `surface` whose centroid is nearest to `uv`: for a

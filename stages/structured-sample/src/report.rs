@@ -40,6 +40,7 @@ impl Structured {
             ("secondary_emitters", self.emitters.len() as f64),
             ("probes", w.probes as f64),
             ("direct_rays", w.direct_rays as f64),
+            ("burial_rays", w.burial_rays as f64),
             ("shots", w.shooting.shots as f64),
             ("shooting_rays", w.shooting.rays as f64),
             ("unshot_fraction", w.shooting.remaining),

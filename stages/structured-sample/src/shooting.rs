@@ -71,6 +71,9 @@ pub struct Collector {
     pub direct: [f64; 3],
     /// Reflected radiosity from the secondary emitters, W/m².
     pub indirect: [f64; 3],
+    /// Inside a solid ([`crate::burial`]): a polygon's means over a
+    /// triangle take this corner's value from the triangle's open corners.
+    pub buried: bool,
 }
 
 /// What the shooting did.
@@ -325,10 +328,11 @@ impl Sender {
             let a = triangle(samples, t).1;
             area += a;
             if !self.is_near(x.map(|x| x.position)) {
+                let at = from_open_corners(x, at, 0.0);
                 integral += a * (at[0] + at[1] + at[2]) / 3.0;
                 continue;
             }
-            let visible = visible_at_corners(x.map(|x| self.unoccluded(x.position, x.normal, x.surface)), at);
+            let visible = visible_at_corners(x, x.map(|x| self.unoccluded(x.position, x.normal, x.surface)), at);
             let m = NEAR_SUBDIVISION;
             let mut sum = 0.0;
             for (u, v) in subtriangle_centroids(m) {
@@ -402,15 +406,27 @@ impl Sender {
     }
 }
 
-/// The visible fraction at a triangle's corners, from their factors
+/// The visible fraction at a triangle's corners `x`, from their factors
 /// without (`unoccluded`) and with occlusion (`factors`): where a corner
-/// does not see the sender at all, the mean of the others' (1 where none
-/// does).
-fn visible_at_corners(unoccluded: [f64; 3], factors: [f64; 3]) -> [f64; 3] {
-    let known: [Option<f64>; 3] = std::array::from_fn(|i| (unoccluded[i] > 0.0).then(|| (factors[i] / unoccluded[i]).clamp(0.0, 1.0)));
+/// does not see the sender at all or is buried, the mean of the others'
+/// (1 where none does).
+fn visible_at_corners(x: [&Collector; 3], unoccluded: [f64; 3], factors: [f64; 3]) -> [f64; 3] {
+    fill(std::array::from_fn(|i| (unoccluded[i] > 0.0 && !x[i].buried).then(|| (factors[i] / unoccluded[i]).clamp(0.0, 1.0))), 1.0)
+}
+
+/// `values` at a triangle's corners `x`, a buried corner's replaced by
+/// the mean of the open ones' (all `none` where every corner is buried):
+/// a triangle that straddles a solid's footprint shows its open part.
+fn from_open_corners(x: [&Collector; 3], values: [f64; 3], none: f64) -> [f64; 3] {
+    fill(std::array::from_fn(|i| (!x[i].buried).then_some(values[i])), none)
+}
+
+/// The known values, each unknown one replaced by the mean of the known
+/// ones (all `none` where none is known).
+fn fill(known: [Option<f64>; 3], none: f64) -> [f64; 3] {
     let seen = known.iter().flatten().count();
-    let fill = if seen == 0 { 1.0 } else { known.iter().flatten().sum::<f64>() / seen as f64 };
-    known.map(|v| v.unwrap_or(fill))
+    let mean = if seen == 0 { none } else { known.iter().flatten().sum::<f64>() / seen as f64 };
+    known.map(|v| v.unwrap_or(mean))
 }
 
 /// The barycentric coordinates `(u, v)` (of the second and third corner)
@@ -458,15 +474,18 @@ fn triangle(samples: &[Collector], t: &[u32; 3]) -> ([DVec3; 3], f64) {
 }
 
 /// The mean of `value` over `polygon`'s area, linear over each of its
-/// triangles between the samples at its corners (`samples`' positions).
+/// triangles between the samples at its corners (`samples`' positions;
+/// a buried corner's value is its open corners' mean, [`from_open_corners`]).
 fn area_mean(polygon: &Polygon, samples: &[Collector], value: impl Fn(usize) -> [f64; 3]) -> [f64; 3] {
     let (mut sum, mut area) = ([0.0; 3], 0.0);
     for t in &polygon.triangles {
         let w = triangle(samples, t).1;
         area += w;
+        let x = t.map(|v| &samples[v as usize]);
         let v = t.map(|v| value(v as usize));
         for (k, s) in sum.iter_mut().enumerate() {
-            *s += w * (v[0][k] + v[1][k] + v[2][k]) / 3.0;
+            let v = from_open_corners(x, v.map(|v| v[k]), 0.0);
+            *s += w * (v[0] + v[1] + v[2]) / 3.0;
         }
     }
     if area > 0.0 { sum.map(|s| s / area) } else { sum }
@@ -513,7 +532,7 @@ mod tests {
     fn rectangle(samples: &mut Vec<Collector>, surface: u32, corners: [DVec3; 4], normal: DVec3) -> Polygon {
         let first = samples.len() as u32;
         for position in corners {
-            samples.push(Collector { position, normal, surface, triangle: surface, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3] });
+            samples.push(Collector { position, normal, surface, triangle: surface, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3], buried: false });
         }
         let area = (corners[1] - corners[0]).cross(corners[3] - corners[0]).length();
         Polygon { surface, triangles: vec![[first, first + 1, first + 2], [first, first + 2, first + 3]], vertices: (first..first + 4).collect(), area }
@@ -526,7 +545,7 @@ mod tests {
     fn casting_points_spread_over_the_area() {
         let mut samples = Vec::new();
         for position in [dvec3(0.0, 0.0, 0.0), dvec3(3.0, 0.0, 0.0), dvec3(0.0, 2.0, 0.0), dvec3(-1.0, 0.0, 0.0)] {
-            samples.push(Collector { position, normal: DVec3::Z, surface: 0, triangle: 0, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3] });
+            samples.push(Collector { position, normal: DVec3::Z, surface: 0, triangle: 0, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3], buried: false });
         }
         // Triangle (0, 1, 2): area 3; triangle (0, 2, 3): area 1.
         let fan = Polygon { surface: 0, triangles: vec![[0, 1, 2], [0, 2, 3]], vertices: (0..4).collect(), area: 4.0 };
