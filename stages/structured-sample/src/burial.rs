@@ -26,37 +26,43 @@ use radiometry::burial::ProvenRoofs;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
 
-/// Whether each of `samples` is buried, and the rays cast: rays start
-/// `t_min` along, `normals[t]` is mesh triangle `t`'s unit front normal,
-/// and each surface draws its grazing rays' turns from its own stream of
-/// `seed` and `pass` (so the result does not depend on the thread count).
-pub fn buried(samples: &[Collector], rays: &SceneRays, normals: &[DVec3], t_min: f32, seed: u64, pass: u64) -> (Vec<bool>, u64) {
+/// Marks the buried ones of `samples` (their `buried`) and returns the
+/// rays cast: rays start `t_min` along, `normals[t]` is mesh triangle
+/// `t`'s unit front normal, and each surface draws its grazing rays'
+/// turns from its own stream of `seed` and `pass` (so the result does not
+/// depend on the thread count).
+pub fn mark(samples: &mut [Collector], rays: &SceneRays, normals: &[DVec3], t_min: f32, seed: u64, pass: u64) -> u64 {
     use rayon::prelude::*;
     let normal_of = |t: u32| normals[t as usize];
-    let surfaces = samples.iter().map(|x| x.surface + 1).max().unwrap_or(0);
-    let per_surface: Vec<(Vec<(usize, bool)>, u64)> = (0..surfaces)
-        .into_par_iter()
-        .map(|s| {
-            let mut stream = Stream::new(seed, 0x5a_b1ed + pass, u64::from(s));
+    let surfaces = samples.iter().map(|x| x.surface as usize + 1).max().unwrap_or(0);
+    let mut of_surface: Vec<Vec<usize>> = vec![Vec::new(); surfaces];
+    for (i, x) in samples.iter().enumerate() {
+        of_surface[x.surface as usize].push(i);
+    }
+    let tested: Vec<(Vec<bool>, u64)> = of_surface
+        .par_iter()
+        .enumerate()
+        .map(|(s, members)| {
+            let mut stream = Stream::new(seed, 0x5a_b1ed + pass, s as u64);
             let (mut roofs, mut cast) = (ProvenRoofs::default(), 0);
-            let tested = samples
+            let buried = members
                 .iter()
-                .enumerate()
-                .filter(|(_, x)| x.surface == s)
-                .map(|(i, x)| {
+                .map(|&i| {
+                    let x = &samples[i];
                     let (is_buried, n) = roofs.buried(rays, &normal_of, x.position, x.normal, x.triangle, t_min, &mut stream);
                     cast += n;
-                    (i, is_buried)
+                    is_buried
                 })
                 .collect();
-            (tested, cast)
+            (buried, cast)
         })
         .collect();
-    let mut result = vec![false; samples.len()];
-    for (i, b) in per_surface.iter().flat_map(|p| &p.0) {
-        result[*i] = *b;
+    for (members, (buried, _)) in of_surface.iter().zip(&tested) {
+        for (&i, &b) in members.iter().zip(buried) {
+            samples[i].buried = b;
+        }
     }
-    (result, per_surface.iter().map(|p| p.1).sum())
+    tested.iter().map(|t| t.1).sum()
 }
 
 #[cfg(test)]
@@ -83,15 +89,15 @@ mod tests {
         assert!(normals[0].z < -0.99 && normals[wall as usize].x < -0.99, "outward cube, wall facing the cube");
         let rays = SceneRays::new(&triangles);
         let sample = |position: DVec3, normal: DVec3, surface: u32, triangle: u32| Collector { position, normal, surface, triangle, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3], buried: false };
-        let samples = [
+        let mut samples = [
             sample(dvec3(0.3, 0.2, 0.0), DVec3::Z, 0, floor),
             sample(dvec3(0.7, 0.1, 0.0), DVec3::Z, 0, floor),
             sample(dvec3(1.2, 0.5, 0.0), DVec3::Z, 0, floor),
             sample(dvec3(-2.0, 2.0, 0.0), DVec3::Z, 0, floor),
             sample(dvec3(3.0, 0.5, 0.5), -DVec3::X, 1, wall),
         ];
-        let (buried, cast) = buried(&samples, &rays, &normals, 1e-6, 1, 0);
-        assert_eq!(buried, [true, true, false, false, false]);
+        let cast = mark(&mut samples, &rays, &normals, 1e-6, 1, 0);
+        assert_eq!(samples.map(|x| x.buried), [true, true, false, false, false]);
         // 17 rays for the first point under the roof, 1 for the second, 1
         // for each open point whose ray along the normal meets nothing.
         assert_eq!(cast, radiometry::burial::EXPOSURE_RAYS as u64 + 4);

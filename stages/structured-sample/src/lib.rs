@@ -263,14 +263,15 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     };
     work.direct_rays += evaluated.iter().map(|e| e.2).sum::<u64>();
     let mut collectors: Vec<Collector> = evaluated.iter().map(|e| e.0).collect();
+    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
+    let diagonal = (scene.max - scene.min).length();
     let normals: Vec<DVec3> = geometry.iter().map(|g| g.normal).collect();
-    let t_min = (1e-6 * scene_diagonal(mesh)) as f32;
-    work.burial_rays = mark_buried(&mut collectors, &rays, &normals, t_min, params.seed, 0);
+    let t_min = (1e-6 * diagonal) as f32;
+    work.burial_rays = burial::mark(&mut collectors, &rays, &normals, t_min, params.seed, 0);
     work.direct_seconds = clock.elapsed().as_secs_f64();
 
     // 4. Secondary emitter polygons per reflecting surface.
     let clock = std::time::Instant::now();
-    let diagonal = scene_diagonal(mesh);
     let mut polygons = Vec::new();
     for (s, surface) in surfaces.iter().enumerate() {
         if luminance(surface.reflectance) <= 0.0 {
@@ -344,7 +345,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         }
     }
     let first = evaluated.len();
-    work.burial_rays += mark_buried(&mut collectors[first..], &rays, &normals, t_min, params.seed, 1);
+    work.burial_rays += burial::mark(&mut collectors[first..], &rays, &normals, t_min, params.seed, 1);
     work.indirect_placement_seconds = clock.elapsed().as_secs_f64();
 
     let mut emitter_of = vec![NO_EMITTER; placed.len()];
@@ -405,22 +406,6 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         .map(|(p, shot)| SecondaryEmitter { surface: p.surface, area: p.area, shot: *shot, triangles: p.triangles.clone() })
         .collect();
     Ok(Structured { samples, surfaces: sampled_surfaces, emitters: secondary, film, size, work })
-}
-
-/// Marks the buried ones of `samples` ([`burial::buried`], its `pass`);
-/// returns the rays cast.
-fn mark_buried(samples: &mut [Collector], rays: &SceneRays, normals: &[DVec3], t_min: f32, seed: u64, pass: u64) -> u64 {
-    let (buried, cast) = burial::buried(samples, rays, normals, t_min, seed, pass);
-    for (x, b) in samples.iter_mut().zip(buried) {
-        x.buried = b;
-    }
-    cast
-}
-
-/// The length of the diagonal of `mesh`'s bounding box.
-fn scene_diagonal(mesh: &Mesh) -> f64 {
-    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
-    (scene.max - scene.min).length()
 }
 
 /// The triangle of `surface` whose centroid is nearest to `uv`: for a

@@ -328,7 +328,7 @@ impl Sender {
             let a = triangle(samples, t).1;
             area += a;
             if !self.is_near(x.map(|x| x.position)) {
-                let at = from_open_corners(x, at, 0.0);
+                let at = from_open_corners(x, at);
                 integral += a * (at[0] + at[1] + at[2]) / 3.0;
                 continue;
             }
@@ -415,10 +415,10 @@ fn visible_at_corners(x: [&Collector; 3], unoccluded: [f64; 3], factors: [f64; 3
 }
 
 /// `values` at a triangle's corners `x`, a buried corner's replaced by
-/// the mean of the open ones' (all `none` where every corner is buried):
-/// a triangle that straddles a solid's footprint shows its open part.
-fn from_open_corners(x: [&Collector; 3], values: [f64; 3], none: f64) -> [f64; 3] {
-    fill(std::array::from_fn(|i| (!x[i].buried).then_some(values[i])), none)
+/// the mean of the open ones' (all 0 where every corner is buried): a
+/// triangle that straddles a solid's footprint shows its open part.
+fn from_open_corners(x: [&Collector; 3], values: [f64; 3]) -> [f64; 3] {
+    fill(std::array::from_fn(|i| (!x[i].buried).then_some(values[i])), 0.0)
 }
 
 /// The known values, each unknown one replaced by the mean of the known
@@ -484,7 +484,7 @@ fn area_mean(polygon: &Polygon, samples: &[Collector], value: impl Fn(usize) -> 
         let x = t.map(|v| &samples[v as usize]);
         let v = t.map(|v| value(v as usize));
         for (k, s) in sum.iter_mut().enumerate() {
-            let v = from_open_corners(x, v.map(|v| v[k]), 0.0);
+            let v = from_open_corners(x, v.map(|v| v[k]));
             *s += w * (v[0] + v[1] + v[2]) / 3.0;
         }
     }
