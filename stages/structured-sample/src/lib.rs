@@ -20,7 +20,8 @@
 //!    one per isolux region (Delaunay triangles merged by band,
 //!    [`delaunay`]);
 //! 5. [`shooting`]: progressive shooting from the polygon of highest unshot
-//!    power, vertex-averaged, with the paper's vertex-ray occlusion; then,
+//!    power, each of its triangles sending the mean of its corners', with
+//!    the paper's ray occlusion (from points over the polygon); then,
 //!    on surfaces the direct light leaves without contours (lit only by
 //!    interreflection, like the paper's B), display samples along the
 //!    contours of the indirect light, each gathering what the emitters
