@@ -65,12 +65,11 @@ pub fn roof(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, n
 /// Whether `point` on mesh triangle `triangle` (unit front normal
 /// `normal`) is buried, and the rays cast; `normal_of(t)` is triangle
 /// `t`'s unit front normal; rays start at `t_min` (past the rounding of
-/// their f32 origin). It is under a [`roof`] and [`walled_in`].
+/// their f32 origin). It is under a [`roof`] and [`walled_in`]
+/// ([`ProvenRoofs::buried`] with none proven: `stream`'s number is drawn
+/// only where a roof is found).
 pub fn buried(scene: &SceneRays, normal_of: &dyn Fn(u32) -> DVec3, point: DVec3, normal: DVec3, triangle: u32, t_min: f32, stream: &mut Stream) -> (bool, u64) {
-    let turn = 2.0 * PI * stream.next_f64();
-    let Some(over) = roof(scene, normal_of, point, normal, triangle, t_min) else { return (false, 1) };
-    let (walls, cast) = grazing(scene, normal_of, point, normal, triangle, over, t_min, turn);
-    (walls.buried(), 1 + cast)
+    ProvenRoofs::default().buried(scene, normal_of, point, normal, triangle, t_min, stream)
 }
 
 /// The roofs ([`roof`]) that [`walled_in`] found a solid's over some

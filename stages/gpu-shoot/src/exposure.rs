@@ -20,7 +20,7 @@
 use crate::atlas::{area_centroid, clip_convex, convex_hull, strictly_inside, texel_point, texel_square, turn, Atlas, Texel, HIDDEN_CORNERS};
 use crate::tiling::Tile;
 use glam::DVec3;
-use radiometry::burial::buried;
+use radiometry::burial::ProvenRoofs;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::rays::SceneRays;
 use radiometry::sampling::Stream;
@@ -49,12 +49,15 @@ impl Burial {
     /// point is buried ([`radiometry::burial`]), and the rays cast.
     pub fn texels(&self, atlas: &Atlas, tiles: &[Tile]) -> (Vec<bool>, u64) {
         let mut rays = 0;
+        // The roofs proven a solid's over some texel of each input triangle.
+        let mut roofs = vec![ProvenRoofs::default(); self.triangles.len()];
         let flags = atlas
             .texels
             .iter()
             .enumerate()
             .map(|(k, texel)| {
-                let (is_buried, cast) = self.point(DVec3::from(texel.position.map(f64::from)), tiles[texel.triangle as usize].root, k as u64, 0);
+                let root = tiles[texel.triangle as usize].root;
+                let (is_buried, cast) = self.point(DVec3::from(texel.position.map(f64::from)), root, k as u64, 0, &mut roofs[root as usize]);
                 rays += cast;
                 is_buried
             })
@@ -63,13 +66,14 @@ impl Burial {
     }
 
     /// Whether `p` on input triangle `root` is buried, and the rays cast;
-    /// `(a, b)` keys the grazing rays' random turn.
-    fn point(&self, p: DVec3, root: u32, a: u64, b: u64) -> (bool, u64) {
+    /// `(a, b)` keys the grazing rays' random turn; `roofs` are those
+    /// proven a solid's over other points of `root`.
+    fn point(&self, p: DVec3, root: u32, a: u64, b: u64, roofs: &mut ProvenRoofs) -> (bool, u64) {
         // Past the rounding of the f32 ray origin.
         let t_min = (1e-6 * p.abs().max_element().max(1.0)) as f32;
         let mut stream = Stream::new(BURIAL_SEED, a, b);
         let normal_of = |t: u32| self.triangles[t as usize].normal;
-        buried(&self.scene, &normal_of, p, normal_of(root), root, t_min, &mut stream)
+        roofs.buried(&self.scene, &normal_of, p, normal_of(root), root, t_min, &mut stream)
     }
 
     /// Gives each group of `atlas` (over `tiles`, whose triangles `mesh`
@@ -201,7 +205,7 @@ impl Burial {
         let towards = |di: i64, dj: i64| [(i as f64 + 0.5 + di as f64 / 2.0) / nf, (j as f64 + 0.5 + dj as f64 / 2.0) / nf];
         // Whether a point is buried; `key` keys its grazing rays.
         let mut test = |uv: [f64; 2], key: u64| {
-            let (is_buried, cast) = self.point(grid.geometry.point(uv), grid.root, k as u64, key);
+            let (is_buried, cast) = self.point(grid.geometry.point(uv), grid.root, k as u64, key, &mut ProvenRoofs::default());
             *rays += cast;
             is_buried
         };
