@@ -288,7 +288,21 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     // 5. Progressive shooting.
     (progress.phase)("shooting", params.max_shots as u64);
     let shooting_params = ShootingParams { threshold: params.threshold, max_shots: params.max_shots, bounces: params.bounces, occlusion_points: params.occlusion_points };
-    work.shooting = shoot(&polygons, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
+    // The direct light at each polygon triangle's centroid, for the power
+    // each polygon shoots first (shooting::direct_emission).
+    let first: Vec<usize> = polygons.iter().scan(0, |n, p| Some(std::mem::replace(n, *n + p.triangles.len()))).collect();
+    let centroid_rays = std::sync::atomic::AtomicU64::new(0);
+    let at_centroid = |p: usize, t: usize| -> [f64; 3] {
+        let (polygon, surface) = (&polygons[p], &surfaces[polygons[p].surface as usize]);
+        let uv = polygon.triangles[t].iter().map(|&v| placed[v as usize].1.uv).sum::<DVec2>() / 3.0;
+        let triangle = surface.triangle_at(uv).unwrap_or_else(|| nearest_triangle(surface, uv));
+        let e = direct.at(surface.point(uv), surface.normal, triangle, (1u64 << 60) + (first[p] + t) as u64);
+        centroid_rays.fetch_add(e.rays, std::sync::atomic::Ordering::Relaxed);
+        [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k])
+    };
+    let direct_first = shooting::direct_emission(&polygons, &collectors, &at_centroid);
+    work.direct_rays += centroid_rays.into_inner();
+    work.shooting = shoot(&polygons, direct_first, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
     work.shooting_seconds = clock.elapsed().as_secs_f64();
 
     // 5b. Surfaces the direct light leaves without isolux structure (lit

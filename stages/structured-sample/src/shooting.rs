@@ -37,7 +37,7 @@
 //!   unshot radiosity the mean of `rho dE` over it ([`Transfer::of`]), so
 //!   that the power a shot leaves on the polygons is the power their
 //!   samples' light stands for (a closed room of reflectance 0.9 shot
-//!   39% too little before, 2.0% now: README, Structured sampling,
+//!   39% too little before, 1.8% now: README, Structured sampling,
 //!   **Energy**);
 //! - shooting stops when the unshot power of all polygons together is
 //!   under `threshold` of the power the light sources emit, or after
@@ -108,19 +108,68 @@ pub struct ShootingParams {
     pub occlusion_points: usize,
 }
 
-/// Shoots until converged (see the module documentation); adds each
-/// sample's received light to its `indirect`. `emitted_power` is the
-/// light sources' luminous power weighting, W; `shot` is called after each
-/// shot with the remaining fraction.
-pub fn shoot(polygons: &[Polygon], samples: &mut [Collector], rays: &SceneRays, emitted_power: f64, params: ShootingParams, shot: &(dyn Fn(f64) + Sync)) -> ShootingWork {
+/// The radiosity each triangle of each polygon reflects from the light
+/// sources, what it shoots first: the mean of its corners' samples'
+/// (linear between them), scaled per polygon and channel so that the
+/// polygon's power is that of a rule exact for a quadratic radiosity
+/// over each triangle whose corners are all open: the corners' mean
+/// weighing 1/4 and `at_centroid(polygon, triangle)` (the reflected
+/// direct radiosity at the triangle's centroid) 3/4.
+///
+/// Between samples on its contours the direct light curves, and under a
+/// lamp it peaks: the corners' means alone left 0.30% of the built-in
+/// Cornell box's first reflected power unshot, and the rooms it lights
+/// dark (against Mitsuba, relative RMSE 2.20% -> 2.13%, mean signed
+/// -0.59% -> -0.44%, the ceiling -1.61% -> -1.23%, the tall block -2.00%
+/// -> -1.79%). Each triangle taking the rule's value itself was worse
+/// (2.28%, the tall block -2.22%): a centroid in a penumbra stands for
+/// its triangle by one point, where the corners' mean keeps the shape.
+pub fn direct_emission(polygons: &[Polygon], samples: &[Collector], at_centroid: &(dyn Fn(usize, usize) -> [f64; 3] + Sync)) -> Vec<Vec<[f64; 3]>> {
+    polygons
+        .par_iter()
+        .enumerate()
+        .map(|(p, polygon)| {
+            let mut means = triangle_means(polygon, samples, |s| samples[s].direct);
+            let (mut linear, mut quadratic) = ([0.0; 3], [0.0; 3]);
+            for (t, (corners, mean)) in polygon.triangles.iter().zip(&means).enumerate() {
+                if corners.iter().any(|&v| samples[v as usize].buried) {
+                    continue;
+                }
+                let (area, centroid) = (triangle(samples, corners).1, at_centroid(p, t));
+                for k in 0..3 {
+                    linear[k] += area * mean[k];
+                    quadratic[k] += area * (0.25 * mean[k] + 0.75 * centroid[k]);
+                }
+            }
+            for mean in &mut means {
+                for k in 0..3 {
+                    if linear[k] > 0.0 {
+                        mean[k] *= quadratic[k] / linear[k];
+                    }
+                }
+            }
+            means
+        })
+        .collect()
+}
+
+/// Shoots until converged (see the module documentation), each
+/// polygon's triangles first sending their `direct` radiosity
+/// ([`direct_emission`]); adds each sample's received light to its
+/// `indirect`. `emitted_power` is the light sources' luminous power
+/// weighting, W; `shot` is called after each shot with the remaining
+/// fraction.
+#[allow(clippy::too_many_arguments)]
+pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Collector], rays: &SceneRays, emitted_power: f64, params: ShootingParams, shot: &(dyn Fn(f64) + Sync)) -> ShootingWork {
     let generations = params.bounces.max(1) as usize;
     let areas: Vec<Vec<f64>> = polygons.iter().map(|p| p.triangles.iter().map(|t| triangle(samples, t).1).collect()).collect();
     // Per polygon, per generation, per triangle.
     let mut unshot: Vec<Vec<Vec<[f64; 3]>>> = polygons
         .iter()
-        .map(|p| {
+        .zip(direct)
+        .map(|(p, direct)| {
             let mut by_generation = vec![vec![[0.0; 3]; p.triangles.len()]; generations];
-            by_generation[0] = triangle_means(p, samples, |s| samples[s].direct);
+            by_generation[0] = direct;
             by_generation
         })
         .collect();
@@ -901,5 +950,30 @@ mod tests {
             let factor: f64 = polygons[0].triangles.iter().map(|t| lambert(t, r)).sum();
             assert!((uniform[34 + i][1] / (0.7 * factor) - 1.0).abs() < 1e-6, "{r:?}: {} against {}", uniform[34 + i][1], 0.7 * factor);
         }
+    }
+
+    /// A 2 x 1 m rectangle of two triangles whose reflected direct light
+    /// is `1 + x²` (RGB alike, `x` along its long side), known at its
+    /// corners and, for the rule, at the triangles' centroids: the power
+    /// the polygon shoots first is the exact integral, 2 + 8/3 = 14/3 W,
+    /// where the corners' means alone give 6 W (+29%); each triangle keeps
+    /// its corners' mean up to one factor for the polygon.
+    #[test]
+    fn a_polygons_first_power_is_its_direct_lights_integral() {
+        let light = |p: DVec3| 1.0 + p.x * p.x;
+        let mut samples = Vec::new();
+        let polygon = rectangle(&mut samples, 0, [dvec3(0.0, 0.0, 0.0), dvec3(2.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0), dvec3(0.0, 1.0, 0.0)], DVec3::Z);
+        for x in &mut samples {
+            x.direct = [light(x.position); 3];
+        }
+        let polygons = [polygon];
+        let at_centroid = |p: usize, t: usize| [light(polygons[p].triangles[t].iter().map(|&v| samples[v as usize].position).sum::<DVec3>() / 3.0); 3];
+        let first = direct_emission(&polygons, &samples, &at_centroid);
+        let power: f64 = polygons[0].triangles.iter().zip(&first[0]).map(|(t, e)| triangle(&samples, t).1 * e[1]).sum();
+        assert!((power - 14.0 / 3.0).abs() < 1e-12, "{power}");
+        let corners = triangle_means(&polygons[0], &samples, |s| samples[s].direct);
+        let linear: f64 = polygons[0].triangles.iter().zip(&corners).map(|(t, e)| triangle(&samples, t).1 * e[1]).sum();
+        assert!((linear - 6.0).abs() < 1e-12, "{linear}");
+        assert!((first[0][0][0] / corners[0][0] - first[0][1][0] / corners[1][0]).abs() < 1e-12, "one factor for the polygon");
     }
 }
