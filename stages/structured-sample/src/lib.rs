@@ -303,6 +303,18 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let direct_first = shooting::direct_emission(&polygons, &collectors, &at_centroid);
     work.direct_rays += centroid_rays.into_inner();
     work.shooting = shoot(&polygons, direct_first, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
+    // Each shot passes on at most the reflectance times what it sends, so
+    // the unshot power never grows past what the surfaces first reflect,
+    // less than the emitted power: more is light made from nothing
+    // (overlapping emitters: a Delaunay triangulation that covered a
+    // panel's face 144 times ended 47 times over), and the samples'
+    // light means nothing.
+    if work.shooting.remaining > 1.0 {
+        return Err(format!(
+            "the shooting diverges: after {} shots the unshot power is {:.3e} times the emitted power, which light reflected once cannot exceed (secondary emitters that overlap?); no output written",
+            work.shooting.shots, work.shooting.remaining
+        ));
+    }
     work.shooting_seconds = clock.elapsed().as_secs_f64();
 
     // 5b. Surfaces the direct light leaves without isolux structure (lit

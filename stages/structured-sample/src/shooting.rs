@@ -976,4 +976,35 @@ mod tests {
         assert!((linear - 6.0).abs() < 1e-12, "{linear}");
         assert!((first[0][0][0] / corners[0][0] - first[0][1][0] / corners[1][0]).abs() < 1e-12, "one factor for the polygon");
     }
+
+    /// Two facing squares 0.1 apart, each sampled at its corners and shot
+    /// as three overlapping polygons (what a triangulation that covers a
+    /// face three times makes): each bounce passes on about 3 x 0.5 x 0.9
+    /// of what it sends, and the unshot power grows past the emitted
+    /// power, which `structured` refuses; shot once each, it falls.
+    #[test]
+    fn overlapping_polygons_make_the_unshot_power_grow() {
+        let square = |samples: &mut Vec<Collector>, surface: u32, z: f64, normal: DVec3| {
+            let corners = [dvec3(0.0, 0.0, z), dvec3(1.0, 0.0, z), dvec3(1.0, 1.0, z), dvec3(0.0, 1.0, z)];
+            let corners = if normal.z < 0.0 { [corners[0], corners[3], corners[2], corners[1]] } else { corners };
+            rectangle(samples, surface, corners, normal)
+        };
+        for copies in [1, 3] {
+            let mut samples = Vec::new();
+            let (low, high) = (square(&mut samples, 0, 0.0, DVec3::Z), square(&mut samples, 1, 0.1, -DVec3::Z));
+            for x in &mut samples {
+                x.direct = [0.5; 3];
+            }
+            let polygons: Vec<Polygon> = (0..copies).flat_map(|_| [low.clone(), high.clone()]).collect();
+            let direct = polygons.iter().map(|p| triangle_means(p, &samples, |s| samples[s].direct)).collect();
+            let params = ShootingParams { threshold: 1e-3, max_shots: 200, bounces: 0, occlusion_points: 4 };
+            // The unshot power starts at 0.5 W a copy, under the 4 W emitted.
+            let work = shoot(&polygons, direct, &mut samples, &open_scene(), 4.0, params, &|_| {});
+            if copies == 1 {
+                assert!(work.remaining < 1.0, "{}", work.remaining);
+            } else {
+                assert!(work.remaining > 1.0, "{}", work.remaining);
+            }
+        }
+    }
 }
