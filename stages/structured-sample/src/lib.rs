@@ -244,7 +244,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
             .enumerate()
             .map(|(i, (s, c))| {
                 let surface = &surfaces[*s as usize];
-                let triangle = surface.triangle_at(c.uv).unwrap_or_else(|| nearest_triangle(surface, c.uv));
+                let triangle = triangle_of(surface, c.uv);
                 let position = surface.point(c.uv);
                 let e = direct.at(position, surface.normal, triangle, (1u64 << 62) + i as u64);
                 let collector = Collector {
@@ -295,7 +295,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let at_centroid = |p: usize, t: usize| -> [f64; 3] {
         let (polygon, surface) = (&polygons[p], &surfaces[polygons[p].surface as usize]);
         let uv = polygon.triangles[t].iter().map(|&v| placed[v as usize].1.uv).sum::<DVec2>() / 3.0;
-        let triangle = surface.triangle_at(uv).unwrap_or_else(|| nearest_triangle(surface, uv));
+        let triangle = triangle_of(surface, uv);
         let e = direct.at(surface.point(uv), surface.normal, triangle, (1u64 << 60) + (first[p] + t) as u64);
         centroid_rays.fetch_add(e.rays, std::sync::atomic::Ordering::Relaxed);
         [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k])
@@ -352,7 +352,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
             thinnings[s].offer(c);
         }
         for c in &thinnings[s].kept()[before..] {
-            let triangle = surface.triangle_at(c.uv).unwrap_or_else(|| nearest_triangle(surface, c.uv));
+            let triangle = triangle_of(surface, c.uv);
             let position = surface.point(c.uv);
             let e = direct.at(position, surface.normal, triangle, (1u64 << 61) + placed.len() as u64);
             let (indirect, rays_cast) = gather(position, surface.normal, s as u32, triangle);
@@ -435,10 +435,13 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     Ok(Structured { samples, surfaces: sampled_surfaces, emitters: secondary, film, size, work })
 }
 
-/// The triangle of `surface` whose centroid is nearest to `uv`: for a
-/// sample that rounding put just outside every triangle.
-fn nearest_triangle(surface: &surfaces::Surface, uv: DVec2) -> u32 {
-    let distance = |c: &[DVec2; 3]| ((c[0] + c[1] + c[2]) / 3.0 - uv).length_squared();
-    let best = surface.corners_uv.iter().enumerate().min_by(|a, b| distance(a.1).total_cmp(&distance(b.1))).map_or(0, |(k, _)| k);
-    surface.triangles[best]
+/// The mesh triangle of `surface` at `uv`, or the one whose centroid is
+/// nearest to it: for a sample that rounding put just outside every
+/// triangle.
+fn triangle_of(surface: &surfaces::Surface, uv: DVec2) -> u32 {
+    surface.triangle_at(uv).unwrap_or_else(|| {
+        let distance = |c: &[DVec2; 3]| ((c[0] + c[1] + c[2]) / 3.0 - uv).length_squared();
+        let best = surface.corners_uv.iter().enumerate().min_by(|a, b| distance(a.1).total_cmp(&distance(b.1))).map_or(0, |(k, _)| k);
+        surface.triangles[best]
+    })
 }

@@ -174,20 +174,23 @@ pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Co
         })
         .collect();
     let mut work = ShootingWork { shot: vec![[0.0; 3]; polygons.len()], ..Default::default() };
-    let power = |p: usize, g: usize, unshot: &[Vec<Vec<[f64; 3]>>]| areas[p].iter().zip(&unshot[p][g]).map(|(a, u)| a * luminance(*u)).sum::<f64>();
+    // Each polygon's unshot power per generation, taken again only where
+    // a shot changed its unshot radiosity.
+    let power_of = |p: usize, unshot: &[[f64; 3]]| areas[p].iter().zip(unshot).map(|(a, u)| a * luminance(*u)).sum::<f64>();
+    let mut power: Vec<Vec<f64>> = unshot.iter().enumerate().map(|(p, by_generation)| by_generation.iter().map(|u| power_of(p, u)).collect()).collect();
     // Each polygon's transfer, kept from its first shot for the next ones
     // (its geometry and occlusion do not change).
     let mut transfer: Vec<Option<Transfer>> = polygons.iter().map(|_| None).collect();
     let mut cached = 0usize;
     loop {
-        let best = (0..polygons.len()).flat_map(|p| (0..generations).map(move |g| (p, g))).max_by(|a, b| power(a.0, a.1, &unshot).total_cmp(&power(b.0, b.1, &unshot)));
+        let best = (0..polygons.len()).flat_map(|p| (0..generations).map(move |g| (p, g))).max_by(|a, b| power[a.0][a.1].total_cmp(&power[b.0][b.1]));
         let Some((p, g)) = best else {
             work.converged = true;
             break;
         };
-        let total: f64 = (0..polygons.len()).flat_map(|p| (0..generations).map(move |g| (p, g))).map(|(p, g)| power(p, g, &unshot)).sum();
+        let total: f64 = power.iter().flatten().sum();
         work.remaining = if emitted_power > 0.0 { total / emitted_power } else { 0.0 };
-        if work.remaining < params.threshold || power(p, g, &unshot) <= 0.0 {
+        if work.remaining < params.threshold || power[p][g] <= 0.0 {
             work.converged = true;
             break;
         }
@@ -195,6 +198,7 @@ pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Co
             break;
         }
         let db = std::mem::replace(&mut unshot[p][g], vec![[0.0; 3]; polygons[p].triangles.len()]);
+        power[p][g] = 0.0;
         let fresh = transfer[p].is_none().then(|| Transfer::of(p, polygons, samples, rays, params.occlusion_points));
         let t = match &fresh {
             Some(fresh) => {
@@ -209,7 +213,11 @@ pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Co
         }
         let irradiance: Vec<[f64; 3]> = (0..samples.len()).map(|i| t.samples.at(i, &totals)).collect();
         shoot_with(&irradiance, samples);
-        spread(t, &irradiance, &totals, g, generations, params.bounces, polygons, samples, &mut unshot);
+        if let Some(next) = spread(t, &irradiance, &totals, g, generations, params.bounces, polygons, samples, &mut unshot) {
+            for q in (0..polygons.len()).filter(|&q| polygons[q].surface != t.surface) {
+                power[q][next] = power_of(q, &unshot[q][next]);
+            }
+        }
         if let Some(fresh) = fresh {
             // Over the cache's bound, the transfer serves this shot only.
             let entries = fresh.samples.entries() + fresh.near.entries();
@@ -245,7 +253,7 @@ pub const GROUP_REACH: f64 = 4.0;
 
 /// The irradiance at a set of points (samples, or receiving triangles'
 /// means) from a sender whose triangles `t` send radiosities `u_t`. The
-/// triangles are grouped in a tree ([`Sender`]: each group split in two
+/// triangles are grouped in a tree ([`Groups`]: each group split in two
 /// across its longest side, down to single triangles); a point takes the
 /// groups that lie [`GROUP_REACH`] of their diameters from it or more, and
 /// single triangles nearer:
@@ -315,8 +323,9 @@ struct Transfer {
     samples: Shaped,
     /// The mean over each receiving triangle near the sender
     /// ([`NEAR_TRIANGLE`]) of the irradiance, taken point by point: which
-    /// polygon and which of its triangles (the others take the mean of
-    /// their corners' samples).
+    /// polygon and which of its triangles, in the order of both, as
+    /// [`spread`] walks them (the others take the mean of their corners'
+    /// samples).
     near: Shaped,
     near_triangles: Vec<(u32, u32)>,
     /// The sender's triangles' groups.
@@ -730,11 +739,12 @@ fn shoot_with(irradiance: &[[f64; 3]], samples: &mut [Collector]) {
 /// generation `g`, on to the unshot radiosity
 /// of the triangles of the polygons on other surfaces than the sender's
 /// ([`Transfer`]; `irradiance` at every sample): generation `g + 1`, or
-/// none past the last one `bounces` allows.
+/// none past the last one `bounces` allows. Returns the generation it
+/// added to.
 #[allow(clippy::too_many_arguments)]
-fn spread(transfer: &Transfer, irradiance: &[[f64; 3]], totals: &[[f64; 3]], g: usize, generations: usize, bounces: u32, polygons: &[Polygon], samples: &[Collector], unshot: &mut [Vec<Vec<[f64; 3]>>]) {
+fn spread(transfer: &Transfer, irradiance: &[[f64; 3]], totals: &[[f64; 3]], g: usize, generations: usize, bounces: u32, polygons: &[Polygon], samples: &[Collector], unshot: &mut [Vec<Vec<[f64; 3]>>]) -> Option<usize> {
     let next = if bounces == 0 { Some(0) } else { (g + 1 < generations).then_some(g + 1) };
-    let Some(next) = next else { return };
+    let next = next?;
     let mut near = transfer.near_triangles.iter().enumerate().peekable();
     for (q, polygon) in polygons.iter().enumerate() {
         if polygon.surface == transfer.surface {
@@ -751,6 +761,7 @@ fn spread(transfer: &Transfer, irradiance: &[[f64; 3]], totals: &[[f64; 3]], g: 
             }
         }
     }
+    Some(next)
 }
 
 /// A polygon's triangle (sample indices): its corners and its area.
