@@ -37,6 +37,12 @@
 //!
 //! The grid is then drawn as the paper draws its polygons: a pixel's
 //! luminance is the bilinear interpolation of its cell's four vertices.
+//!
+//! What is filtered is the indirect light alone (a choice): the direct
+//! light, whose peaks and penumbrae the samples follow but a filter of
+//! them cannot reproduce between contours, is shown from the probe grid
+//! ([`crate::probes::ProbeGrid::irradiance_at`]). The figures above were
+//! measured filtering both.
 
 use glam::DVec2;
 use schemas::samples::Tag;

@@ -181,26 +181,7 @@ fn merge_small_regions(parent: &mut [usize], areas: &[f64], adjacent: &[(usize, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
-
-    /// A 4 x 2 m rectangle in the plane z = 0, facing +z, as one surface.
-    fn rectangle() -> Surface {
-        let corners = [DVec2::new(0.0, 0.0), DVec2::new(4.0, 0.0), DVec2::new(4.0, 2.0), DVec2::new(0.0, 2.0)];
-        Surface {
-            object: 0,
-            material: 0,
-            normal: DVec3::Z,
-            origin: DVec3::ZERO,
-            axes: [DVec3::X, DVec3::Y],
-            triangles: vec![0, 1],
-            corners_uv: vec![[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]],
-            lo: corners[0],
-            hi: corners[2],
-            area: 8.0,
-            reflectance: [0.5; 3],
-            emission: [0.0; 3],
-        }
-    }
+    use crate::surfaces::rectangle;
 
     fn lattice() -> Vec<DVec2> {
         (0..=16).flat_map(|i| (0..=8).map(move |j| DVec2::new(0.25 * i as f64, 0.25 * j as f64))).collect()
@@ -208,7 +189,7 @@ mod tests {
 
     #[test]
     fn regions_follow_the_bands_and_partition_the_surface() {
-        let (surface, uv) = (rectangle(), lattice());
+        let (surface, uv) = (rectangle(4.0, 2.0), lattice());
         let indices: Vec<u32> = (100..100 + uv.len() as u32).collect();
         // Illuminance growing with u: cuts at u = 1.1, 2.1, 3.1 make four bands.
         let polygons = isolux_polygons(7, &surface, &indices, &uv, |p| p.x, &[1.1, 2.1, 3.1], 0.0, 1, &|_| false);
@@ -226,7 +207,7 @@ mod tests {
 
     #[test]
     fn regions_under_the_least_area_join_a_neighbour() {
-        let (surface, uv) = (rectangle(), lattice());
+        let (surface, uv) = (rectangle(4.0, 2.0), lattice());
         let indices: Vec<u32> = (0..uv.len() as u32).collect();
         // A thin band u in (1.0, 1.3) between two wide ones.
         let cuts = [1.05, 1.3];
@@ -247,7 +228,7 @@ mod tests {
     /// it keeps: the triangles with an open corner, u in [0.75, 1.25]).
     #[test]
     fn buried_triangles_leave_the_polygons_after_the_regions_form() {
-        let (surface, uv) = (rectangle(), lattice());
+        let (surface, uv) = (rectangle(4.0, 2.0), lattice());
         let indices: Vec<u32> = (0..uv.len() as u32).collect();
         let buried = |i: u32| uv[i as usize].x < 0.99;
         let polygons = isolux_polygons(0, &surface, &indices, &uv, |p| p.x, &[1.3], 1.2, 1, &buried);

@@ -26,8 +26,12 @@
 //!    interreflection, like the paper's B), display samples along the
 //!    contours of the indirect light, each gathering what the emitters
 //!    shot;
-//! 6. [`display`]: grid resampling with the conical filter, tag-aware at
-//!    shadow boundaries, and [`render`]: the image through the camera.
+//! 6. [`display`]: the indirect light's grid resampling with the conical
+//!    filter, tag-aware at shadow boundaries, and [`render`]: the image
+//!    through the camera, each hit's direct light from the probe grid
+//!    ([`probes::ProbeGrid::irradiance_at`], or evaluated at the hit along
+//!    a surface's border and a solid's footprint) plus its indirect light
+//!    from the display grid.
 //!
 //! Why an image and not a `solution.exr` for grid-gather: the paper's
 //! display is part of the method (its grid resampling and conical filter
@@ -112,9 +116,9 @@ stage_kit::knobs! {
         bounces: u32 = 0, "", value;
         /// Display grid cells along a surface's longer side.
         display_resolution: usize = 64, "cells", value(1..=4096);
-        /// The display filter: `conical` (paper 002's cone),
-        /// `conical-linear` or `conical-quadratic` (the cone with a first- or
-        /// second-order correction).
+        /// The display filter of the indirect light: `conical` (paper
+        /// 002's cone), `conical-linear` or `conical-quadratic` (the cone
+        /// with a first- or second-order correction).
         filter: display::Filter = display::Filter::ConicalQuadratic, "", value;
         /// Radius `r` of the conical filter.
         filter_radius: f64 = 0.2, "fraction of extent", value(left_open(0.0, 10.0));
@@ -209,6 +213,10 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let size = (params.width.unwrap_or(camera.width), params.height.unwrap_or(camera.height));
     let pinhole = pinhole(camera, size.0, size.1).ok_or("the manifest's camera has a zero view direction, one parallel to up, or a field of view outside (0, 180) degrees")?;
     let mut work = Work::default();
+    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
+    let diagonal = (scene.max - scene.min).length();
+    let normals: Vec<DVec3> = geometry.iter().map(|g| g.normal).collect();
+    let t_min = (1e-6 * diagonal) as f32;
 
     // 1-2. Probes, candidates, thinning.
     let clock = std::time::Instant::now();
@@ -216,9 +224,10 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let mut grids = Vec::with_capacity(surfaces.len());
     let mut thinnings = Vec::with_capacity(surfaces.len());
     for (s, surface) in surfaces.iter().enumerate() {
-        let grid = ProbeGrid::new(surface, &direct, params.probe_resolution, (s as u64) << 32);
+        let mut grid = ProbeGrid::new(surface, &direct, params.probe_resolution, (s as u64) << 32);
         work.probes += grid.probes.len();
         work.direct_rays += grid.rays;
+        work.burial_rays += burial::mark_probes(&mut grid, s, surface, &rays, &normals, t_min, params.seed, 2);
         let mut thinning = Thinning::new(params.contour_spacing * surface.extent());
         for c in light_candidates(surface, &surface.boundary(mesh), &grid, params) {
             thinning.offer(c);
@@ -264,11 +273,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     };
     work.direct_rays += evaluated.iter().map(|e| e.2).sum::<u64>();
     let mut collectors: Vec<Collector> = evaluated.iter().map(|e| e.0).collect();
-    let scene = Aabb::around(mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))));
-    let diagonal = (scene.max - scene.min).length();
-    let normals: Vec<DVec3> = geometry.iter().map(|g| g.normal).collect();
-    let t_min = (1e-6 * diagonal) as f32;
-    work.burial_rays = burial::mark(&mut collectors, &rays, &normals, t_min, params.seed, 0);
+    work.burial_rays += burial::mark(&mut collectors, &rays, &normals, t_min, params.seed, 0);
     work.direct_seconds = clock.elapsed().as_secs_f64();
 
     // 4. Secondary emitter polygons per reflecting surface.
@@ -344,7 +349,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         }
         let grid = ProbeGrid::of(surface, (params.probe_resolution / 4).max(8), |point, triangle, _| {
             let (e, rays_cast) = gather(point, surface.normal, s as u32, triangle);
-            (luminance(e), 1.0, rays_cast)
+            (e, 1.0, rays_cast)
         });
         work.indirect_rays += grid.rays;
         let before = thinnings[s].kept().len();
@@ -404,7 +409,8 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         })
         .collect();
 
-    // 6. Display: grids of the reflected luminance, then the image.
+    // 6. Display: the direct light from the probes, grids of the
+    // indirect light filtered from the samples, then the image.
     let clock = std::time::Instant::now();
     (progress.phase)("display", u64::from(size.1));
     let display: Vec<DisplayGrid> = surfaces
@@ -413,17 +419,27 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         .map(|(s, surface)| {
             let filter: Vec<FilterSample> = placed
                 .iter()
-                .zip(&samples)
                 .zip(&collectors)
-                .filter(|(((owner, _), _), x)| *owner == s as u32 && !x.buried)
-                .map(|(sample, _)| sample)
-                .map(|((_, c), sample)| FilterSample { uv: c.uv, luminance: [0, 1, 2].map(|k| sample.luminance[k] - surface.emission[k] / PI), tag: c.reason.tag() })
+                .filter(|((owner, _), x)| *owner == s as u32 && !x.buried)
+                .map(|((_, c), x)| FilterSample { uv: c.uv, luminance: x.indirect.map(|b| b / PI), tag: c.reason.tag() })
                 .collect();
             let extent = surface.extent();
             DisplayGrid::new(params.filter, surface.lo, surface.hi, extent / params.display_resolution as f64, &filter, params.filter_radius * extent, params.shadow_filter_radius * extent)
         })
         .collect();
-    let film = render::render(&view, &display, size, params.spp_side, progress.step);
+    let shown_rays = std::sync::atomic::AtomicU64::new(0);
+    let reflected = |s: u32, uv: DVec2, triangle: u32, key: u64| -> [f64; 3] {
+        let surface = &surfaces[s as usize];
+        let e = grids[s as usize].irradiance_at(uv).unwrap_or_else(|| {
+            let e = direct.at(surface.point(uv), surface.normal, triangle, (1u64 << 59) + key);
+            shown_rays.fetch_add(e.rays, std::sync::atomic::Ordering::Relaxed);
+            e.rgb
+        });
+        let indirect = display[s as usize].at(uv);
+        [0, 1, 2].map(|k| surface.reflectance[k] * e[k] / PI + indirect[k])
+    };
+    let film = render::render(&view, &reflected, size, params.spp_side, progress.step);
+    work.direct_rays += shown_rays.into_inner();
     work.display_seconds = clock.elapsed().as_secs_f64();
 
     let sampled_surfaces = surfaces.iter().map(|s| SampledSurface { object: s.object, material: s.material, normal: s.normal.to_array() }).collect();

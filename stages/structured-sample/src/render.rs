@@ -1,7 +1,6 @@
 //! The camera: the screen-space lattice of view-dependent display samples,
 //! and the image of the resampled surfaces.
 
-use crate::display::DisplayGrid;
 use crate::surfaces::Surface;
 use glam::{DVec2, DVec3};
 use radiometry::camera::Pinhole;
@@ -69,11 +68,12 @@ pub struct Film {
 
 /// Renders the surfaces through `camera`: `spp_side`² rays per pixel at
 /// the centres of a regular grid of sub-pixels (no randomness), each
-/// front-face hit given its surface's display grid at the hit, plus the
-/// surface's emitted luminance `B_e / pi`. A pixel's surface is the one
-/// most of its rays hit (ties: the lower surface index), single when all
-/// of them did.
-pub fn render(view: &View, grids: &[DisplayGrid], size: (u32, u32), spp_side: u32, row_done: &(dyn Fn() + Sync)) -> Film {
+/// front-face hit given `reflected(surface, (u, v), mesh triangle, key)`,
+/// the luminance it reflects (`key` numbers the ray: pixel by pixel, row
+/// by row), plus the surface's emitted luminance `B_e / pi`. A pixel's
+/// surface is the one most of its rays hit (ties: the lower surface
+/// index), single when all of them did.
+pub fn render(view: &View, reflected: &(dyn Fn(u32, DVec2, u32, u64) -> [f64; 3] + Sync), size: (u32, u32), spp_side: u32, row_done: &(dyn Fn() + Sync)) -> Film {
     let surfaces = view.surfaces;
     let (width, height) = size;
     let n = f64::from(spp_side * spp_side);
@@ -86,9 +86,10 @@ pub fn render(view: &View, grids: &[DisplayGrid], size: (u32, u32), spp_side: u3
                     let mut hits: Vec<(u32, u32)> = Vec::new();
                     for k in 0..spp_side * spp_side {
                         let (sx, sy) = ((f64::from(k % spp_side) + 0.5) / f64::from(spp_side), (f64::from(k / spp_side) + 0.5) / f64::from(spp_side));
-                        let Some((s, uv, _, _)) = view.look(f64::from(x) + sx, f64::from(y) + sy) else { continue };
+                        let Some((s, uv, triangle, _)) = view.look(f64::from(x) + sx, f64::from(y) + sy) else { continue };
                         let surface = &surfaces[s as usize];
-                        let l = grids[s as usize].at(uv);
+                        let key = (u64::from(y) * u64::from(width) + u64::from(x)) * u64::from(spp_side * spp_side) + u64::from(k);
+                        let l = reflected(s, uv, triangle, key);
                         for c in 0..3 {
                             sum[c] += l[c] + surface.emission[c] / PI;
                         }

@@ -151,3 +151,24 @@ pub fn planar_surfaces(mesh: &Mesh, manifest: &Manifest, geometry: &[TriangleGeo
     }
     (surfaces, surface_of)
 }
+
+/// A `width` x `height` m rectangle in the plane z = 0, facing +z, corner
+/// at the origin, as one surface of two triangles (for tests).
+#[cfg(test)]
+pub fn rectangle(width: f64, height: f64) -> Surface {
+    let corners = [DVec2::new(0.0, 0.0), DVec2::new(width, 0.0), DVec2::new(width, height), DVec2::new(0.0, height)];
+    Surface {
+        object: 0,
+        material: 0,
+        normal: DVec3::Z,
+        origin: DVec3::ZERO,
+        axes: [DVec3::X, DVec3::Y],
+        triangles: vec![0, 1],
+        corners_uv: vec![[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]],
+        lo: corners[0],
+        hi: corners[2],
+        area: width * height,
+        reflectance: [0.5; 3],
+        emission: [0.0; 3],
+    }
+}
