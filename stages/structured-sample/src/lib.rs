@@ -332,14 +332,13 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let clock = std::time::Instant::now();
     let mut placed = placed;
     let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_points)).collect();
+    let totals: Vec<Vec<[f64; 3]>> = senders.iter().zip(&work.shooting.shot_triangles).map(|(sender, shot)| sender.totals(shot)).collect();
     let gather = |point: DVec3, normal: DVec3, surface: u32, triangle: u32| -> ([f64; 3], u64) {
         let (mut e, mut rays_cast) = ([0.0; 3], 0);
-        for (sender, shot) in senders.iter().zip(&work.shooting.shot) {
-            let (f, r) = sender.factor(&rays, point, normal, surface, triangle);
+        for (sender, totals) in senders.iter().zip(&totals) {
+            let (de, r) = sender.irradiance(&rays, point, normal, surface, triangle, totals);
             rays_cast += r;
-            for (e, b) in e.iter_mut().zip(shot) {
-                *e += b * f;
-            }
+            e.iter_mut().zip(de).for_each(|(e, de)| *e += de);
         }
         (e, rays_cast)
     };

@@ -16,7 +16,7 @@
 //!   ```
 //!
 //!   over P's casting points `p_i`, each weighted by the point kernel
-//!   `K = cos_x cos_p / r²` ([`Sender::factor`]: points behind the
+//!   `K = cos_x cos_p / r²` ([`Sender::visible`]: points behind the
 //!   receiver's plane weigh nothing); the triangles near `x` each with its
 //!   own `dB_t`, groups of them farther away with their mean ([`Shaped`]);
 //!
@@ -89,8 +89,10 @@ pub struct ShootingWork {
     pub remaining: f64,
     /// Whether it fell under the threshold (else `max_shots` stopped it).
     pub converged: bool,
-    /// Radiosity each polygon shot in all, W/m².
+    /// Radiosity each polygon shot in all, W/m²: its mean over the polygon.
     pub shot: Vec<[f64; 3]>,
+    /// Radiosity each triangle of each polygon shot in all, W/m².
+    pub shot_triangles: Vec<Vec<[f64; 3]>>,
 }
 
 /// The shooting's knobs.
@@ -173,7 +175,7 @@ pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Co
             by_generation
         })
         .collect();
-    let mut work = ShootingWork { shot: vec![[0.0; 3]; polygons.len()], ..Default::default() };
+    let mut work = ShootingWork { shot: vec![[0.0; 3]; polygons.len()], shot_triangles: polygons.iter().map(|p| vec![[0.0; 3]; p.triangles.len()]).collect(), ..Default::default() };
     // Each polygon's unshot power per generation, taken again only where
     // a shot changed its unshot radiosity.
     let power_of = |p: usize, unshot: &[[f64; 3]]| areas[p].iter().zip(unshot).map(|(a, u)| a * luminance(*u)).sum::<f64>();
@@ -210,6 +212,9 @@ pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Co
         let totals = t.groups.totals(&db);
         for (s, d) in work.shot[p].iter_mut().zip(totals[0]) {
             *s += d / polygons[p].area;
+        }
+        for (s, d) in work.shot_triangles[p].iter_mut().zip(&db) {
+            s.iter_mut().zip(d).for_each(|(s, d)| *s += d);
         }
         let irradiance: Vec<[f64; 3]> = (0..samples.len()).map(|i| t.samples.at(i, &totals)).collect();
         shoot_with(&irradiance, samples);
@@ -319,7 +324,7 @@ impl Shaped {
 /// What a shot of one polygon brings, per unit of radiosity shot from
 /// each of its triangles.
 struct Transfer {
-    /// At every sample ([`Sender::factor`] weighed by [`Shaped`]).
+    /// At every sample ([`Sender::irradiance`]'s terms).
     samples: Shaped,
     /// The mean over each receiving triangle near the sender
     /// ([`NEAR_TRIANGLE`]) of the irradiance, taken point by point: which
@@ -480,7 +485,7 @@ impl Sender {
 
     /// At sample `x`: its visible fraction (none where the sender sends it
     /// nothing), its [`Shaped`] terms with the fraction in them, and the
-    /// rays cast ([`Self::factor`]).
+    /// rays cast ([`Self::visible`]).
     fn shaped(&self, rays: &SceneRays, x: &Collector) -> (Option<f64>, Terms, u64) {
         if x.surface == self.surface {
             return (None, Vec::new(), 0);
@@ -548,12 +553,44 @@ impl Sender {
         gap <= NEAR_TRIANGLE * longest
     }
 
-    /// `F_{dx->P} V_P(x)` at `position` (unit `normal`, on `surface` and
-    /// mesh `triangle`; 0 on the sender's own surface), and the rays cast:
-    /// Lambert's formula summed over the triangles, the visible fraction
-    /// by one ray from each casting point, weighted by the point kernel
-    /// `cos_x cos_p / r²` there, which is what the factor integrates
-    /// (where no casting point has weight, plainly).
+    /// The irradiance at `position` (unit `normal`, on `surface` and mesh
+    /// `triangle`; 0 on the sender's own surface) from the sender's
+    /// triangles sending the radiosities whose groups' totals are `totals`
+    /// ([`Self::totals`]), and the rays cast: `V_P(x) sum_g (F_xg / A_g)
+    /// U_g` ([`Shaped`], [`Self::visible`]). What a sample placed after the
+    /// shooting gathers from each polygon (its triangles' radiosities shot
+    /// in all), as the samples placed before it received each shot.
+    #[allow(clippy::too_many_arguments)]
+    pub fn irradiance(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32, totals: &[[f64; 3]]) -> ([f64; 3], u64) {
+        if surface == self.surface {
+            return ([0.0; 3], 0);
+        }
+        let position = self.off_plane(position, normal);
+        let (factor, terms) = self.shape(position, normal);
+        if factor <= 0.0 {
+            return ([0.0; 3], 0);
+        }
+        let (visible, cast) = self.visible(rays, position, normal, triangle);
+        let mut e = [0.0; 3];
+        for (g, c) in terms {
+            for (e, u) in e.iter_mut().zip(totals[g as usize]) {
+                *e += visible * c * u;
+            }
+        }
+        (e, cast)
+    }
+
+    /// The groups' totals ([`Groups::totals`]) of the sender's triangles
+    /// sending radiosities `u`, for [`Self::irradiance`].
+    pub fn totals(&self, u: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        self.groups.totals(u)
+    }
+
+    /// The visible fraction `V_P` at `position` (off the sender's plane,
+    /// [`Self::off_plane`]; unit `normal`, on mesh `triangle`) and the
+    /// rays cast: one ray from each casting point, weighted by the point
+    /// kernel `cos_x cos_p / r²` there, which is what Lambert's factor
+    /// integrates (where no casting point has weight, plainly).
     ///
     /// A sender that straddles the receiver's plane (the lamp and the
     /// walls that light a block's face) has casting points behind that
@@ -562,22 +599,6 @@ impl Sender {
     /// darkened the built-in Cornell box's tall block by 5.6% against a
     /// path-traced reference, as issue 10 found of hierarchical-solve's
     /// links.
-    pub fn factor(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32) -> (f64, u64) {
-        if surface == self.surface {
-            return (0.0, 0);
-        }
-        let position = self.off_plane(position, normal);
-        let factor = self.lambert(position, normal);
-        if factor <= 0.0 {
-            return (0.0, 0);
-        }
-        let (visible, cast) = self.visible(rays, position, normal, triangle);
-        (factor * visible, cast)
-    }
-
-    /// The visible fraction `V_P` at `position` (off the sender's plane,
-    /// [`Self::off_plane`]; unit `normal`, on mesh `triangle`) and the
-    /// rays cast ([`Self::factor`]).
     fn visible(&self, rays: &SceneRays, position: DVec3, normal: DVec3, triangle: u32) -> (f64, u64) {
         // Off its own plane to its front too, and each ray stopped short
         // of it by RAY_END_MARGIN, so that a ray that reaches it at a
@@ -877,7 +898,8 @@ mod tests {
         // Face x = 1 is quad 1: (1,0,0) (1,0,1) (1,1,1) (1,1,0); the point
         // (1, 0.3, 0.6) lies in its first triangle.
         let (point, normal) = (dvec3(1.0, 0.3, 0.6), DVec3::X);
-        let (seen, _) = sender.factor(&rays, point, normal, 0, 2);
+        let (seen, _) = sender.irradiance(&rays, point, normal, 0, 2, &sender.totals(&[[1.0; 3]; 2]));
+        let seen = seen[0];
         let front = [[1.0, -1.0, 2.0], [1.0, 2.0, 2.0], [3.0, 2.0, 2.0], [3.0, -1.0, 2.0]];
         let lambert = lambert_polygon(point.to_array(), normal.to_array(), &front).abs();
         assert!((seen / lambert - 1.0).abs() < 0.01, "F V {seen} against Lambert's {lambert} for the front half");
@@ -931,8 +953,10 @@ mod tests {
     /// above the bright square's centre, facing down: the irradiance
     /// within 1% of each triangle's Lambert factor times its own
     /// radiosity (the test's formula), where the polygon's mean sent from
-    /// all of it (the shooting before [`Shaped`]) is 84% short. With every
-    /// triangle alike the two agree to single precision at any point.
+    /// all of it (the shooting before [`Shaped`]) is 84% short, both as a
+    /// shot brings it and as a point gathers it after the shooting
+    /// ([`Sender::irradiance`]). With every triangle alike the two agree
+    /// to single precision at any point.
     #[test]
     fn a_polygon_sends_each_triangles_own_light_to_what_lies_near_it() {
         let mut samples = Vec::new();
@@ -956,6 +980,10 @@ mod tests {
         let mean = (2.0 * 0.03125 * 1.0 + 30.0 * 0.03125 * 0.1) / 1.0;
         assert!((irradiance[near][0] / exact - 1.0).abs() < 0.01, "{} against {exact}", irradiance[near][0]);
         assert!(mean * factor / exact < 0.2, "the mean would send {} of {exact}", mean * factor);
+        // A point gathering after the shooting takes the same light.
+        let sender = Sender::new(&polygons[0], &samples, 16);
+        let (gathered, _) = sender.irradiance(&open_scene(), samples[near].position, -DVec3::Z, 1, 0, &sender.totals(&db));
+        assert!((gathered[0] / exact - 1.0).abs() < 0.01, "gathered {} against {exact}", gathered[0]);
         let (uniform, _) = shoot_once(0, &polygons, &samples, &[[0.7; 3]; 32]);
         for (i, &r) in receivers.iter().enumerate() {
             let factor: f64 = polygons[0].triangles.iter().map(|t| lambert(t, r)).sum();
