@@ -459,8 +459,9 @@ fn shadow_samples_lie_across_the_exact_penumbra_and_umbra() {
 /// lamp of exitance 10 that reflects too) keeps all its light: its
 /// surfaces reflect `R = rho (Phi + R)`, `R = rho Phi / (1 - rho)` = 10 W,
 /// and the secondary emitters must shoot that power between them (the sum
-/// of area times radiosity shot, within 3%; -1.8% measured, the shooting
-/// stopping at a thousandth of the emitted power unshot). Before the
+/// of area times radiosity shot, within 3%; -1.65% measured, the shooting
+/// stopping at a ten-thousandth of the emitted power unshot, -1.75% at a
+/// thousandth). Before the
 /// samples on a surface's edges took the neighbouring surfaces' factors
 /// as their limit and each polygon passed on what its area received,
 /// 39% of it was lost (`structured_sample::shooting`).

@@ -109,7 +109,7 @@ stage_kit::knobs! {
         occlusion_points: usize = 16, "points", value(1..=4096);
         /// Stop shooting when the unshot power (all polygons together) is
         /// under this fraction of the emitted power.
-        threshold: f64 = 1e-3, "fraction of emitted power", value(open(0.0, 1.0));
+        threshold: f64 = 1e-4, "fraction of emitted power", value(open(0.0, 1.0));
         /// Most shots.
         max_shots: usize = 10_000, "shots", value;
         /// Reflections off secondary emitters (0: all, until `threshold`).
