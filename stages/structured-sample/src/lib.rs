@@ -93,7 +93,7 @@ stage_kit::knobs! {
         /// Spacing of samples in an umbra.
         umbra_spacing: f64 = 0.3, "fraction of extent", value(left_open(0.0, 10.0));
         /// One view-dependent display sample per this many pixels squared.
-        screen_spacing: u32 = 12, "pixels", value(1..=16384);
+        screen_spacing: u32 = 8, "pixels", value(1..=16384);
         /// Rays per light-source triangle for the direct light's visibility.
         visibility_rays: usize = 16, "rays", value(1..=4096);
         /// Least area of a secondary emitter, as a fraction of its surface's:
