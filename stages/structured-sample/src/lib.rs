@@ -327,39 +327,41 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     // Figure 3(b) shows): their indirect light is probed from the shot
     // emitters (on a grid a quarter as fine as the direct light's: the
     // indirect light is smooth, and each probe gathers from every
-    // emitter), display samples go along its contours, and each gathers
-    // what the emitters shot.
+    // emitter), display samples go along its contours and across the
+    // outline of what hides most of the room from it ([`SHADOWED`]), and
+    // each gathers what the emitters shot.
     let clock = std::time::Instant::now();
     let mut placed = placed;
     let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_points)).collect();
     let totals: Vec<Vec<[f64; 3]>> = senders.iter().zip(&work.shooting.shot_triangles).map(|(sender, shot)| sender.totals(shot)).collect();
-    let gather = |point: DVec3, normal: DVec3, surface: u32, triangle: u32| -> ([f64; 3], u64) {
-        let (mut e, mut rays_cast) = ([0.0; 3], 0);
+    let gather = |point: DVec3, normal: DVec3, surface: u32, triangle: u32| -> ([f64; 3], [f64; 3], u64) {
+        let (mut e, mut unoccluded, mut rays_cast) = ([0.0; 3], [0.0; 3], 0);
         for (sender, totals) in senders.iter().zip(&totals) {
-            let (de, r) = sender.irradiance(&rays, point, normal, surface, triangle, totals);
+            let (de, du, r) = sender.irradiance(&rays, point, normal, surface, triangle, totals);
             rays_cast += r;
             e.iter_mut().zip(de).for_each(|(e, de)| *e += de);
+            unoccluded.iter_mut().zip(du).for_each(|(u, du)| *u += du);
         }
-        (e, rays_cast)
+        (e, unoccluded, rays_cast)
     };
     for (s, surface) in surfaces.iter().enumerate() {
         if !isolux_levels(&grids[s], params.levels).is_empty() || luminance(surface.reflectance) <= 0.0 || senders.is_empty() {
             continue;
         }
         let grid = ProbeGrid::of(surface, (params.probe_resolution / 4).max(8), |point, triangle, _| {
-            let (e, rays_cast) = gather(point, surface.normal, s as u32, triangle);
-            (e, 1.0, rays_cast)
+            let (e, unoccluded, rays_cast) = gather(point, surface.normal, s as u32, triangle);
+            (e, if luminance(e) < SHADOWED * luminance(unoccluded) { 0.0 } else { 1.0 }, rays_cast)
         });
         work.indirect_rays += grid.rays;
         let before = thinnings[s].kept().len();
-        for c in light_candidates(surface, &[], &grid, params).into_iter().filter(|c| c.reason == Reason::IsoluxContour) {
+        for c in light_candidates(surface, &[], &grid, params).into_iter().filter(|c| matches!(c.reason, Reason::IsoluxContour | Reason::Penumbra | Reason::Umbra)) {
             thinnings[s].offer(c);
         }
         for c in &thinnings[s].kept()[before..] {
             let triangle = triangle_of(surface, c.uv);
             let position = surface.point(c.uv);
             let e = direct.at(position, surface.normal, triangle, (1u64 << 61) + placed.len() as u64);
-            let (indirect, rays_cast) = gather(position, surface.normal, s as u32, triangle);
+            let (indirect, _, rays_cast) = gather(position, surface.normal, s as u32, triangle);
             work.direct_rays += e.rays;
             work.indirect_rays += rays_cast;
             collectors.push(Collector {
@@ -449,6 +451,19 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         .collect();
     Ok(Structured { samples, surfaces: sampled_surfaces, emitters: secondary, film, size, work })
 }
+
+/// On a surface lit only by reflection, a probe of its indirect light
+/// counts as shadowed (visibility 0 for the placement, else 1) where it
+/// receives less than this fraction of what it would with nothing in the
+/// way, so that the outline of what hides the room from it is sampled as
+/// a shadow boundary ([`placement::light_candidates`]'s penumbra) and the
+/// display's filter takes the small cone there. A fraction, not any
+/// occlusion at all: nearly every point of a room has some of its senders
+/// partly hidden, and the placement's penumbra test marks every
+/// visibility strictly between 0 and 1. Half marks the outline of what
+/// hides most of the room (a lamp hung under a ceiling) and not the soft
+/// shade of a block seen from the ceiling.
+pub const SHADOWED: f64 = 0.5;
 
 /// The mesh triangle of `surface` at `uv`, or the one whose centroid is
 /// nearest to it: for a sample that rounding put just outside every

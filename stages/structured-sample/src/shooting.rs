@@ -618,28 +618,29 @@ impl Sender {
     /// The irradiance at `position` (unit `normal`, on `surface` and mesh
     /// `triangle`; 0 on the sender's own surface) from the sender's
     /// triangles sending the radiosities whose groups' totals are `totals`
-    /// ([`Self::totals`]), and the rays cast: `V_P(x) sum_g (F_xg / A_g)
-    /// U_g` ([`Shaped`], [`Self::visible`]). What a sample placed after the
-    /// shooting gathers from each polygon (its triangles' radiosities shot
-    /// in all), as the samples placed before it received each shot.
+    /// ([`Self::totals`]), the same unoccluded, and the rays cast:
+    /// `V_P(x) sum_g (F_xg / A_g) U_g` ([`Shaped`], [`Self::visible`]).
+    /// What a sample placed after the shooting gathers from each polygon
+    /// (its triangles' radiosities shot in all), as the samples placed
+    /// before it received each shot.
     #[allow(clippy::too_many_arguments)]
-    pub fn irradiance(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32, totals: &[[f64; 3]]) -> ([f64; 3], u64) {
+    pub fn irradiance(&self, rays: &SceneRays, position: DVec3, normal: DVec3, surface: u32, triangle: u32, totals: &[[f64; 3]]) -> ([f64; 3], [f64; 3], u64) {
         if surface == self.surface {
-            return ([0.0; 3], 0);
+            return ([0.0; 3], [0.0; 3], 0);
         }
         let position = self.off_plane(position, normal);
         let (factor, terms) = self.shape(position, normal);
         if factor <= 0.0 {
-            return ([0.0; 3], 0);
+            return ([0.0; 3], [0.0; 3], 0);
         }
         let (visible, cast) = self.visible(rays, position, normal, triangle);
-        let mut e = [0.0; 3];
+        let mut unoccluded = [0.0; 3];
         for (g, c) in terms {
-            for (e, u) in e.iter_mut().zip(totals[g as usize]) {
-                *e += visible * c * u;
+            for (e, u) in unoccluded.iter_mut().zip(totals[g as usize]) {
+                *e += c * u;
             }
         }
-        (e, cast)
+        (unoccluded.map(|e| visible * e), unoccluded, cast)
     }
 
     /// The groups' totals ([`Groups::totals`]) of the sender's triangles
@@ -960,7 +961,7 @@ mod tests {
         // Face x = 1 is quad 1: (1,0,0) (1,0,1) (1,1,1) (1,1,0); the point
         // (1, 0.3, 0.6) lies in its first triangle.
         let (point, normal) = (dvec3(1.0, 0.3, 0.6), DVec3::X);
-        let (seen, _) = sender.irradiance(&rays, point, normal, 0, 2, &sender.totals(&[[1.0; 3]; 2]));
+        let (seen, _, _) = sender.irradiance(&rays, point, normal, 0, 2, &sender.totals(&[[1.0; 3]; 2]));
         let seen = seen[0];
         let front = [[1.0, -1.0, 2.0], [1.0, 2.0, 2.0], [3.0, 2.0, 2.0], [3.0, -1.0, 2.0]];
         let lambert = lambert_polygon(point.to_array(), normal.to_array(), &front).abs();
@@ -1072,7 +1073,7 @@ mod tests {
         assert!(mean * factor / exact < 0.2, "the mean would send {} of {exact}", mean * factor);
         // A point gathering after the shooting takes the same light.
         let sender = Sender::new(&polygons[0], &samples, 16);
-        let (gathered, _) = sender.irradiance(&open_scene(), samples[near].position, -DVec3::Z, 1, 0, &sender.totals(&db));
+        let (gathered, _, _) = sender.irradiance(&open_scene(), samples[near].position, -DVec3::Z, 1, 0, &sender.totals(&db));
         assert!((gathered[0] / exact - 1.0).abs() < 0.01, "gathered {} against {exact}", gathered[0]);
         let (uniform, _) = shoot_once(0, &polygons, &samples, &[[0.7; 3]; 32]);
         for (i, &r) in receivers.iter().enumerate() {
