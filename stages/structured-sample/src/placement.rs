@@ -100,7 +100,7 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
                     continue;
                 }
                 for (level, &t) in levels.iter().enumerate() {
-                    let (fa, fb) = (pa.illuminance - t, pb.illuminance - t);
+                    let (fa, fb) = (pa.illuminance() - t, pb.illuminance() - t);
                     if fa * fb >= 0.0 && !(fa == 0.0 && fb != 0.0) {
                         continue;
                     }

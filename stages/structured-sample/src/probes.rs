@@ -18,13 +18,19 @@ pub struct Probe {
     pub triangle: Option<u32>,
     /// The irradiance, W/m², RGB.
     pub irradiance: [f64; 3],
-    /// Its luminance weighting (Y of its RGB), W/m²: isolux contours are
-    /// lines of constant illuminance, whatever the surface reflects of it.
-    pub illuminance: f64,
     /// Visible fraction of the light sources ([`crate::direct::Irradiance`]).
     pub visibility: f64,
     /// Inside a solid standing on the surface ([`crate::burial::mark_probes`]).
     pub buried: bool,
+}
+
+impl Probe {
+    /// The irradiance's luminance weighting (Y of its RGB), W/m²: isolux
+    /// contours are lines of constant illuminance, whatever the surface
+    /// reflects of it.
+    pub fn illuminance(&self) -> f64 {
+        radiometry::color::luminance(self.irradiance)
+    }
 }
 
 /// The probe grid over one surface's bounding rectangle: nodes
@@ -68,10 +74,10 @@ impl ProbeGrid {
             .map(|k| {
                 let uv = surface.lo + DVec2::new((k % nu) as f64, (k / nu) as f64) * h;
                 let Some(triangle) = surface.triangle_at(uv) else {
-                    return (Probe { triangle: None, irradiance: [0.0; 3], illuminance: 0.0, visibility: 1.0, buried: false }, 0);
+                    return (Probe { triangle: None, irradiance: [0.0; 3], visibility: 1.0, buried: false }, 0);
                 };
                 let (irradiance, visibility, rays) = light(surface.point(uv), triangle, k as u64);
-                (Probe { triangle: Some(triangle), irradiance, illuminance: radiometry::color::luminance(irradiance), visibility, buried: false }, rays)
+                (Probe { triangle: Some(triangle), irradiance, visibility, buried: false }, rays)
             })
             .collect();
         let rays = evaluated.iter().map(|p| p.1).sum();
@@ -96,7 +102,7 @@ impl ProbeGrid {
     /// The illuminance at `uv`, bilinear between the four nodes around it
     /// (clamped to the grid).
     pub fn illuminance_at(&self, uv: DVec2) -> f64 {
-        self.cell(uv).iter().map(|&((i, j), w)| w * self.at(i, j).illuminance).sum()
+        self.cell(uv).iter().map(|&((i, j), w)| w * self.at(i, j).illuminance()).sum()
     }
 
     /// The irradiance (RGB) at `uv` for display: bilinear between the four
@@ -156,7 +162,7 @@ impl ProbeGrid {
                 if p.triangle.is_none() {
                     return 0.0;
                 }
-                *value = p.illuminance;
+                *value = p.illuminance();
             }
         }
         let h = self.h;
@@ -177,7 +183,7 @@ impl ProbeGrid {
         if i == 0 || j == 0 || i + 1 >= self.nu || j + 1 >= self.nv {
             return 0.0;
         }
-        let f = |a: usize, b: usize| self.at(a, b).triangle.map(|_| self.at(a, b).illuminance);
+        let f = |a: usize, b: usize| self.at(a, b).triangle.map(|_| self.at(a, b).illuminance());
         match (f(i + 1, j), f(i - 1, j), f(i, j + 1), f(i, j - 1)) {
             (Some(e), Some(w), Some(n), Some(s)) => ((e - w).powi(2) + (n - s).powi(2)).sqrt() / (2.0 * self.h),
             _ => 0.0,
@@ -216,7 +222,7 @@ impl ProbeGrid {
 
     /// The smallest and largest illuminance over the surface's probes.
     pub fn range(&self) -> (f64, f64) {
-        self.probes.iter().filter(|p| p.triangle.is_some()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.illuminance), hi.max(p.illuminance)))
+        self.probes.iter().filter(|p| p.triangle.is_some()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.illuminance()), hi.max(p.illuminance())))
     }
 }
 
