@@ -18,7 +18,9 @@
 //!    inside a solid ([`burial`]: the floor under a block);
 //! 4. [`emitters`]: secondary emitter polygons of light-transfer samples,
 //!    one per isolux region (Delaunay triangles merged by band,
-//!    [`delaunay`]);
+//!    [`delaunay`]); on surfaces lit only by reflection, with vertices
+//!    along the outline of what hides the room from them, as the first
+//!    reflection off the other polygons shows it;
 //! 5. [`shooting`]: progressive shooting from the polygon of highest unshot
 //!    power, each of its triangles sending the mean of its corners', with
 //!    the paper's ray occlusion (from points over the polygon); then,
@@ -154,10 +156,12 @@ pub struct Work {
     pub placement_seconds: f64,
     /// Seconds computing the direct light at the samples.
     pub direct_seconds: f64,
-    /// Seconds shooting.
+    /// Seconds cutting the secondary emitters (the outline of surfaces lit
+    /// only indirectly included) and shooting.
     pub shooting_seconds: f64,
-    /// Rays cast placing and gathering the display samples of surfaces
-    /// lit only indirectly.
+    /// Rays cast probing surfaces lit only indirectly: for their outline
+    /// before the shooting, and placing and gathering their display
+    /// samples after it.
     pub indirect_rays: u64,
     /// Seconds placing and gathering them.
     pub indirect_placement_seconds: f64,
@@ -276,38 +280,88 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     work.burial_rays += burial::mark(&mut collectors, &rays, &normals, t_min, params.seed, 0);
     work.direct_seconds = clock.elapsed().as_secs_f64();
 
-    // 4. Secondary emitter polygons per reflecting surface.
+    // 4. Secondary emitter polygons per reflecting surface: first of the
+    // surfaces the direct light gives isolux contours; then of those lit
+    // only by reflection, whose vertices include the outline of what
+    // hides the room from them (where a probe receives under [`SHADOWED`]
+    // of its unoccluded first reflection, from the first polygons' direct
+    // light): a lamp hung a centimetre under a ceiling leaves a pocket
+    // over it that sees nothing of the room. Cut from lattice samples
+    // alone, the ceiling's triangles straddled the pocket's outline
+    // wherever the lattice happened to fall, their corners' visibility
+    // stood for the pocket or for the open ceiling round it, and what the
+    // ceiling received moved by 3% from one lattice spacing to the next
+    // (McGuire's white box against hierarchical-solve: -1.0% to -3.9%;
+    // README, Structured sampling).
     let clock = std::time::Instant::now();
+    let reflecting: Vec<bool> = surfaces.iter().map(|s| luminance(s.reflectance) > 0.0).collect();
+    let by_reflection: Vec<bool> = (0..surfaces.len()).map(|s| reflecting[s] && isolux_levels(&grids[s], params.levels).is_empty()).collect();
     let mut polygons = Vec::new();
-    for (s, surface) in surfaces.iter().enumerate() {
-        if luminance(surface.reflectance) <= 0.0 {
-            continue;
-        }
+    let cut = |s: usize, placed: &[(u32, Candidate)], collectors: &[Collector], grid: &ProbeGrid, polygons: &mut Vec<emitters::Polygon>| {
+        let surface = &surfaces[s];
         let members: Vec<u32> = (0..placed.len() as u32).filter(|&i| placed[i as usize].0 == s as u32 && placed[i as usize].1.reason != Reason::ScreenDensity).collect();
         let uv: Vec<DVec2> = members.iter().map(|&i| placed[i as usize].1.uv).collect();
-        let grid = &grids[s];
         let min_area = params.emitter_min_area * surface.area;
         let cells = (surface.extent() / (params.emitter_cell * diagonal)).ceil().clamp(1.0, 256.0) as usize;
         polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area, cells, &|i| collectors[i as usize].buried));
+    };
+    for s in (0..surfaces.len()).filter(|&s| reflecting[s] && !by_reflection[s]) {
+        cut(s, &placed, &collectors, &grids[s], &mut polygons);
     }
+    // The direct light at each polygon triangle's centroid, for the power
+    // each polygon shoots first (shooting::direct_emission), `key` the
+    // random stream of the first one's first triangle.
+    let direct_first = |polygons: &[emitters::Polygon], placed: &[(u32, Candidate)], collectors: &[Collector], key: u64| -> (Vec<Vec<[f64; 3]>>, u64) {
+        let first: Vec<usize> = polygons.iter().scan(0, |n, p| Some(std::mem::replace(n, *n + p.triangles.len()))).collect();
+        let centroid_rays = std::sync::atomic::AtomicU64::new(0);
+        let at_centroid = |p: usize, t: usize| -> [f64; 3] {
+            let (polygon, surface) = (&polygons[p], &surfaces[polygons[p].surface as usize]);
+            let uv = polygon.triangles[t].iter().map(|&v| placed[v as usize].1.uv).sum::<DVec2>() / 3.0;
+            let triangle = triangle_of(surface, uv);
+            let e = direct.at(surface.point(uv), surface.normal, triangle, key + (first[p] + t) as u64);
+            centroid_rays.fetch_add(e.rays, std::sync::atomic::Ordering::Relaxed);
+            [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k])
+        };
+        let emission = shooting::direct_emission(polygons, collectors, &at_centroid);
+        (emission, centroid_rays.into_inner())
+    };
+    let (mut emission, centroid_rays) = direct_first(&polygons, &placed, &collectors, 1u64 << 60);
+    work.direct_rays += centroid_rays;
+    let mut placed = placed;
+    if by_reflection.iter().any(|&b| b) && !polygons.is_empty() {
+        let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_points)).collect();
+        let totals: Vec<Vec<[f64; 3]>> = senders.iter().zip(&emission).map(|(sender, u)| sender.totals(u)).collect();
+        let before = placed.len();
+        for s in (0..surfaces.len()).filter(|&s| by_reflection[s]) {
+            let grid = indirect_probes(&surfaces[s], params.probe_resolution / OUTLINE_COARSENING, |point, triangle| gather(&senders, &totals, &rays, point, surfaces[s].normal, s as u32, triangle));
+            work.indirect_rays += grid.rays;
+            let offered = thinnings[s].kept().len();
+            for c in light_candidates(&surfaces[s], &[], &grid, params).into_iter().filter(|c| matches!(c.reason, Reason::Penumbra | Reason::Umbra)) {
+                thinnings[s].offer(c);
+            }
+            placed.extend(thinnings[s].kept()[offered..].iter().map(|c| (s as u32, *c)));
+        }
+        for (i, &(s, c)) in placed.iter().enumerate().skip(before) {
+            let surface = &surfaces[s as usize];
+            let (triangle, position) = (triangle_of(surface, c.uv), surface.point(c.uv));
+            let e = direct.at(position, surface.normal, triangle, (1u64 << 62) + i as u64);
+            work.direct_rays += e.rays;
+            collectors.push(Collector { position, normal: surface.normal, surface: s, triangle, reflectance: surface.reflectance, direct: [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]), indirect: [0.0; 3], buried: false });
+        }
+        work.burial_rays += burial::mark(&mut collectors[before..], &rays, &normals, t_min, params.seed, 3);
+    }
+    let lit = polygons.len();
+    for s in (0..surfaces.len()).filter(|&s| by_reflection[s]) {
+        cut(s, &placed, &collectors, &grids[s], &mut polygons);
+    }
+    let lit_triangles: usize = polygons[..lit].iter().map(|p| p.triangles.len()).sum();
+    let (rest, centroid_rays) = direct_first(&polygons[lit..], &placed, &collectors, (1u64 << 60) + lit_triangles as u64);
+    work.direct_rays += centroid_rays;
+    emission.extend(rest);
     // 5. Progressive shooting.
     (progress.phase)("shooting", params.max_shots as u64);
     let shooting_params = ShootingParams { threshold: params.threshold, max_shots: params.max_shots, bounces: params.bounces, occlusion_points: params.occlusion_points };
-    // The direct light at each polygon triangle's centroid, for the power
-    // each polygon shoots first (shooting::direct_emission).
-    let first: Vec<usize> = polygons.iter().scan(0, |n, p| Some(std::mem::replace(n, *n + p.triangles.len()))).collect();
-    let centroid_rays = std::sync::atomic::AtomicU64::new(0);
-    let at_centroid = |p: usize, t: usize| -> [f64; 3] {
-        let (polygon, surface) = (&polygons[p], &surfaces[polygons[p].surface as usize]);
-        let uv = polygon.triangles[t].iter().map(|&v| placed[v as usize].1.uv).sum::<DVec2>() / 3.0;
-        let triangle = triangle_of(surface, uv);
-        let e = direct.at(surface.point(uv), surface.normal, triangle, (1u64 << 60) + (first[p] + t) as u64);
-        centroid_rays.fetch_add(e.rays, std::sync::atomic::Ordering::Relaxed);
-        [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k])
-    };
-    let direct_first = shooting::direct_emission(&polygons, &collectors, &at_centroid);
-    work.direct_rays += centroid_rays.into_inner();
-    work.shooting = shoot(&polygons, direct_first, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
+    work.shooting = shoot(&polygons, emission, &mut collectors, &rays, emitted_power, shooting_params, &|_| (progress.step)());
     // Each shot passes on at most the reflectance times what it sends, so
     // the unshot power never grows past what the surfaces first reflect,
     // less than the emitted power: more is light made from nothing
@@ -331,27 +385,14 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     // outline of what hides most of the room from it ([`SHADOWED`]), and
     // each gathers what the emitters shot.
     let clock = std::time::Instant::now();
-    let mut placed = placed;
+    let before_display = placed.len();
     let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_points)).collect();
     let totals: Vec<Vec<[f64; 3]>> = senders.iter().zip(&work.shooting.shot_triangles).map(|(sender, shot)| sender.totals(shot)).collect();
-    let gather = |point: DVec3, normal: DVec3, surface: u32, triangle: u32| -> ([f64; 3], [f64; 3], u64) {
-        let (mut e, mut unoccluded, mut rays_cast) = ([0.0; 3], [0.0; 3], 0);
-        for (sender, totals) in senders.iter().zip(&totals) {
-            let (de, du, r) = sender.irradiance(&rays, point, normal, surface, triangle, totals);
-            rays_cast += r;
-            e.iter_mut().zip(de).for_each(|(e, de)| *e += de);
-            unoccluded.iter_mut().zip(du).for_each(|(u, du)| *u += du);
-        }
-        (e, unoccluded, rays_cast)
-    };
     for (s, surface) in surfaces.iter().enumerate() {
-        if !isolux_levels(&grids[s], params.levels).is_empty() || luminance(surface.reflectance) <= 0.0 || senders.is_empty() {
+        if !by_reflection[s] || senders.is_empty() {
             continue;
         }
-        let grid = ProbeGrid::of(surface, (params.probe_resolution / 4).max(8), |point, triangle, _| {
-            let (e, unoccluded, rays_cast) = gather(point, surface.normal, s as u32, triangle);
-            (e, if luminance(e) < SHADOWED * luminance(unoccluded) { 0.0 } else { 1.0 }, rays_cast)
-        });
+        let grid = indirect_probes(surface, params.probe_resolution / 4, |point, triangle| gather(&senders, &totals, &rays, point, surface.normal, s as u32, triangle));
         work.indirect_rays += grid.rays;
         let before = thinnings[s].kept().len();
         for c in light_candidates(surface, &[], &grid, params).into_iter().filter(|c| matches!(c.reason, Reason::IsoluxContour | Reason::Penumbra | Reason::Umbra)) {
@@ -361,7 +402,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
             let triangle = triangle_of(surface, c.uv);
             let position = surface.point(c.uv);
             let e = direct.at(position, surface.normal, triangle, (1u64 << 61) + placed.len() as u64);
-            let (indirect, _, rays_cast) = gather(position, surface.normal, s as u32, triangle);
+            let (indirect, _, rays_cast) = gather(&senders, &totals, &rays, position, surface.normal, s as u32, triangle);
             work.direct_rays += e.rays;
             work.indirect_rays += rays_cast;
             collectors.push(Collector {
@@ -377,8 +418,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
             placed.push((s as u32, *c));
         }
     }
-    let first = evaluated.len();
-    work.burial_rays += burial::mark(&mut collectors[first..], &rays, &normals, t_min, params.seed, 1);
+    work.burial_rays += burial::mark(&mut collectors[before_display..], &rays, &normals, t_min, params.seed, 1);
     work.indirect_placement_seconds = clock.elapsed().as_secs_f64();
 
     let mut emitter_of = vec![NO_EMITTER; placed.len()];
@@ -464,6 +504,48 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
 /// hides most of the room (a lamp hung under a ceiling) and not the soft
 /// shade of a block seen from the ceiling.
 pub const SHADOWED: f64 = 0.5;
+
+/// How much coarser than the direct light's probes (`probe_resolution`)
+/// the grid is that finds, before the shooting, the outline of what hides
+/// the room from a surface lit only by reflection ([`SHADOWED`]); the
+/// indirect light's probes after the shooting are a quarter as fine. Each
+/// probe gathers from every polygon: at a quarter, this probing took 0.9
+/// s of the built-in Cornell box's 10.2 s (whose ceiling has no such
+/// outline). An eighth (a twelfth of the white box's ceiling, 17 cm)
+/// takes about a quarter of that, and against Mitsuba McGuire's `Original` went
+/// 2.10% -> 1.68% (its ceiling round the lamp 5.9% -> 4.1%), its white
+/// box against hierarchical-solve 1.16-1.29% -> 1.11-1.36% over four
+/// lattice spacings: the outline's place to a cell matters less than
+/// having one.
+pub const OUTLINE_COARSENING: usize = 8;
+
+
+/// What `senders` bring to `point` (unit `normal`, on `surface` and mesh
+/// `triangle`), each shooting the radiosities whose groups' totals are
+/// `totals` ([`shooting::Sender::irradiance`]): the irradiance, the same
+/// unoccluded, and the rays cast.
+#[allow(clippy::too_many_arguments)]
+fn gather(senders: &[shooting::Sender], totals: &[Vec<[f64; 3]>], rays: &SceneRays, point: DVec3, normal: DVec3, surface: u32, triangle: u32) -> ([f64; 3], [f64; 3], u64) {
+    let (mut e, mut unoccluded, mut rays_cast) = ([0.0; 3], [0.0; 3], 0);
+    for (sender, totals) in senders.iter().zip(totals) {
+        let (de, du, r) = sender.irradiance(rays, point, normal, surface, triangle, totals);
+        rays_cast += r;
+        e.iter_mut().zip(de).for_each(|(e, de)| *e += de);
+        unoccluded.iter_mut().zip(du).for_each(|(u, du)| *u += du);
+    }
+    (e, unoccluded, rays_cast)
+}
+
+/// Probes of the reflected light on `surface` with `resolution` cells
+/// along its longer side, by `light(point, mesh triangle) -> (irradiance,
+/// the same unoccluded, rays cast)`; each probe's visibility 0 where it is
+/// [`SHADOWED`], else 1.
+fn indirect_probes(surface: &surfaces::Surface, resolution: usize, light: impl Fn(DVec3, u32) -> ([f64; 3], [f64; 3], u64) + Sync) -> ProbeGrid {
+    ProbeGrid::of(surface, resolution.max(8), |point, triangle, _| {
+        let (e, unoccluded, rays_cast) = light(point, triangle);
+        (e, if luminance(e) < SHADOWED * luminance(unoccluded) { 0.0 } else { 1.0 }, rays_cast)
+    })
+}
 
 /// The mesh triangle of `surface` at `uv`, or the one whose centroid is
 /// nearest to it: for a sample that rounding put just outside every
