@@ -386,16 +386,19 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     // each gathers what the emitters shot.
     let clock = std::time::Instant::now();
     let before_display = placed.len();
+    // Each such surface's indirect probes, whose outline of what hides the
+    // room from it parts the display's filter (`DisplayGrid::new`).
+    let mut reflected: Vec<Option<ProbeGrid>> = vec![None; surfaces.len()];
     let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_points)).collect();
     let totals: Vec<Vec<[f64; 3]>> = senders.iter().zip(&work.shooting.shot_triangles).map(|(sender, shot)| sender.totals(shot)).collect();
     for (s, surface) in surfaces.iter().enumerate() {
         if !by_reflection[s] || senders.is_empty() {
             continue;
         }
-        let grid = indirect_probes(surface, params.probe_resolution / 4, |point, triangle| gather(&senders, &totals, &rays, point, surface.normal, s as u32, triangle));
+        let grid = reflected[s].insert(indirect_probes(surface, params.probe_resolution / 4, |point, triangle| gather(&senders, &totals, &rays, point, surface.normal, s as u32, triangle)));
         work.indirect_rays += grid.rays;
         let before = thinnings[s].kept().len();
-        for c in light_candidates(surface, &[], &grid, params).into_iter().filter(|c| matches!(c.reason, Reason::IsoluxContour | Reason::Penumbra | Reason::Umbra)) {
+        for c in light_candidates(surface, &[], grid, params).into_iter().filter(|c| matches!(c.reason, Reason::IsoluxContour | Reason::Penumbra | Reason::Umbra)) {
             thinnings[s].offer(c);
         }
         for c in &thinnings[s].kept()[before..] {
@@ -465,7 +468,8 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
                 .map(|((_, c), x)| FilterSample { uv: c.uv, luminance: x.indirect.map(|b| b / PI), tag: c.reason.tag() })
                 .collect();
             let extent = surface.extent();
-            DisplayGrid::new(params.filter, surface.lo, surface.hi, extent / params.display_resolution as f64, &filter, params.filter_radius * extent, params.shadow_filter_radius * extent)
+            let open = |uv: DVec2| reflected[s].as_ref().is_none_or(|g| g.open_at(uv));
+            DisplayGrid::new(params.filter, surface.lo, surface.hi, extent / params.display_resolution as f64, &filter, params.filter_radius * extent, params.shadow_filter_radius * extent, open)
         })
         .collect();
     let shown_rays = std::sync::atomic::AtomicU64::new(0);

@@ -105,6 +105,21 @@ impl ProbeGrid {
         self.cell(uv).iter().map(|&((i, j), w)| w * self.at(i, j).illuminance()).sum()
     }
 
+    /// Whether `uv` lies in the open: the visibility of the nodes round it
+    /// that lie on the surface, bilinear, at least a half (in the open
+    /// where none does).
+    pub fn open_at(&self, uv: DVec2) -> bool {
+        let (mut seen, mut total) = (0.0, 0.0);
+        for ((i, j), w) in self.cell(uv) {
+            let p = self.at(i, j);
+            if p.triangle.is_some() {
+                seen += w * p.visibility;
+                total += w;
+            }
+        }
+        total <= 0.0 || seen >= 0.5 * total
+    }
+
     /// The irradiance (RGB) at `uv` for display: bilinear between the four
     /// nodes around it where all four lie on the surface and in the open
     /// (not buried) and `uv` lies within the grid; `None` elsewhere (along
