@@ -490,8 +490,8 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let sampled_surfaces = surfaces.iter().map(|s| SampledSurface { object: s.object, material: s.material, normal: s.normal.to_array() }).collect();
     let secondary = polygons
         .iter()
-        .zip(&work.shooting.shot)
-        .map(|(p, shot)| SecondaryEmitter { surface: p.surface, area: p.area, shot: *shot, triangles: p.triangles.clone() })
+        .enumerate()
+        .map(|(i, p)| SecondaryEmitter { surface: p.surface, area: p.area, shot: work.shooting.shot(i, p, &collectors), triangles: p.triangles.clone() })
         .collect();
     Ok(Structured { samples, surfaces: sampled_surfaces, emitters: secondary, film, size, work })
 }

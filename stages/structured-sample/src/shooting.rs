@@ -91,10 +91,21 @@ pub struct ShootingWork {
     pub remaining: f64,
     /// Whether it fell under the threshold (else `max_shots` stopped it).
     pub converged: bool,
-    /// Radiosity each polygon shot in all, W/m²: its mean over the polygon.
-    pub shot: Vec<[f64; 3]>,
     /// Radiosity each triangle of each polygon shot in all, W/m².
     pub shot_triangles: Vec<Vec<[f64; 3]>>,
+}
+
+impl ShootingWork {
+    /// The radiosity polygon `p` (`polygon`, whose vertices are `samples`)
+    /// shot in all, W/m²: the mean over it of its triangles'.
+    pub fn shot(&self, p: usize, polygon: &Polygon, samples: &[Collector]) -> [f64; 3] {
+        let mut power = [0.0; 3];
+        for (t, shot) in polygon.triangles.iter().zip(&self.shot_triangles[p]) {
+            let area = triangle(samples, t).1;
+            power.iter_mut().zip(shot).for_each(|(e, s)| *e += area * s);
+        }
+        power.map(|e| e / polygon.area)
+    }
 }
 
 /// The shooting's knobs.
@@ -177,7 +188,7 @@ pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Co
             by_generation
         })
         .collect();
-    let mut work = ShootingWork { shot: vec![[0.0; 3]; polygons.len()], shot_triangles: polygons.iter().map(|p| vec![[0.0; 3]; p.triangles.len()]).collect(), ..Default::default() };
+    let mut work = ShootingWork { shot_triangles: polygons.iter().map(|p| vec![[0.0; 3]; p.triangles.len()]).collect(), ..Default::default() };
     // Each polygon's unshot power per generation, taken again only where
     // a shot changed its unshot radiosity.
     let power_of = |p: usize, unshot: &[[f64; 3]]| areas[p].iter().zip(unshot).map(|(a, u)| a * luminance(*u)).sum::<f64>();
@@ -212,9 +223,6 @@ pub fn shoot(polygons: &[Polygon], direct: Vec<Vec<[f64; 3]>>, samples: &mut [Co
             None => transfer[p].as_ref().expect("cached"),
         };
         let totals = t.groups.totals(&db);
-        for (s, d) in work.shot[p].iter_mut().zip(totals[0]) {
-            *s += d / polygons[p].area;
-        }
         for (s, d) in work.shot_triangles[p].iter_mut().zip(&db) {
             s.iter_mut().zip(d).for_each(|(s, d)| *s += d);
         }
