@@ -54,7 +54,7 @@ use crate::emitters::Polygon;
 use glam::DVec3;
 use radiometry::color::luminance;
 use radiometry::bounds::Aabb;
-use radiometry::form_factor::point_to_one_sided_polygon;
+use radiometry::form_factor::{point_to_boundary, point_to_one_sided_polygon};
 use radiometry::rays::SceneRays;
 use rayon::prelude::*;
 
@@ -560,7 +560,7 @@ impl Sender {
         let (normal, extent) = (samples[polygon.vertices[0] as usize].normal, (bounds.max - bounds.min).length());
         Sender {
             surface: polygon.surface,
-            groups: Groups::new(&triangles, &areas),
+            groups: Groups::new(&triangles, &polygon.triangles, &areas, normal),
             triangles,
             normal,
             // Off the plane to the front, by more than f32 rounding of
@@ -609,12 +609,11 @@ impl Sender {
     /// [`Self::off_plane`]): Lambert's factor of the whole sender, and the
     /// unoccluded [`Shaped`] terms (none where the factor is 0).
     fn shape(&self, position: DVec3, normal: DVec3) -> (f64, Terms) {
-        let factors: Vec<f64> = self.triangles.iter().map(|t| point_to_one_sided_polygon(position, normal, t, self.normal)).collect();
-        let factor: f64 = factors.iter().sum();
+        let (factor, terms) = self.groups.cut(position, normal, &self.triangles, self.normal);
         if factor <= 0.0 {
             return (0.0, Vec::new());
         }
-        (factor, self.groups.cut(position, &factors))
+        (factor, terms)
     }
 
     /// At sample `x`: its visible fraction (none where the sender sends it
@@ -776,6 +775,8 @@ impl Sender {
 /// before its halves.
 struct Groups {
     groups: Vec<Group>,
+    /// The triangles in the tree's leaf order: each group's are a run of it.
+    order: Vec<u32>,
 }
 
 struct Group {
@@ -785,6 +786,13 @@ struct Group {
     area: f64,
     /// Its two halves' indices, or the triangle it is.
     content: Content,
+    /// Its triangles: `order[first..first + count]`.
+    first: u32,
+    count: u32,
+    /// Its boundary: the directed edges of its triangles, each wound
+    /// counter-clockwise about the sender's normal, but those two of them
+    /// share ([`point_to_boundary`]).
+    boundary: Vec<[DVec3; 2]>,
 }
 
 enum Content {
@@ -793,34 +801,59 @@ enum Content {
 }
 
 impl Groups {
-    /// The groups of `triangles` of `areas`.
-    fn new(triangles: &[[DVec3; 3]], areas: &[f64]) -> Self {
-        let mut groups = Groups { groups: Vec::with_capacity(2 * triangles.len()) };
-        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        if !order.is_empty() {
-            groups.split(&mut order, triangles, areas);
+    /// The groups of `triangles` (their corners, and the same as sample
+    /// indices, `corners`) of `areas`, on a plane of unit normal `normal`.
+    fn new(triangles: &[[DVec3; 3]], corners: &[[u32; 3]], areas: &[f64], normal: DVec3) -> Self {
+        let mut groups = Groups { groups: Vec::with_capacity(2 * triangles.len()), order: (0..triangles.len() as u32).collect() };
+        if !triangles.is_empty() {
+            let mut order = std::mem::take(&mut groups.order);
+            // Each triangle's corners counter-clockwise about the normal.
+            let wound: Vec<[u32; 3]> = triangles
+                .iter()
+                .zip(corners)
+                .map(|(c, &k)| if (c[1] - c[0]).cross(c[2] - c[0]).dot(normal) < 0.0 { [k[0], k[2], k[1]] } else { k })
+                .collect();
+            let mut positions = std::collections::HashMap::new();
+            for (c, k) in triangles.iter().zip(corners) {
+                for i in 0..3 {
+                    positions.entry(k[i]).or_insert(c[i]);
+                }
+            }
+            groups.split(&mut order, 0, triangles, &wound, areas, &positions);
+            groups.order = order;
         }
         groups
     }
 
-    /// Adds the group of triangles `members` and, below it, its halves;
-    /// its index.
-    fn split(&mut self, members: &mut [u32], triangles: &[[DVec3; 3]], areas: &[f64]) -> u32 {
+    /// Adds the group of triangles `members` (`order[first..]`) and,
+    /// below it, its halves; its index and its boundary as sample-index
+    /// edges.
+    #[allow(clippy::too_many_arguments)]
+    fn split(&mut self, members: &mut [u32], first: u32, triangles: &[[DVec3; 3]], wound: &[[u32; 3]], areas: &[f64], positions: &std::collections::HashMap<u32, DVec3>) -> (u32, Vec<[u32; 2]>) {
         let at = self.groups.len() as u32;
         let bounds = Aabb::around(members.iter().flat_map(|&t| triangles[t as usize]));
         let area = members.iter().map(|&t| areas[t as usize]).sum();
-        self.groups.push(Group { bounds, diameter: (bounds.max - bounds.min).length(), area, content: Content::Triangle(members[0]) });
-        if members.len() > 1 {
+        let count = members.len() as u32;
+        self.groups.push(Group { bounds, diameter: (bounds.max - bounds.min).length(), area, content: Content::Triangle(members[0]), first, count, boundary: Vec::new() });
+        let edges = if members.len() > 1 {
             let centroid = |t: u32| triangles[t as usize].iter().sum::<DVec3>() / 3.0;
             let spread = Aabb::around(members.iter().map(|&t| centroid(t)));
             let axis = (spread.max - spread.min).max_position();
             members.sort_by(|&a, &b| centroid(a)[axis].total_cmp(&centroid(b)[axis]).then(a.cmp(&b)));
-            let (low, high) = members.split_at_mut(members.len() / 2);
-            let low = self.split(low, triangles, areas);
-            let high = self.split(high, triangles, areas);
+            let half = members.len() / 2;
+            let (low, high) = members.split_at_mut(half);
+            let (low, low_edges) = self.split(low, first, triangles, wound, areas, positions);
+            let (high, high_edges) = self.split(high, first + half as u32, triangles, wound, areas, positions);
             self.groups[at as usize].content = Content::Halves(low, high);
-        }
-        at
+            let reversed = |edges: &[[u32; 2]]| edges.iter().map(|e| [e[1], e[0]]).collect::<std::collections::HashSet<[u32; 2]>>();
+            let (in_low, in_high) = (reversed(&low_edges), reversed(&high_edges));
+            low_edges.iter().filter(|e| !in_high.contains(*e)).chain(high_edges.iter().filter(|e| !in_low.contains(*e))).copied().collect()
+        } else {
+            let k = wound[members[0] as usize];
+            vec![[k[0], k[1]], [k[1], k[2]], [k[2], k[0]]]
+        };
+        self.groups[at as usize].boundary = edges.iter().map(|e| [positions[&e[0]], positions[&e[1]]]).collect();
+        (at, edges)
     }
 
     /// Each group's `U_g = sum_t A_t u_t` of the triangles' radiosities `u`.
@@ -835,27 +868,44 @@ impl Groups {
         totals
     }
 
-    /// The groups a point at `position` takes ([`Shaped`]), each with
-    /// `F_g / A_g`, of Lambert's `factors` per triangle.
-    fn cut(&self, position: DVec3, factors: &[f64]) -> Terms {
-        let mut sums = vec![0.0; self.groups.len()];
-        for (g, group) in self.groups.iter().enumerate().rev() {
-            sums[g] = match group.content {
-                Content::Triangle(t) => factors[t as usize],
-                Content::Halves(a, b) => sums[a as usize] + sums[b as usize],
-            };
-        }
-        let (mut cut, mut open) = (Vec::new(), vec![0u32]);
+    /// The groups a point at `position` (unit `normal`) takes
+    /// ([`Shaped`]), each with `F_g / A_g`, and the sum of their `F_g`:
+    /// Lambert's factors of the sender's `triangles` (one-sided, facing
+    /// `front`).
+    fn cut(&self, position: DVec3, normal: DVec3, triangles: &[[DVec3; 3]], front: DVec3) -> (f64, Terms) {
+        let (mut cut, mut open, mut total) = (Vec::new(), vec![0u32], 0.0);
         while let Some(g) = open.pop() {
             let group = &self.groups[g as usize];
             let gap = (group.bounds.min - position).max(position - group.bounds.max).max(DVec3::ZERO).length();
             match group.content {
                 Content::Halves(a, b) if gap < GROUP_REACH * group.diameter => open.extend([b, a]),
-                _ if sums[g as usize] != 0.0 && group.area > 0.0 => cut.push((g, sums[g as usize] / group.area)),
-                _ => {}
+                _ => {
+                    let factor = self.factor(group, position, normal, triangles, front);
+                    total += factor;
+                    if factor != 0.0 && group.area > 0.0 {
+                        cut.push((g, factor / group.area));
+                    }
+                }
             }
         }
-        cut
+        (total, cut)
+    }
+
+    /// Lambert's factor of `group` at `position` (unit `normal`): from its
+    /// boundary where all of it lies at or above the point's plane
+    /// ([`point_to_boundary`]), else triangle by triangle, each clipped to
+    /// the point's hemisphere. The boundary of a polygon cut from isolux
+    /// contours is about as long as it has triangles, so its factor takes
+    /// a third of the terms; the triangle by triangle sum took three
+    /// fifths of the stage's time on the built-in Cornell box.
+    fn factor(&self, group: &Group, position: DVec3, normal: DVec3, triangles: &[[DVec3; 3]], front: DVec3) -> f64 {
+        let above = group.boundary.iter().all(|e| (e[0] - position).dot(normal) >= 0.0);
+        if above && group.count > 1 {
+            let in_front = group.boundary.first().is_some_and(|e| (position - e[0]).dot(front) > 0.0);
+            return if in_front { point_to_boundary(position, normal, &group.boundary) } else { 0.0 };
+        }
+        let members = &self.order[group.first as usize..(group.first + group.count) as usize];
+        members.iter().map(|&t| point_to_one_sided_polygon(position, normal, &triangles[t as usize], front)).sum()
     }
 }
 
@@ -1128,6 +1178,42 @@ mod tests {
         assert!((mean / exact - 1.0).abs() < 5e-4, "{mean} against {exact}");
         let corner_mean = (irradiance[4][0] + irradiance[5][0] + irradiance[6][0]) / 3.0;
         assert!(corner_mean / exact < 0.99, "the corners' mean {corner_mean} against {exact}");
+    }
+
+    /// A sender of 18 triangles on a 4 x 4 grid of samples, every other one
+    /// wound clockwise: at points above it (the groups' factors from their
+    /// boundaries) and at a point whose plane cuts it (the groups it cuts
+    /// triangle by triangle), every group's factor in the cut, and their
+    /// sum, equal the sum of its triangles' Lambert factors, to 1e-12.
+    #[test]
+    fn a_groups_factor_from_its_boundary_is_its_triangles_sum() {
+        let mut samples = Vec::new();
+        for j in 0..4 {
+            for i in 0..4 {
+                let position = dvec3(i as f64 * 0.3 + 0.05 * (j % 2) as f64, j as f64 * 0.25 + 0.03 * (i * i % 3) as f64, 0.0);
+                samples.push(Collector { position, normal: DVec3::Z, surface: 0, triangle: 0, reflectance: [0.5; 3], direct: [0.0; 3], indirect: [0.0; 3], buried: false });
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..3u32 {
+            for i in 0..3u32 {
+                let (a, b, c, d) = (4 * j + i, 4 * j + i + 1, 4 * j + i + 5, 4 * j + i + 4);
+                triangles.extend([[a, b, c], if (i + j) % 2 == 0 { [a, d, c] } else { [a, c, d] }]);
+            }
+        }
+        let polygon = Polygon { surface: 0, triangles, vertices: (0..16).collect(), area: 0.0 };
+        let sender = Sender::new(&polygon, &samples, 16);
+        for (point, normal) in [(dvec3(0.4, 0.3, 0.5), -DVec3::Z), (dvec3(2.5, 0.4, 1.0), dvec3(-1.0, 0.2, -0.3).normalize()), (dvec3(0.5, 0.4, 0.3), dvec3(1.0, 0.0, -0.4).normalize())] {
+            let factors: Vec<f64> = sender.triangles.iter().map(|t| point_to_one_sided_polygon(point, normal, t, DVec3::Z)).collect();
+            let (total, terms) = sender.shape(point, normal);
+            assert!((total - factors.iter().sum::<f64>()).abs() < 1e-12, "{total} against {}", factors.iter().sum::<f64>());
+            for (g, c) in terms {
+                let group = &sender.groups.groups[g as usize];
+                let members = &sender.groups.order[group.first as usize..(group.first + group.count) as usize];
+                let summed: f64 = members.iter().map(|&t| factors[t as usize]).sum();
+                assert!((c * group.area - summed).abs() < 1e-12, "group {g}: {} against {summed}", c * group.area);
+            }
+        }
     }
 
     /// A receiving triangle (facing down, longest edge 0.45 m) over a 1 m
