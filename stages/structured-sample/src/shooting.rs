@@ -23,7 +23,7 @@
 //!   own `dB_t`, groups of them farther away with their mean ([`Shaped`]);
 //!
 //!   (`F` at a sample on the sender's plane is the limit from inside its
-//!   own surface, [`Sender::unoccluded`]). The paper's occlusion: "a ray
+//!   own surface, [`Sender::off_plane`]). The paper's occlusion: "a ray
 //!   is cast from each v_i to every display sample ... the result at each
 //!   display sample is weighted based on the ray intersection count". The
 //!   paper's polygons are coarse (a few vertices); a merged region here
@@ -521,7 +521,7 @@ pub const NEAR_SUBDIVISION: usize = 4;
 
 /// How near (a fraction of the sender's extent) a receiving point must lie
 /// to the sender's plane to take the factor's limit from inside its
-/// surface ([`Sender::unoccluded`]).
+/// surface ([`Sender::off_plane`]).
 pub const ON_PLANE: f64 = 1e-6;
 
 /// The fraction of its length by which an occlusion ray stops short of
@@ -571,38 +571,6 @@ impl Sender {
             bounds,
             extent,
         }
-    }
-
-    /// `F_{dx->P}` at `position` (unit `normal`, on `surface`), unoccluded:
-    /// Lambert's formula summed over the triangles, 0 on the sender's own
-    /// surface.
-    ///
-    /// Where the point lies on the sender's plane (within [`ON_PLANE`] of
-    /// its extent) and its surface leaves that plane (their normals not
-    /// parallel), the factor is its limit from inside the receiving
-    /// surface: taken a millionth of the sender's extent into it, along
-    /// the surface, to the sender's front. On the plane itself Lambert's
-    /// formula gives 0 (the sender seen edge-on), but where the receiving
-    /// surface meets the sender along an edge the factor jumps there: a
-    /// point of a wall just above a floor polygon that reaches the wall
-    /// sees the floor fill up to half its hemisphere. The samples along a
-    /// surface's edges lie on the neighbouring surfaces' planes; taken on
-    /// the plane they received nothing from those neighbours, the nearest
-    /// and strongest exchange of a room, and the surface between them and
-    /// the next samples was reconstructed from that nothing. A closed box
-    /// of reflectance 0.9 was 35% dark in its mean, McGuire's empty white
-    /// box 29% against the other solvers (module docs, issue 10).
-    pub fn unoccluded(&self, position: DVec3, normal: DVec3, surface: u32) -> f64 {
-        if surface == self.surface {
-            return 0.0;
-        }
-        self.lambert(self.off_plane(position, normal), normal)
-    }
-
-    /// Lambert's formula summed over the triangles at `position` (unit
-    /// `normal`), taken as it is.
-    fn lambert(&self, position: DVec3, normal: DVec3) -> f64 {
-        self.triangles.iter().map(|t| point_to_one_sided_polygon(position, normal, t, self.normal)).sum()
     }
 
     /// At `position` (unit `normal`, already off the sender's plane,
@@ -666,7 +634,23 @@ impl Sender {
 
     /// `position`, or where it lies on the sender's plane, the point a
     /// millionth of the sender's extent from it along its own surface
-    /// (unit `normal`) to the sender's front ([`Self::unoccluded`]).
+    /// (unit `normal`) to the sender's front: where Lambert's factor is
+    /// taken.
+    ///
+    /// Where the point lies on the sender's plane (within [`ON_PLANE`] of
+    /// its extent) and its surface leaves that plane (their normals not
+    /// parallel), the factor is its limit from inside the receiving
+    /// surface. On the plane itself Lambert's formula gives 0 (the sender
+    /// seen edge-on), but where the receiving surface meets the sender
+    /// along an edge the factor jumps there: a point of a wall just above
+    /// a floor polygon that reaches the wall sees the floor fill up to
+    /// half its hemisphere. The samples along a surface's edges lie on the
+    /// neighbouring surfaces' planes; taken on the plane they received
+    /// nothing from those neighbours, the nearest and strongest exchange
+    /// of a room, and the surface between them and the next samples was
+    /// reconstructed from that nothing. A closed box of reflectance 0.9
+    /// was 35% dark in its mean, McGuire's empty white box 29% against the
+    /// other solvers (module docs, issue 10).
     fn off_plane(&self, position: DVec3, normal: DVec3) -> DVec3 {
         let extent = self.extent;
         let height = (position - self.triangles[0][0]).dot(self.normal);
