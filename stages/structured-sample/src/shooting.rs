@@ -876,17 +876,18 @@ impl Groups {
     }
 
     /// Lambert's factor of `group` at `position` (unit `normal`): from its
-    /// boundary where all of it lies at or above the point's plane
-    /// ([`point_to_boundary`]), else triangle by triangle, each clipped to
-    /// the point's hemisphere. The boundary of a polygon cut from isolux
-    /// contours is about as long as it has triangles, so its factor takes
-    /// a third of the terms; the triangle by triangle sum took three
-    /// fifths of the stage's time on the built-in Cornell box.
+    /// boundary where all of it lies at or above the point's plane and the
+    /// point before every corner of it ([`point_to_boundary`]), else
+    /// triangle by triangle, each one-sided and clipped to the point's
+    /// hemisphere (a surface's triangles are coplanar only to a
+    /// tolerance). The boundary of a polygon cut from isolux contours is
+    /// about as long as it has triangles, so its factor takes a third of
+    /// the terms; the triangle by triangle sum took three fifths of the
+    /// stage's time on the built-in Cornell box.
     fn factor(&self, group: &Group, position: DVec3, normal: DVec3, triangles: &[[DVec3; 3]], front: DVec3) -> f64 {
-        let above = group.boundary.iter().all(|e| (e[0] - position).dot(normal) >= 0.0);
-        if above && group.count > 1 {
-            let in_front = group.boundary.first().is_some_and(|e| (position - e[0]).dot(front) > 0.0);
-            return if in_front { point_to_boundary(position, normal, &group.boundary) } else { 0.0 };
+        let open = group.boundary.iter().all(|e| (e[0] - position).dot(normal) >= 0.0 && (position - e[0]).dot(front) > 0.0);
+        if open && group.count > 1 {
+            return point_to_boundary(position, normal, &group.boundary);
         }
         let members = &self.order[group.first as usize..(group.first + group.count) as usize];
         members.iter().map(|&t| point_to_one_sided_polygon(position, normal, &triangles[t as usize], front)).sum()
