@@ -857,6 +857,12 @@ impl Groups {
     /// Lambert's factors of the sender's `triangles` (one-sided, facing
     /// `front`).
     fn cut(&self, position: DVec3, normal: DVec3, triangles: &[[DVec3; 3]], front: DVec3) -> (f64, Terms) {
+        // Nothing to take where the whole sender lies behind the point's
+        // plane or the point behind the sender's.
+        let corners = self.groups.first().map_or(&[][..], |root| &root.boundary[..]);
+        if corners.iter().all(|e| (e[0] - position).dot(normal) < 0.0) || corners.iter().all(|e| (position - e[0]).dot(front) <= 0.0) {
+            return (0.0, Vec::new());
+        }
         let (mut cut, mut open, mut total) = (Vec::new(), vec![0u32], 0.0);
         while let Some(g) = open.pop() {
             let group = &self.groups[g as usize];
@@ -886,7 +892,7 @@ impl Groups {
     /// stage's time on the built-in Cornell box.
     fn factor(&self, group: &Group, position: DVec3, normal: DVec3, triangles: &[[DVec3; 3]], front: DVec3) -> f64 {
         let open = group.boundary.iter().all(|e| (e[0] - position).dot(normal) >= 0.0 && (position - e[0]).dot(front) > 0.0);
-        if open && group.count > 1 {
+        if open {
             return point_to_boundary(position, normal, &group.boundary);
         }
         let members = &self.order[group.first as usize..(group.first + group.count) as usize];
