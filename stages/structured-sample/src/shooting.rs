@@ -788,9 +788,9 @@ impl Groups {
     /// The groups of `triangles` (their corners, and the same as sample
     /// indices, `corners`) of `areas`, on a plane of unit normal `normal`.
     fn new(triangles: &[[DVec3; 3]], corners: &[[u32; 3]], areas: &[f64], normal: DVec3) -> Self {
-        let mut groups = Groups { groups: Vec::with_capacity(2 * triangles.len()), order: (0..triangles.len() as u32).collect() };
-        if !triangles.is_empty() {
-            let mut order = std::mem::take(&mut groups.order);
+        let mut groups = Groups { groups: Vec::with_capacity(2 * triangles.len()), order: Vec::new() };
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        if !order.is_empty() {
             // Each triangle's corners counter-clockwise about the normal.
             let wound: Vec<[u32; 3]> = triangles
                 .iter()
@@ -804,8 +804,8 @@ impl Groups {
                 }
             }
             groups.split(&mut order, 0, triangles, &wound, areas, &positions);
-            groups.order = order;
         }
+        groups.order = order;
         groups
     }
 
