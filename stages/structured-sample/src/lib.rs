@@ -250,33 +250,29 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let clock = std::time::Instant::now();
     let placed: Vec<(u32, Candidate)> = thinnings.iter().enumerate().flat_map(|(s, t)| t.kept().iter().map(move |c| (s as u32, *c))).collect();
     (progress.phase)("direct light", placed.len() as u64);
-    let evaluated: Vec<(Collector, f64, u64)> = {
+    // A sample on surface `s` at `uv` with its exact direct light (random
+    // stream `key`), nothing reflected yet; and the rays cast.
+    let sample_at = |s: u32, uv: DVec2, key: u64| -> (Collector, u64) {
+        let surface = &surfaces[s as usize];
+        let (triangle, position) = (triangle_of(surface, uv), surface.point(uv));
+        let e = direct.at(position, surface.normal, triangle, key);
+        let direct = [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]);
+        (Collector { position, normal: surface.normal, surface: s, triangle, reflectance: surface.reflectance, direct, indirect: [0.0; 3], buried: false }, e.rays)
+    };
+    let evaluated: Vec<(Collector, u64)> = {
         use rayon::prelude::*;
         placed
             .par_iter()
             .enumerate()
             .map(|(i, (s, c))| {
-                let surface = &surfaces[*s as usize];
-                let triangle = triangle_of(surface, c.uv);
-                let position = surface.point(c.uv);
-                let e = direct.at(position, surface.normal, triangle, (1u64 << 62) + i as u64);
-                let collector = Collector {
-                    position,
-                    normal: surface.normal,
-                    surface: *s,
-                    triangle,
-                    reflectance: surface.reflectance,
-                    direct: [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]),
-                    indirect: [0.0; 3],
-                    buried: false,
-                };
+                let sample = sample_at(*s, c.uv, (1u64 << 62) + i as u64);
                 (progress.step)();
-                (collector, luminance(e.rgb), e.rays)
+                sample
             })
             .collect()
     };
-    work.direct_rays += evaluated.iter().map(|e| e.2).sum::<u64>();
-    let mut collectors: Vec<Collector> = evaluated.iter().map(|e| e.0).collect();
+    work.direct_rays += evaluated.iter().map(|e| e.1).sum::<u64>();
+    let mut collectors: Vec<Collector> = evaluated.into_iter().map(|e| e.0).collect();
     work.burial_rays += burial::mark(&mut collectors, &rays, &normals, t_min, params.seed, 0);
     work.direct_seconds = clock.elapsed().as_secs_f64();
 
@@ -342,11 +338,9 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
             placed.extend(thinnings[s].kept()[offered..].iter().map(|c| (s as u32, *c)));
         }
         for (i, &(s, c)) in placed.iter().enumerate().skip(before) {
-            let surface = &surfaces[s as usize];
-            let (triangle, position) = (triangle_of(surface, c.uv), surface.point(c.uv));
-            let e = direct.at(position, surface.normal, triangle, (1u64 << 62) + i as u64);
-            work.direct_rays += e.rays;
-            collectors.push(Collector { position, normal: surface.normal, surface: s, triangle, reflectance: surface.reflectance, direct: [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]), indirect: [0.0; 3], buried: false });
+            let (x, rays_cast) = sample_at(s, c.uv, (1u64 << 62) + i as u64);
+            work.direct_rays += rays_cast;
+            collectors.push(x);
         }
         work.burial_rays += burial::mark(&mut collectors[before..], &rays, &normals, t_min, params.seed, 3);
     }
@@ -388,36 +382,26 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let before_display = placed.len();
     // Each such surface's indirect probes, whose outline of what hides the
     // room from it parts the display's filter (`DisplayGrid::new`).
-    let mut reflected: Vec<Option<ProbeGrid>> = vec![None; surfaces.len()];
+    let mut indirect_grids: Vec<Option<ProbeGrid>> = vec![None; surfaces.len()];
     let senders: Vec<shooting::Sender> = polygons.iter().map(|p| shooting::Sender::new(p, &collectors, params.occlusion_points)).collect();
     let totals: Vec<Vec<[f64; 3]>> = senders.iter().zip(&work.shooting.shot_triangles).map(|(sender, shot)| sender.totals(shot)).collect();
     for (s, surface) in surfaces.iter().enumerate() {
         if !by_reflection[s] || senders.is_empty() {
             continue;
         }
-        let grid = reflected[s].insert(indirect_probes(surface, params.probe_resolution / 4, |point, triangle| gather(&senders, &totals, &rays, point, surface.normal, s as u32, triangle)));
+        let grid = indirect_grids[s].insert(indirect_probes(surface, params.probe_resolution / 4, |point, triangle| gather(&senders, &totals, &rays, point, surface.normal, s as u32, triangle)));
         work.indirect_rays += grid.rays;
         let before = thinnings[s].kept().len();
         for c in light_candidates(surface, &[], grid, params).into_iter().filter(|c| matches!(c.reason, Reason::IsoluxContour | Reason::Penumbra | Reason::Umbra)) {
             thinnings[s].offer(c);
         }
         for c in &thinnings[s].kept()[before..] {
-            let triangle = triangle_of(surface, c.uv);
-            let position = surface.point(c.uv);
-            let e = direct.at(position, surface.normal, triangle, (1u64 << 61) + placed.len() as u64);
-            let (indirect, _, rays_cast) = gather(&senders, &totals, &rays, position, surface.normal, s as u32, triangle);
-            work.direct_rays += e.rays;
-            work.indirect_rays += rays_cast;
-            collectors.push(Collector {
-                position,
-                normal: surface.normal,
-                surface: s as u32,
-                triangle,
-                reflectance: surface.reflectance,
-                direct: [0, 1, 2].map(|k| surface.reflectance[k] * e.rgb[k]),
-                indirect: [0, 1, 2].map(|k| surface.reflectance[k] * indirect[k]),
-                buried: false,
-            });
+            let (mut x, direct_rays) = sample_at(s as u32, c.uv, (1u64 << 61) + placed.len() as u64);
+            let (indirect, _, indirect_rays) = gather(&senders, &totals, &rays, x.position, surface.normal, s as u32, x.triangle);
+            x.indirect = [0, 1, 2].map(|k| surface.reflectance[k] * indirect[k]);
+            work.direct_rays += direct_rays;
+            work.indirect_rays += indirect_rays;
+            collectors.push(x);
             placed.push((s as u32, *c));
         }
     }
@@ -468,7 +452,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
                 .map(|((_, c), x)| FilterSample { uv: c.uv, luminance: x.indirect.map(|b| b / PI), tag: c.reason.tag() })
                 .collect();
             let extent = surface.extent();
-            let open = |uv: DVec2| reflected[s].as_ref().is_none_or(|g| g.open_at(uv));
+            let open = |uv: DVec2| indirect_grids[s].as_ref().is_none_or(|g| g.open_at(uv));
             DisplayGrid::new(params.filter, surface.lo, surface.hi, extent / params.display_resolution as f64, &filter, params.filter_radius * extent, params.shadow_filter_radius * extent, open)
         })
         .collect();
@@ -522,7 +506,6 @@ pub const SHADOWED: f64 = 0.5;
 /// lattice spacings: the outline's place to a cell matters less than
 /// having one.
 pub const OUTLINE_COARSENING: usize = 8;
-
 
 /// What `senders` bring to `point` (unit `normal`, on `surface` and mesh
 /// `triangle`), each shooting the radiosities whose groups' totals are

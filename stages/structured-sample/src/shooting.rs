@@ -316,19 +316,25 @@ impl Shaped {
 
     /// Point `i`'s irradiance from the groups' `totals` ([`Groups::totals`]).
     fn at(&self, i: usize, totals: &[[f64; 3]]) -> [f64; 3] {
-        let mut e = [0.0; 3];
-        for &(g, c) in &self.terms[self.offsets[i] as usize..self.offsets[i + 1] as usize] {
-            for (e, u) in e.iter_mut().zip(totals[g as usize]) {
-                *e += f64::from(c) * u;
-            }
-        }
-        e
+        weighed(self.terms[self.offsets[i] as usize..self.offsets[i + 1] as usize].iter().map(|&(g, c)| (g, f64::from(c))), totals)
     }
 
     /// The factors kept.
     fn entries(&self) -> usize {
         self.offsets.len() + self.terms.len()
     }
+}
+
+/// `sum_g c_g U_g` over `terms` `(g, c_g)`, of the groups' `totals`:
+/// an irradiance from [`Shaped`] terms.
+fn weighed(terms: impl IntoIterator<Item = (u32, f64)>, totals: &[[f64; 3]]) -> [f64; 3] {
+    let mut e = [0.0; 3];
+    for (g, c) in terms {
+        for (e, u) in e.iter_mut().zip(totals[g as usize]) {
+            *e += c * u;
+        }
+    }
+    e
 }
 
 /// What a shot of one polygon brings, per unit of radiosity shot from
@@ -389,16 +395,17 @@ impl Transfer {
             .filter(|r| r.2 <= MID_TRIANGLE)
             .collect();
         let corners = |q: u32, i: u32| polygons[q as usize].triangles[i as usize];
+        let seen: Vec<[f64; 3]> = reached.iter().map(|r| seen_at_corners(samples, &corners(r.0, r.1), &visible)).collect();
         // The midpoint rule's points, each edge once (two triangles share
         // it), with the visible fraction there where a triangle of the edge
         // is one whose corners see the sender differently.
         let mut edges: Vec<([u32; 2], bool)> = reached
             .iter()
-            .filter(|r| r.2 > NEAR_TRIANGLE)
-            .flat_map(|r| {
-                let t = corners(r.0, r.1);
-                let varies = visibility_varies(&seen_at_corners(samples, &t, &visible));
-                edges_of(&t).map(|e| (e, varies))
+            .zip(&seen)
+            .filter(|(r, _)| r.2 > NEAR_TRIANGLE)
+            .flat_map(|(r, seen)| {
+                let varies = visibility_varies(seen);
+                edges_of(&corners(r.0, r.1)).map(|e| (e, varies))
             })
             .collect();
         edges.sort_unstable();
@@ -421,12 +428,12 @@ impl Transfer {
             .collect();
         let near: Vec<(Terms, u64)> = reached
             .par_iter()
-            .map(|&(q, i, reach)| {
+            .zip(&seen)
+            .map(|(&(q, i, reach), &seen)| {
                 let t = corners(q, i);
                 if reach <= NEAR_TRIANGLE {
-                    return sender.shaped_mean(rays, samples, &t, &visible);
+                    return sender.shaped_mean(rays, samples, &t, seen);
                 }
-                let seen = seen_at_corners(samples, &t, &visible);
                 let varies = visibility_varies(&seen);
                 let parts = edges_of(&t).into_iter().enumerate().map(|(k, e)| {
                     let j = edges.binary_search_by(|probe| probe.0.cmp(&e)).expect("listed");
@@ -604,12 +611,11 @@ impl Sender {
     /// The [`Shaped`] terms of the mean over a receiving triangle `t`
     /// (sample indices) of the irradiance ([`Transfer::of`]), and the rays
     /// cast: at the centroids of its [`NEAR_SUBDIVISION`]² parts, times the
-    /// visible fraction interpolated between its corners
+    /// visible fraction interpolated between its corners' `seen`
     /// ([`seen_at_corners`]), or, where those differ
     /// ([`visibility_varies`]), the fraction at each centroid.
-    fn shaped_mean(&self, rays: &SceneRays, samples: &[Collector], t: &[u32; 3], visible: &[Option<f64>]) -> (Terms, u64) {
+    fn shaped_mean(&self, rays: &SceneRays, samples: &[Collector], t: &[u32; 3], seen: [f64; 3]) -> (Terms, u64) {
         let x = t.map(|v| &samples[v as usize]);
-        let seen = seen_at_corners(samples, t, visible);
         let varies = visibility_varies(&seen);
         let m = NEAR_SUBDIVISION;
         let share = 1.0 / (m * m) as f64;
@@ -693,12 +699,7 @@ impl Sender {
             return ([0.0; 3], [0.0; 3], 0);
         }
         let (visible, cast) = self.visible(rays, position, normal, triangle);
-        let mut unoccluded = [0.0; 3];
-        for (g, c) in terms {
-            for (e, u) in unoccluded.iter_mut().zip(totals[g as usize]) {
-                *e += c * u;
-            }
-        }
+        let unoccluded = weighed(terms, totals);
         (unoccluded.map(|e| visible * e), unoccluded, cast)
     }
 
