@@ -567,7 +567,7 @@ impl Sender {
         let (normal, extent) = (samples[polygon.vertices[0] as usize].normal, (bounds.max - bounds.min).length());
         Sender {
             surface: polygon.surface,
-            groups: Groups::new(&triangles, &polygon.triangles, &areas, normal),
+            groups: Groups::new(&triangles, &polygon.triangles, &areas, normal, samples),
             triangles,
             normal,
             // Off the plane to the front, by more than f32 rounding of
@@ -786,9 +786,10 @@ enum Content {
 }
 
 impl Groups {
-    /// The groups of `triangles` (their corners, and the same as sample
-    /// indices, `corners`) of `areas`, on a plane of unit normal `normal`.
-    fn new(triangles: &[[DVec3; 3]], corners: &[[u32; 3]], areas: &[f64], normal: DVec3) -> Self {
+    /// The groups of `triangles` (their corners, and the same as indices
+    /// of `samples`, `corners`) of `areas`, on a plane of unit normal
+    /// `normal`.
+    fn new(triangles: &[[DVec3; 3]], corners: &[[u32; 3]], areas: &[f64], normal: DVec3, samples: &[Collector]) -> Self {
         let mut groups = Groups { groups: Vec::with_capacity(2 * triangles.len()), order: Vec::new() };
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
         if !order.is_empty() {
@@ -798,13 +799,7 @@ impl Groups {
                 .zip(corners)
                 .map(|(c, &k)| if (c[1] - c[0]).cross(c[2] - c[0]).dot(normal) < 0.0 { [k[0], k[2], k[1]] } else { k })
                 .collect();
-            let mut positions = std::collections::HashMap::new();
-            for (c, k) in triangles.iter().zip(corners) {
-                for i in 0..3 {
-                    positions.entry(k[i]).or_insert(c[i]);
-                }
-            }
-            groups.split(&mut order, 0, triangles, &wound, areas, &positions);
+            groups.split(&mut order, 0, triangles, &wound, areas, samples);
         }
         groups.order = order;
         groups
@@ -814,7 +809,7 @@ impl Groups {
     /// below it, its halves; its index and its boundary as sample-index
     /// edges.
     #[allow(clippy::too_many_arguments)]
-    fn split(&mut self, members: &mut [u32], first: u32, triangles: &[[DVec3; 3]], wound: &[[u32; 3]], areas: &[f64], positions: &std::collections::HashMap<u32, DVec3>) -> (u32, Vec<[u32; 2]>) {
+    fn split(&mut self, members: &mut [u32], first: u32, triangles: &[[DVec3; 3]], wound: &[[u32; 3]], areas: &[f64], samples: &[Collector]) -> (u32, Vec<[u32; 2]>) {
         let at = self.groups.len() as u32;
         let bounds = Aabb::around(members.iter().flat_map(|&t| triangles[t as usize]));
         let area = members.iter().map(|&t| areas[t as usize]).sum();
@@ -827,8 +822,8 @@ impl Groups {
             members.sort_by(|&a, &b| centroid(a)[axis].total_cmp(&centroid(b)[axis]).then(a.cmp(&b)));
             let half = members.len() / 2;
             let (low, high) = members.split_at_mut(half);
-            let (low, low_edges) = self.split(low, first, triangles, wound, areas, positions);
-            let (high, high_edges) = self.split(high, first + half as u32, triangles, wound, areas, positions);
+            let (low, low_edges) = self.split(low, first, triangles, wound, areas, samples);
+            let (high, high_edges) = self.split(high, first + half as u32, triangles, wound, areas, samples);
             self.groups[at as usize].content = Content::Halves(low, high);
             let reversed = |edges: &[[u32; 2]]| edges.iter().map(|e| [e[1], e[0]]).collect::<std::collections::HashSet<[u32; 2]>>();
             let (in_low, in_high) = (reversed(&low_edges), reversed(&high_edges));
@@ -837,7 +832,7 @@ impl Groups {
             let k = wound[members[0] as usize];
             vec![[k[0], k[1]], [k[1], k[2]], [k[2], k[0]]]
         };
-        self.groups[at as usize].boundary = edges.iter().map(|e| [positions[&e[0]], positions[&e[1]]]).collect();
+        self.groups[at as usize].boundary = edges.iter().map(|e| e.map(|k| samples[k as usize].position)).collect();
         (at, edges)
     }
 
