@@ -535,16 +535,85 @@ fn a_ceiling_over_a_hung_lamp_marks_the_lamps_outline() {
 /// 39% of it was lost (`structured_sample::shooting`).
 #[test]
 fn a_closed_room_shoots_all_the_light_it_reflects() {
-    let dir = scratch("structured_closed_room");
     let (rho, exitance) = (0.9, 10.0);
-    let scene_path = test_support::scenes::closed_box(1.0, rho, exitance).write(&dir);
+    let (_, samples) = closed_room_run("structured_closed_room", &test_support::scenes::closed_box(1.0, rho, exitance));
+    keeps_its_light(&samples, rho, exitance);
+}
+
+/// mesh-prep and structured-sample at its defaults on `scene` in `test`'s
+/// scratch directory: the manifest and the samples.
+fn closed_room_run(test: &str, scene: &test_support::scenes::QuadScene) -> (Manifest, Samples) {
+    let dir = scratch(test);
+    let scene_path = scene.write(&dir);
     let (mesh, manifest, samples, image) = (dir.join("mesh.exr"), dir.join("manifest.ron"), dir.join("samples.exr"), dir.join("image.exr"));
     run_ok("mesh-prep", &[s(&scene_path), "--mesh", s(&mesh), "--manifest", s(&manifest)]);
     run_ok("structured-sample", &["--mesh", s(&mesh), "--manifest", s(&manifest), "-o", s(&samples), "--image", s(&image)]);
-    let emitters = Samples::read(&samples).unwrap().0.emitters;
+    (read_ron::<Manifest>(&manifest).unwrap().value, Samples::read(&samples).unwrap().0)
+}
+
+/// The secondary emitters of `closed_box(1.0, rho, exitance)` (with
+/// anything of reflectance `rho` inside) shot `R = rho Phi / (1 - rho)`
+/// between them, the sum of area times radiosity shot, within 1% in
+/// every channel.
+fn keeps_its_light(samples: &Samples, rho: f64, exitance: f64) {
     let reflected = rho * exitance / 9.0 / (1.0 - rho);
     for c in 0..3 {
-        let shot: f64 = emitters.iter().map(|e| e.area * e.shot[c]).sum();
+        let shot: f64 = samples.emitters.iter().map(|e| e.area * e.shot[c]).sum();
+        eprintln!("channel {c}: {shot:.5} W shot, {:+.3}%", 100.0 * (shot / reflected - 1.0));
         assert!((shot / reflected - 1.0).abs() < 0.01, "channel {c}: {shot} W shot against {reflected} W reflected");
     }
+}
+
+/// A closed room of reflectance 0.5 ([`a_closed_room_shoots_all_the_light_it_reflects`]'s,
+/// darker so that its 600 secondary emitters converge within the default
+/// `max_shots`) with a faceted ball hung in it: a band of a sphere (radius 0.15,
+/// latitudes -60 to 60 degrees, 24 x 6 planar trapezoids a few
+/// centimetres wide, far under the least extent the stage's spacings are
+/// fractions of, `surfaces::SMALLEST_EXTENT`) closed by two flat caps.
+/// Per facet, the secondary emitters must cover the facet (their areas'
+/// sum against the facet's own, from its corners, within 1e-6, the mesh's
+/// f32 positions; 7e-8 measured): a facet
+/// whose corners lie closer than the spacing along edges kept one or two
+/// of them in the thinning, and its polygons covered none of it (the
+/// ball's polygons covered 36% of its area on McGuire's
+/// `CornellBox-Glossy`). And the room keeps all its light, `rho Phi / (1
+/// - rho)` shot in all, within 1%.
+#[test]
+fn the_facets_of_a_ball_send_from_all_their_area() {
+    use glam::DVec3;
+    use test_support::scenes::closed_box;
+    let (rho, exitance) = (0.5, 10.0);
+    let mut scene = closed_box(1.0, rho, exitance);
+    let (centre, radius, around) = (DVec3::new(0.5, 0.5, 0.45), 0.15, 24);
+    let latitudes: Vec<f64> = (0..=6).map(|k| (-60.0 + 20.0 * k as f64).to_radians()).collect();
+    let at = |latitude: f64, k: usize| {
+        let longitude = 2.0 * PI * k as f64 / around as f64;
+        centre + radius * DVec3::new(latitude.cos() * longitude.cos(), latitude.cos() * longitude.sin(), latitude.sin())
+    };
+    // Each facet's outward normal and area (two triangles of its corners).
+    let mut facets: Vec<(DVec3, f64)> = Vec::new();
+    for band in latitudes.windows(2) {
+        for k in 0..around {
+            let corners = [at(band[0], k), at(band[0], k + 1), at(band[1], k + 1), at(band[1], k)];
+            let halves = [(corners[1] - corners[0]).cross(corners[2] - corners[0]), (corners[2] - corners[0]).cross(corners[3] - corners[0])];
+            facets.push((halves[0].normalize(), 0.5 * (halves[0].length() + halves[1].length())));
+            scene.quad("ball", "wall", corners.map(|c| c.to_array()), (corners.iter().sum::<DVec3>() / 4.0 - centre).to_array());
+        }
+    }
+    for (latitude, normal) in [(latitudes[0], [0.0, 0.0, -1.0]), (latitudes[6], [0.0, 0.0, 1.0])] {
+        for k in (0..around).step_by(2) {
+            let corners = [DVec3::new(centre.x, centre.y, at(latitude, k).z), at(latitude, k), at(latitude, k + 1), at(latitude, k + 2)];
+            scene.quad("cap", "wall", corners.map(|c| c.to_array()), normal);
+        }
+    }
+    let (manifest, samples) = closed_room_run("structured_faceted_ball", &scene);
+    let mut checked = 0;
+    for (index, surface) in samples.surfaces.iter().enumerate().filter(|(_, x)| manifest.objects[x.object as usize] == "ball") {
+        let (_, area) = facets.iter().find(|(n, _)| n.distance(DVec3::from(surface.normal)) < 1e-6).expect("a surface of the ball with no facet's normal");
+        let covered: f64 = samples.emitters.iter().filter(|e| e.surface == index as u32).map(|e| e.area).sum();
+        assert!((covered / area - 1.0).abs() < 1e-6, "a facet of {area:.9} m² with secondary emitters over {covered:.9} m² ({:.2e})", covered / area - 1.0);
+        checked += 1;
+    }
+    assert_eq!(checked, facets.len(), "surfaces of the ball");
+    keeps_its_light(&samples, rho, exitance);
 }

@@ -63,7 +63,7 @@ pub mod surfaces;
 use direct::{DirectLight, PrimaryEmitter};
 use display::{DisplayGrid, FilterSample};
 use glam::{DVec2, DVec3};
-use placement::{isolux_levels, light_candidates, Candidate, Thinning};
+use placement::{bands, isolux_levels, light_candidates, Candidate, Thinning};
 use probes::ProbeGrid;
 use radiometry::bounds::Aabb;
 use radiometry::color::luminance;
@@ -77,9 +77,10 @@ use std::f64::consts::PI;
 
 stage_kit::knobs! {
     /// The stage's parameters. Spacings and radii are fractions of each
-    /// surface's extent (the longer side of its bounding rectangle).
+    /// surface's extent (the longer side of its bounding rectangle, at
+    /// least [`surfaces::SMALLEST_EXTENT`] of the scene's size).
     pub struct Params {
-        /// Probe grid cells along a surface's longer side.
+        /// Probe grid cells along a surface's extent.
         probe_resolution: usize = 96, "cells", value(4..=4096);
         /// Isolux bands per surface (`levels - 1` contours).
         levels: usize = 8, "bands", value(1..=256);
@@ -116,7 +117,7 @@ stage_kit::knobs! {
         max_shots: usize = 10_000, "shots", value;
         /// Reflections off secondary emitters (0: all, until `threshold`).
         bounces: u32 = 0, "", value;
-        /// Display grid cells along a surface's longer side.
+        /// Display grid cells along a surface's extent.
         display_resolution: usize = 64, "cells", value(1..=4096);
         /// The display filter of the indirect light: `conical` (paper
         /// 002's cone), `conical-linear` or `conical-quadratic` (the cone
@@ -299,7 +300,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         let uv: Vec<DVec2> = members.iter().map(|&i| placed[i as usize].1.uv).collect();
         let min_area = params.emitter_min_area * surface.area;
         let cells = (surface.extent() / (params.emitter_cell * diagonal)).ceil().clamp(1.0, 256.0) as usize;
-        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, params.levels), min_area, cells, &|i| collectors[i as usize].buried));
+        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, bands(surface, params.levels)), min_area, cells, &|i| collectors[i as usize].buried));
     };
     for s in (0..surfaces.len()).filter(|&s| reflecting[s] && !by_reflection[s]) {
         cut(s, &placed, &collectors, &grids[s], &mut polygons);
@@ -524,7 +525,7 @@ fn gather(senders: &[shooting::Sender], totals: &[Vec<[f64; 3]>], rays: &SceneRa
 }
 
 /// Probes of the reflected light on `surface` with `resolution` cells
-/// along its longer side, by `light(point, mesh triangle) -> (irradiance,
+/// along its extent, by `light(point, mesh triangle) -> (irradiance,
 /// the same unoccluded, rays cast)`; each probe's visibility 0 where it is
 /// [`SHADOWED`], else 1.
 fn indirect_probes(surface: &surfaces::Surface, resolution: usize, light: impl Fn(DVec3, u32) -> ([f64; 3], [f64; 3], u64) + Sync) -> ProbeGrid {

@@ -64,6 +64,18 @@ pub fn isolux_levels(grid: &ProbeGrid, levels: usize) -> Vec<f64> {
     (1..levels).map(|k| lo + (hi - lo) * k as f64 / levels as f64).collect()
 }
 
+/// The isolux bands of `surface`: `levels` across a surface whose longer
+/// side is at least its [`Surface::extent`], fewer (at least one) in
+/// proportion on a smaller one, as its spacings are in proportion to that
+/// extent. The light on a small facet varies over the room's scale, so
+/// it shows a small part of the range the room's surfaces show; `levels`
+/// bands across each of a sphere's thousand facets cut its light into a
+/// hundred bands from pole to pole and made five secondary emitters of
+/// every facet.
+pub fn bands(surface: &Surface, levels: usize) -> usize {
+    ((levels as f64 * surface.longer_side() / surface.extent()).round() as usize).max(1)
+}
+
 /// The illumination-driven candidates of one surface (all but the screen
 /// ones).
 pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &ProbeGrid, params: &Params) -> Vec<Candidate> {
@@ -73,10 +85,13 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
     let candidate = |uv, reason, spacing| Candidate { uv, reason, level: NO_LEVEL, spacing, priority: 0.0 };
     let mut out = Vec::new();
     let s_edge = params.lattice_spacing * extent;
+    let corners = corner_spacings(boundary, s_edge);
     for edge in boundary {
         let pieces = ((edge[1] - edge[0]).length() / s_edge).ceil().max(1.0) as usize;
         for k in 0..=pieces {
-            out.push(candidate(edge[0].lerp(edge[1], k as f64 / pieces as f64), Reason::SurfaceEdge, s_edge));
+            let uv = edge[0].lerp(edge[1], k as f64 / pieces as f64);
+            let spacing = if k == 0 || k == pieces { corners.get(&key(uv)).copied().unwrap_or(s_edge) } else { s_edge };
+            out.push(candidate(uv, Reason::SurfaceEdge, spacing));
         }
     }
     for j in 0..grid.nv {
@@ -86,7 +101,7 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
             }
         }
     }
-    let levels = isolux_levels(grid, params.levels);
+    let levels = isolux_levels(grid, bands(surface, params.levels));
     let g_mean = grid.mean_gradient();
     let mut contour = Vec::new();
     for j in 0..grid.nv {
@@ -136,6 +151,56 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
     out
 }
 
+/// Two kept samples lie at least this fraction of the lesser of their
+/// spacings apart (see the module documentation).
+const APART: f64 = 0.7;
+
+/// The exact position of an edge's end, for matching ends.
+fn key(uv: DVec2) -> [u64; 2] {
+    [uv.x.to_bits(), uv.y.to_bits()]
+}
+
+/// The spacing of each corner of a surface's `boundary` (an end where it
+/// turns, or where other than two of its edges meet): `s_edge`, or the
+/// distance to the nearest other corner where thinning would drop one of
+/// them at `s_edge` (nearer than [`APART`] of it), so that it keeps every
+/// corner. The secondary emitters are triangles between samples and
+/// cover what the corners span: a corner thinned away leaves part of its
+/// surface sending and receiving nothing (a small facet whose corners lie
+/// closer than `APART s_edge` kept one or two, and its polygons covered
+/// none of it).
+fn corner_spacings(boundary: &[[DVec2; 2]], s_edge: f64) -> HashMap<[u64; 2], f64> {
+    let mut directions: HashMap<[u64; 2], (DVec2, Vec<DVec2>)> = HashMap::new();
+    for edge in boundary {
+        let along = (edge[1] - edge[0]).normalize_or_zero();
+        directions.entry(key(edge[0])).or_insert((edge[0], Vec::new())).1.push(along);
+        directions.entry(key(edge[1])).or_insert((edge[1], Vec::new())).1.push(-along);
+    }
+    let corners: Vec<([u64; 2], DVec2)> = directions
+        .into_iter()
+        .filter(|(_, (_, d))| d.len() != 2 || d[0].perp_dot(d[1]).abs() > 1e-9 || d[0].dot(d[1]) > 0.0)
+        .map(|(k, (uv, _))| (k, uv))
+        .collect();
+    let cell = |uv: DVec2| ((uv.x / s_edge).floor() as i64, (uv.y / s_edge).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<DVec2>> = HashMap::new();
+    for &(_, uv) in &corners {
+        grid.entry(cell(uv)).or_default().push(uv);
+    }
+    corners
+        .iter()
+        .map(|&(k, uv)| {
+            let (i, j) = cell(uv);
+            let nearest = (i - 1..=i + 1)
+                .flat_map(|a| (j - 1..=j + 1).map(move |b| (a, b)))
+                .flat_map(|c| grid.get(&c).into_iter().flatten())
+                .filter(|&&q| q != uv)
+                .map(|&q| (q - uv).length())
+                .fold(s_edge, f64::min);
+            (k, if nearest < APART * s_edge { nearest } else { s_edge })
+        })
+        .collect()
+}
+
 /// Kept samples of one surface, with a hash grid for the distance test.
 pub struct Thinning {
     cell: f64,
@@ -156,15 +221,15 @@ impl Thinning {
     /// Keeps `c` unless a kept sample is too close (see the module
     /// documentation); returns whether it was kept.
     pub fn offer(&mut self, c: Candidate) -> bool {
-        // No conflict reaches further than 0.7 of c's own spacing.
-        let span = (0.7 * c.spacing / self.cell).ceil() as i64;
+        // No conflict reaches further than APART of c's own spacing.
+        let span = (APART * c.spacing / self.cell).ceil() as i64;
         let (ci, cj) = self.key(c.uv);
         for di in -span..=span {
             for dj in -span..=span {
                 for &k in self.cells.get(&(ci + di, cj + dj)).into_iter().flatten() {
                     let q = &self.kept[k];
                     let both_contours = c.reason == Reason::IsoluxContour && q.reason == Reason::IsoluxContour && c.level != q.level;
-                    let factor = if both_contours { 0.25 } else { 0.7 };
+                    let factor = if both_contours { 0.25 } else { APART };
                     if (q.uv - c.uv).length() < factor * c.spacing.min(q.spacing) {
                         return false;
                     }
@@ -180,5 +245,45 @@ impl Thinning {
     /// The samples kept, in the order kept.
     pub fn kept(&self) -> &[Candidate] {
         &self.kept
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surfaces::rectangle;
+
+    /// The edges of `corners` in order, the first one split in two at its
+    /// middle (a collinear boundary vertex, not a corner).
+    fn outline(corners: &[DVec2]) -> Vec<[DVec2; 2]> {
+        let middle = corners[0].lerp(corners[1], 0.5);
+        let mut edges = vec![[corners[0], middle], [middle, corners[1]]];
+        edges.extend((1..corners.len()).map(|k| [corners[k], corners[(k + 1) % corners.len()]]));
+        edges
+    }
+
+    /// A 3 x 1 cm facet whose spacings are fractions of a 1 m least extent
+    /// (edge samples 25 cm apart): the thinning keeps its four corners,
+    /// where at 25 cm it kept the first alone. On a 4 x 2 m surface with
+    /// 0.5 m edge spacing every corner keeps that spacing, and the split
+    /// edge's middle is no corner.
+    #[test]
+    fn thinning_keeps_every_corner_of_a_small_surface() {
+        let params = Params::default();
+        let mut facet = rectangle(0.03, 0.01);
+        facet.least_extent = 1.0;
+        let corners = [DVec2::ZERO, DVec2::new(0.03, 0.0), DVec2::new(0.03, 0.01), DVec2::new(0.0, 0.01)];
+        let grid = ProbeGrid::of(&facet, 8, |_, _, _| ([1.0; 3], 1.0, 0));
+        let mut thinning = Thinning::new(params.contour_spacing * facet.extent());
+        for c in light_candidates(&facet, &outline(&corners), &grid, &params) {
+            thinning.offer(c);
+        }
+        for corner in corners {
+            assert!(thinning.kept().iter().any(|c| c.uv == corner), "corner {corner} thinned away");
+        }
+        let large = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(4.0, 2.0), DVec2::new(0.0, 2.0)];
+        let spacings = corner_spacings(&outline(&large), 0.5);
+        assert_eq!(spacings.len(), 4, "corners of the large rectangle");
+        assert!(large.iter().all(|&c| spacings[&key(c)] == 0.5), "{spacings:?}");
     }
 }

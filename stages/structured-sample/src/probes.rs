@@ -53,8 +53,8 @@ pub struct ProbeGrid {
 
 impl ProbeGrid {
     /// Probes `surface`'s direct light with `resolution` cells along its
-    /// longer side; `key` offsets the probes' random streams (one range
-    /// per surface).
+    /// extent ([`Surface::extent`]); `key` offsets the probes' random
+    /// streams (one range per surface).
     pub fn new(surface: &Surface, direct: &DirectLight, resolution: usize, key: u64) -> Self {
         Self::of(surface, resolution, |point, triangle, k| {
             let e = direct.at(point, surface.normal, triangle, key + k);
@@ -62,7 +62,7 @@ impl ProbeGrid {
         })
     }
 
-    /// Probes `surface` with `resolution` cells along its longer side by
+    /// Probes `surface` with `resolution` cells along its extent by
     /// `light(point, triangle, probe index) -> (irradiance RGB, visibility,
     /// rays cast)`.
     pub fn of(surface: &Surface, resolution: usize, light: impl Fn(DVec3, u32, u64) -> ([f64; 3], f64, u64) + Sync) -> Self {

@@ -37,7 +37,23 @@ pub struct Surface {
     pub reflectance: [f64; 3],
     /// Emitted radiosity, W/m², RGB.
     pub emission: [f64; 3],
+    /// The least [`Surface::extent`]: [`SMALLEST_EXTENT`] of the scene's
+    /// size.
+    pub least_extent: f64,
 }
+
+/// The least length the stage's spacings are fractions of, as a fraction
+/// of the scene's size (the longest side of its bounding box). Paper 002
+/// places samples on a few large surfaces; a curved object is hundreds of
+/// small planar facets, and with spacings in fractions of each facet
+/// every facet took a full set (probes, contours, edges at a quarter of
+/// its side): McGuire's `CornellBox-Glossy`, whose sphere has a thousand
+/// facets, had 59,000 samples, 42,000 of them on contours across facets
+/// a few centimetres wide, and took 163 s. The light on a facet varies
+/// with what lights it, whose scale is the room's, not the facet's. An
+/// eighth: every surface of the Cornell boxes keeps its own extent (the
+/// smallest, the lamps, are near a quarter of the room).
+pub const SMALLEST_EXTENT: f64 = 0.125;
 
 impl Surface {
     /// `(u, v)` of a point of the plane.
@@ -51,9 +67,14 @@ impl Surface {
         self.origin + self.axes[0] * uv.x + self.axes[1] * uv.y
     }
 
-    /// The longer side of the bounding rectangle, m: the length the
-    /// stage's spacings are fractions of.
+    /// The longer side of the bounding rectangle, m, but at least
+    /// `least_extent`: the length the stage's spacings are fractions of.
     pub fn extent(&self) -> f64 {
+        self.longer_side().max(self.least_extent)
+    }
+
+    /// The longer side of the bounding rectangle, m.
+    pub fn longer_side(&self) -> f64 {
         let size = self.hi - self.lo;
         size.x.max(size.y)
     }
@@ -133,6 +154,7 @@ pub fn planar_surfaces(mesh: &Mesh, manifest: &Manifest, geometry: &[TriangleGeo
                     area: 0.0,
                     reflectance: material.diffuse,
                     emission: material.emission,
+                    least_extent: SMALLEST_EXTENT * size,
                 });
                 candidates.push(surfaces.len() - 1);
                 surfaces.len() - 1
@@ -170,5 +192,6 @@ pub fn rectangle(width: f64, height: f64) -> Surface {
         area: width * height,
         reflectance: [0.5; 3],
         emission: [0.0; 3],
+        least_extent: 0.0,
     }
 }
