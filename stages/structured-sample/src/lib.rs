@@ -77,8 +77,8 @@ use std::f64::consts::PI;
 
 stage_kit::knobs! {
     /// The stage's parameters. Spacings and radii are fractions of each
-    /// surface's extent (the longer side of its bounding rectangle, at
-    /// least [`surfaces::SMALLEST_EXTENT`] of the scene's size).
+    /// surface's extent (the longer side of its bounding rectangle, or of
+    /// the curved surface it is a facet of: [`surfaces::Surface::extent`]).
     pub struct Params {
         /// Probe grid cells along a surface's extent.
         probe_resolution: usize = 96, "cells", value(4..=4096);

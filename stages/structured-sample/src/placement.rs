@@ -64,14 +64,13 @@ pub fn isolux_levels(grid: &ProbeGrid, levels: usize) -> Vec<f64> {
     (1..levels).map(|k| lo + (hi - lo) * k as f64 / levels as f64).collect()
 }
 
-/// The isolux bands of `surface`: `levels` across a surface whose longer
-/// side is at least its [`Surface::extent`], fewer (at least one) in
-/// proportion on a smaller one, as its spacings are in proportion to that
-/// extent. The light on a small facet varies over the room's scale, so
-/// it shows a small part of the range the room's surfaces show; `levels`
-/// bands across each of a sphere's thousand facets cut its light into a
-/// hundred bands from pole to pole and made five secondary emitters of
-/// every facet.
+/// The isolux bands of `surface`: `levels` across a surface of its own,
+/// fewer (at least one) on a facet of a curved surface, in proportion to
+/// its share of that surface's extent, as its spacings are fractions of
+/// that extent ([`Surface::extent`]): the curved surface has `levels`
+/// bands across it. `levels` bands across each of a sphere's thousand
+/// facets cut its light into a hundred from pole to pole and made five
+/// secondary emitters of every facet.
 pub fn bands(surface: &Surface, levels: usize) -> usize {
     ((levels as f64 * surface.longer_side() / surface.extent()).round() as usize).max(1)
 }
@@ -262,8 +261,8 @@ mod tests {
         edges
     }
 
-    /// A 3 x 1 cm facet whose spacings are fractions of a 1 m least extent
-    /// (edge samples 25 cm apart): the thinning keeps its four corners,
+    /// A 3 x 1 cm facet of a curved surface 1 m wide, whose spacings are
+    /// fractions of that metre (edge samples 25 cm apart): the thinning keeps its four corners,
     /// where at 25 cm it kept the first alone. On a 4 x 2 m surface with
     /// 0.5 m edge spacing every corner keeps that spacing, and the split
     /// edge's middle is no corner.
