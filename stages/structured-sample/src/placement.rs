@@ -262,10 +262,10 @@ mod tests {
     }
 
     /// A 3 x 1 cm facet of a curved surface 1 m wide, whose spacings are
-    /// fractions of that metre (edge samples 25 cm apart): the thinning keeps its four corners,
-    /// where at 25 cm it kept the first alone. On a 4 x 2 m surface with
-    /// 0.5 m edge spacing every corner keeps that spacing, and the split
-    /// edge's middle is no corner.
+    /// fractions of that metre (edge samples 25 cm apart): the thinning
+    /// keeps its four corners, where at 25 cm it kept the first alone. On a
+    /// 4 x 2 m surface with 0.5 m edge spacing every corner keeps that
+    /// spacing, and the split edge's middle is no corner.
     #[test]
     fn thinning_keeps_every_corner_of_a_small_surface() {
         let params = Params::default();
