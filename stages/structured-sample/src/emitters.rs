@@ -10,6 +10,7 @@
 
 use crate::delaunay::triangulate;
 use crate::surfaces::Surface;
+use crate::union_find::{find, union};
 use glam::DVec2;
 use std::collections::HashMap;
 
@@ -31,14 +32,6 @@ pub struct Polygon {
 /// cuts lie at or below it.
 fn band(levels: &[f64], value: f64) -> usize {
     levels.iter().take_while(|&&t| t <= value).count()
-}
-
-fn find(parent: &mut [usize], mut i: usize) -> usize {
-    while parent[i] != i {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    i
 }
 
 /// The isolux polygons of one surface, `surface_index`, from its
@@ -131,11 +124,6 @@ pub fn isolux_polygons(surface_index: u32, surface: &Surface, indices: &[u32], u
         p.vertices.dedup();
     }
     polygons
-}
-
-fn union(parent: &mut [usize], i: usize, j: usize) {
-    let (ri, rj) = (find(parent, i), find(parent, j));
-    parent[ri.max(rj)] = ri.min(rj);
 }
 
 /// Merges every region (union-find `parent` over triangles of `areas`)

@@ -5,6 +5,7 @@
 //! them for display on a grid over each surface (Section 3.2); a surface
 //! here is what such a grid covers.
 
+use crate::union_find::{find, union};
 use glam::{DVec2, DVec3};
 use radiometry::geometry::{frame_with_normal, TriangleGeometry};
 use schemas::mesh::{Manifest, Mesh};
@@ -196,13 +197,6 @@ pub fn planar_surfaces(mesh: &Mesh, manifest: &Manifest, geometry: &[TriangleGeo
 /// would be.
 fn smooth_patches(mesh: &Mesh, geometry: &[TriangleGeometry], surfaces: &[Surface], surface_of: &[u32]) -> Vec<f64> {
     let mut root: Vec<usize> = (0..surfaces.len()).collect();
-    fn find(root: &mut [usize], mut s: usize) -> usize {
-        while root[s] != s {
-            root[s] = root[root[s]];
-            s = root[s];
-        }
-        s
-    }
     let mut first: HashMap<(u32, u32), usize> = HashMap::new();
     let cos_turn = SMOOTH_TURN_DEG.to_radians().cos();
     for (t, triangle) in mesh.triangles.iter().enumerate() {
@@ -216,15 +210,14 @@ fn smooth_patches(mesh: &Mesh, geometry: &[TriangleGeometry], surfaces: &[Surfac
             let turn = surfaces[other].normal.dot(surfaces[s].normal);
             let smooth = surfaces[other].material == surfaces[s].material && turn > cos_turn && turn <= PARALLEL_COS;
             if smooth {
-                let (x, y) = (find(&mut root, other), find(&mut root, s));
-                root[x.max(y)] = x.min(y);
+                union(&mut root, other, s);
             }
         }
     }
-    let mut bounds: HashMap<usize, (DVec3, DVec3, usize)> = HashMap::new();
+    // Each curved surface's bounding box and facet count, at its root.
+    let mut bounds = vec![(DVec3::INFINITY, DVec3::NEG_INFINITY, 0); surfaces.len()];
     for (s, surface) in surfaces.iter().enumerate() {
-        let r = find(&mut root, s);
-        let entry = bounds.entry(r).or_insert((DVec3::INFINITY, DVec3::NEG_INFINITY, 0));
+        let entry = &mut bounds[find(&mut root, s)];
         entry.2 += 1;
         for &t in &surface.triangles {
             for c in geometry[t as usize].corners {
@@ -235,7 +228,7 @@ fn smooth_patches(mesh: &Mesh, geometry: &[TriangleGeometry], surfaces: &[Surfac
     }
     (0..surfaces.len())
         .map(|s| {
-            let (lo, hi, count) = bounds[&find(&mut root, s)];
+            let (lo, hi, count) = bounds[find(&mut root, s)];
             if count > 1 { (hi - lo).max_element() } else { 0.0 }
         })
         .collect()
