@@ -59,11 +59,12 @@ pub mod render;
 pub mod report;
 pub mod shooting;
 pub mod surfaces;
+mod union_find;
 
 use direct::{DirectLight, PrimaryEmitter};
 use display::{DisplayGrid, FilterSample};
 use glam::{DVec2, DVec3};
-use placement::{bands, isolux_levels, light_candidates, Candidate, Thinning};
+use placement::{contour_levels, isolux_levels, light_candidates, Candidate, Thinning};
 use probes::ProbeGrid;
 use radiometry::bounds::Aabb;
 use radiometry::color::luminance;
@@ -294,16 +295,16 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     let reflecting: Vec<bool> = surfaces.iter().map(|s| luminance(s.reflectance) > 0.0).collect();
     let by_reflection: Vec<bool> = (0..surfaces.len()).map(|s| reflecting[s] && isolux_levels(&grids[s], params.levels).is_empty()).collect();
     let mut polygons = Vec::new();
-    let cut = |s: usize, placed: &[(u32, Candidate)], collectors: &[Collector], grid: &ProbeGrid, polygons: &mut Vec<emitters::Polygon>| {
-        let surface = &surfaces[s];
+    let cut = |s: usize, placed: &[(u32, Candidate)], collectors: &[Collector], polygons: &mut Vec<emitters::Polygon>| {
+        let (surface, grid) = (&surfaces[s], &grids[s]);
         let members: Vec<u32> = (0..placed.len() as u32).filter(|&i| placed[i as usize].0 == s as u32 && placed[i as usize].1.reason != Reason::ScreenDensity).collect();
         let uv: Vec<DVec2> = members.iter().map(|&i| placed[i as usize].1.uv).collect();
         let min_area = params.emitter_min_area * surface.area;
         let cells = (surface.extent() / (params.emitter_cell * diagonal)).ceil().clamp(1.0, 256.0) as usize;
-        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &isolux_levels(grid, bands(surface, params.levels)), min_area, cells, &|i| collectors[i as usize].buried));
+        polygons.extend(emitters::isolux_polygons(s as u32, surface, &members, &uv, |p| grid.illuminance_at(p), &contour_levels(surface, grid, params.levels), min_area, cells, &|i| collectors[i as usize].buried));
     };
     for s in (0..surfaces.len()).filter(|&s| reflecting[s] && !by_reflection[s]) {
-        cut(s, &placed, &collectors, &grids[s], &mut polygons);
+        cut(s, &placed, &collectors, &mut polygons);
     }
     // The direct light at each polygon triangle's centroid, for the power
     // each polygon shoots first (shooting::direct_emission), `key` the
@@ -330,7 +331,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         let totals: Vec<Vec<[f64; 3]>> = senders.iter().zip(&emission).map(|(sender, u)| sender.totals(u)).collect();
         let before = placed.len();
         for s in (0..surfaces.len()).filter(|&s| by_reflection[s]) {
-            let grid = indirect_probes(&surfaces[s], params.probe_resolution / OUTLINE_COARSENING, |point, triangle| gather(&senders, &totals, &rays, point, surfaces[s].normal, s as u32, triangle));
+            let grid = indirect_probes(&surfaces[s], s as u32, params.probe_resolution / OUTLINE_COARSENING, &senders, &totals, &rays);
             work.indirect_rays += grid.rays;
             let offered = thinnings[s].kept().len();
             for c in light_candidates(&surfaces[s], &[], &grid, params).into_iter().filter(|c| matches!(c.reason, Reason::Penumbra | Reason::Umbra)) {
@@ -347,7 +348,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
     }
     let lit = polygons.len();
     for s in (0..surfaces.len()).filter(|&s| by_reflection[s]) {
-        cut(s, &placed, &collectors, &grids[s], &mut polygons);
+        cut(s, &placed, &collectors, &mut polygons);
     }
     let lit_triangles: usize = polygons[..lit].iter().map(|p| p.triangles.len()).sum();
     let (rest, centroid_rays) = direct_first(&polygons[lit..], &placed, &collectors, (1u64 << 60) + lit_triangles as u64);
@@ -390,7 +391,7 @@ pub fn structured(mesh: &Mesh, manifest: &Manifest, params: &Params, progress: &
         if !by_reflection[s] || senders.is_empty() {
             continue;
         }
-        let grid = indirect_grids[s].insert(indirect_probes(surface, params.probe_resolution / 4, |point, triangle| gather(&senders, &totals, &rays, point, surface.normal, s as u32, triangle)));
+        let grid = indirect_grids[s].insert(indirect_probes(surface, s as u32, params.probe_resolution / 4, &senders, &totals, &rays));
         work.indirect_rays += grid.rays;
         let before = thinnings[s].kept().len();
         for c in light_candidates(surface, &[], grid, params).into_iter().filter(|c| matches!(c.reason, Reason::IsoluxContour | Reason::Penumbra | Reason::Umbra)) {
@@ -524,13 +525,13 @@ fn gather(senders: &[shooting::Sender], totals: &[Vec<[f64; 3]>], rays: &SceneRa
     (e, unoccluded, rays_cast)
 }
 
-/// Probes of the reflected light on `surface` with `resolution` cells
-/// along its extent, by `light(point, mesh triangle) -> (irradiance,
-/// the same unoccluded, rays cast)`; each probe's visibility 0 where it is
+/// Probes of the reflected light on `surface` (number `s`) with
+/// `resolution` cells along its extent, each gathering what `senders`
+/// bring ([`gather`]); each probe's visibility 0 where it is
 /// [`SHADOWED`], else 1.
-fn indirect_probes(surface: &surfaces::Surface, resolution: usize, light: impl Fn(DVec3, u32) -> ([f64; 3], [f64; 3], u64) + Sync) -> ProbeGrid {
+fn indirect_probes(surface: &surfaces::Surface, s: u32, resolution: usize, senders: &[shooting::Sender], totals: &[Vec<[f64; 3]>], rays: &SceneRays) -> ProbeGrid {
     ProbeGrid::of(surface, resolution.max(8), |point, triangle, _| {
-        let (e, unoccluded, rays_cast) = light(point, triangle);
+        let (e, unoccluded, rays_cast) = gather(senders, totals, rays, point, surface.normal, s, triangle);
         (e, if luminance(e) < SHADOWED * luminance(unoccluded) { 0.0 } else { 1.0 }, rays_cast)
     })
 }

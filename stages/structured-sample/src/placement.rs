@@ -71,8 +71,14 @@ pub fn isolux_levels(grid: &ProbeGrid, levels: usize) -> Vec<f64> {
 /// bands across it. `levels` bands across each of a sphere's thousand
 /// facets cut its light into a hundred from pole to pole and made five
 /// secondary emitters of every facet.
-pub fn bands(surface: &Surface, levels: usize) -> usize {
+fn bands(surface: &Surface, levels: usize) -> usize {
     ((levels as f64 * surface.longer_side() / surface.extent()).round() as usize).max(1)
+}
+
+/// The isolux cuts of `surface` whose probes are `grid`: `levels` bands
+/// of its own, or its share of a curved surface's ([`bands`]).
+pub fn contour_levels(surface: &Surface, grid: &ProbeGrid, levels: usize) -> Vec<f64> {
+    isolux_levels(grid, bands(surface, levels))
 }
 
 /// The illumination-driven candidates of one surface (all but the screen
@@ -100,7 +106,7 @@ pub fn light_candidates(surface: &Surface, boundary: &[[DVec2; 2]], grid: &Probe
             }
         }
     }
-    let levels = isolux_levels(grid, bands(surface, params.levels));
+    let levels = contour_levels(surface, grid, params.levels);
     let g_mean = grid.mean_gradient();
     let mut contour = Vec::new();
     for j in 0..grid.nv {

@@ -584,11 +584,7 @@ impl Sender {
     /// [`Self::off_plane`]): Lambert's factor of the whole sender, and the
     /// unoccluded [`Shaped`] terms (none where the factor is 0).
     fn shape(&self, position: DVec3, normal: DVec3) -> (f64, Terms) {
-        let (factor, terms) = self.groups.cut(position, normal, &self.triangles, self.normal);
-        if factor <= 0.0 {
-            return (0.0, Vec::new());
-        }
-        (factor, terms)
+        self.groups.cut(position, normal, &self.triangles, self.normal)
     }
 
     /// At sample `x`: its visible fraction (none where the sender sends it
