@@ -541,6 +541,24 @@ pub const ON_PLANE: f64 = 1e-6;
 /// 3.3% short where it is 1.9% short without them.
 pub const RAY_END_MARGIN: f64 = 1e-4;
 
+/// How far a receiving point must lie from a sender, in the sender's
+/// extents (its bounding box's diagonal) from the box's centre, to see
+/// it through one ray, from its casting point nearest that centre
+/// ([`Sender::visible`]), rather than one from each casting point. From
+/// there the casting points' rays part by under a sixteenth of a radian
+/// (3.6 degrees): they meet the same occluders, but where one stands
+/// right at the sender. Each secondary emitter casts rays to every
+/// sample, so a scene of many small surfaces casts their product: the
+/// leaves of `plants-2k` (10,567 secondary emitters, 104,358 samples)
+/// cast 3.0G rays in 18.4 minutes, now 1.86G in 13.7 (the image within
+/// 0.011% rms of the one before). No pair of the built-in Cornell box or of McGuire's
+/// `Original` is that far (their images the same to the bit); `Glossy`'s
+/// sphere, whose facets are small senders, cast 13% fewer shooting rays
+/// and 23% fewer placing samples, its image against Mitsuba the same
+/// (relative RMSE 1.4909% both). At 8 extents the Cornell box's image
+/// moved (relative RMSE 1.0215% -> 1.0213%) for 0.5% fewer rays.
+pub const FAR_SENDER: f64 = 16.0;
+
 /// A polygon as a sender: its triangles' corners, its normal, and the
 /// points that cast its occlusion rays ([`casting_points`]), each with a
 /// mesh triangle its ray leaves.
@@ -555,6 +573,9 @@ pub struct Sender {
     bounds: Aabb,
     /// The length of the box's diagonal: what [`ON_PLANE`] is a fraction of.
     extent: f64,
+    /// The casting point nearest the bounding box's centre: the one a far
+    /// receiving point's ray leaves from ([`FAR_SENDER`]).
+    central: usize,
 }
 
 impl Sender {
@@ -565,7 +586,8 @@ impl Sender {
         let (triangles, areas): (Vec<[DVec3; 3]>, Vec<f64>) = polygon.triangles.iter().map(|t| triangle(samples, t)).unzip();
         let bounds = Aabb::around(triangles.iter().flatten().copied());
         let (normal, extent) = (samples[polygon.vertices[0] as usize].normal, (bounds.max - bounds.min).length());
-        Sender {
+        let mut sender = Sender {
+            central: 0,
             surface: polygon.surface,
             groups: Groups::new(&triangles, &polygon.triangles, &areas, normal, samples),
             triangles,
@@ -577,7 +599,14 @@ impl Sender {
             casting: casting_points(polygon, samples, polygon.vertices.len().min(occlusion_points.max(1))).into_iter().map(|c| CastingPoint { position: c.position + normal * (ON_PLANE * extent), ..c }).collect(),
             bounds,
             extent,
-        }
+        };
+        sender.central = sender.casting.iter().enumerate().min_by(|a, b| a.1.position.distance(sender.centre()).total_cmp(&b.1.position.distance(sender.centre()))).map_or(0, |c| c.0);
+        sender
+    }
+
+    /// Its bounding box's centre.
+    fn centre(&self) -> DVec3 {
+        (self.bounds.min + self.bounds.max) * 0.5
     }
 
     /// At `position` (unit `normal`, already off the sender's plane,
@@ -711,7 +740,8 @@ impl Sender {
     /// kernel `cos_x cos_p / r²` there, which is what Lambert's factor
     /// integrates, and by the sender's radiosity there
     /// ([`casting_points`]; where no casting point has kernel weight, by
-    /// the radiosity alone).
+    /// the radiosity alone). From farther than [`FAR_SENDER`] extents, one
+    /// ray from the central casting point: the fraction is 1 or 0.
     ///
     /// A sender that straddles the receiver's plane (the lamp and the
     /// walls that light a block's face) has casting points behind that
@@ -731,6 +761,12 @@ impl Sender {
             if r2 > 0.0 { d.dot(normal).max(0.0) * (-d.dot(self.normal)).max(0.0) / (r2 * r2) } else { 0.0 }
         };
         let clear = |c: &CastingPoint| rays.segment_clear(c.position, position + (c.position - position) * RAY_END_MARGIN, [c.triangle, triangle]);
+        if self.extent * FAR_SENDER < self.centre().distance(position) {
+            let central = &self.casting[self.central];
+            if kernel(central.position) > 0.0 {
+                return (if clear(central) { 1.0 } else { 0.0 }, 1);
+            }
+        }
         let (mut seen, mut total, mut cast) = (0.0, 0.0, 0);
         for point in &self.casting {
             let w = kernel(point.position) * point.weight;
@@ -1109,6 +1145,39 @@ mod tests {
         let front = [[1.0, -1.0, 2.0], [1.0, 2.0, 2.0], [3.0, 2.0, 2.0], [3.0, -1.0, 2.0]];
         let lambert = lambert_polygon(point.to_array(), normal.to_array(), &front).abs();
         assert!((seen / lambert - 1.0).abs() < 0.01, "F V {seen} against Lambert's {lambert} for the front half");
+    }
+
+    /// A 20 cm square sender facing down at height `h` over a receiving
+    /// point at the origin, a 2 cm square occluder half a metre over the
+    /// point where `occluded`: the light the point receives and the rays
+    /// it cast. The sender's extent is its diagonal, 0.283 m, so it lies
+    /// farther than [`FAR_SENDER`] extents from the point above 4.53 m.
+    fn over_a_point(h: f64, occluded: bool) -> (f64, u64) {
+        let square = |half: f64, z: f64| [dvec3(-half, -half, z), dvec3(-half, half, z), dvec3(half, half, z), dvec3(half, -half, z)];
+        let [a, b, c, d] = square(0.01, 0.5);
+        let rays = if occluded { SceneRays::new(&[[a, b, c], [a, c, d]]) } else { open_scene() };
+        let mut samples = Vec::new();
+        let sender = Sender::new(&rectangle(&mut samples, 7, square(0.1, h), -DVec3::Z), &samples, 16);
+        let (seen, _, cast) = sender.irradiance(&rays, DVec3::ZERO, DVec3::Z, 0, 9, &sender.totals(&[[1.0; 3]; 2]));
+        (seen[0], cast)
+    }
+
+    /// From farther than [`FAR_SENDER`] extents a sender is seen through
+    /// one ray, from its casting point nearest its centre: a small
+    /// occluder on the axis hides it all, and with none it is seen whole
+    /// (`F` is Lambert's factor of the square); nearer, each of its four
+    /// casting points casts, and the occluder hides one of them (`V`
+    /// 3/4, the kernel nearly alike at the four).
+    #[test]
+    fn a_far_sender_is_seen_through_one_ray() {
+        let lambert = |h: f64| lambert_polygon([0.0; 3], [0.0, 0.0, 1.0], &[[-0.1, -0.1, h], [-0.1, 0.1, h], [0.1, 0.1, h], [0.1, -0.1, h]]).abs();
+        for (h, rays) in [(4.4, 4), (4.7, 1)] {
+            let (open, cast) = over_a_point(h, false);
+            assert!((open / lambert(h) - 1.0).abs() < 1e-9 && cast == rays, "h {h}: F V {open} against Lambert's {}, {cast} rays", lambert(h));
+        }
+        assert_eq!(over_a_point(4.7, true), (0.0, 1));
+        let (near, cast) = over_a_point(4.4, true);
+        assert!((near / lambert(4.4) - 0.75).abs() < 1e-3 && cast == 4, "F V {near} against Lambert's {}, {cast} rays", lambert(4.4));
     }
 
     /// Rays through a scene with nothing in the way: one triangle far off.
