@@ -17,6 +17,11 @@ impl Aabb {
         points.into_iter().fold(Aabb { min: DVec3::INFINITY, max: DVec3::NEG_INFINITY }, |b, p| Aabb { min: b.min.min(p), max: b.max.max(p) })
     }
 
+    /// Its centre, halfway between its corners.
+    pub fn centre(&self) -> DVec3 {
+        0.5 * (self.min + self.max)
+    }
+
     /// Whether the two boxes share a point.
     pub fn overlaps(&self, other: &Aabb) -> bool {
         self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
@@ -38,6 +43,7 @@ mod tests {
         let b = Aabb::around([dvec3(1.0, -2.0, 0.5), dvec3(-1.0, 3.0, 0.0), dvec3(0.0, 0.0, 2.0)]);
         assert_eq!((b.min, b.max), (dvec3(-1.0, -2.0, 0.0), dvec3(1.0, 3.0, 2.0)));
         assert!(b.contains(dvec3(1.0, 3.0, 2.0)) && !b.contains(dvec3(1.0 + 1e-12, 0.0, 1.0)));
+        assert_eq!(b.centre(), dvec3(0.0, 0.5, 1.0));
         let touching = Aabb { min: dvec3(1.0, 3.0, 2.0), max: dvec3(5.0, 5.0, 5.0) };
         let apart = Aabb { min: dvec3(1.0, 3.0, 2.0 + 1e-9), max: dvec3(5.0, 5.0, 5.0) };
         assert!(b.overlaps(&touching) && touching.overlaps(&b));

@@ -253,7 +253,7 @@ impl<'a> Senders<'a> {
     pub fn centre(&self, node: Node) -> DVec3 {
         match node {
             Node::Element(e) => self.element_corners(e).iter().sum::<DVec3>() / 3.0,
-            Node::Cluster(c) => self.cluster_box(c).map_or(DVec3::ZERO, |b| 0.5 * (b.min + b.max)),
+            Node::Cluster(c) => self.cluster_box(c).map_or(DVec3::ZERO, |b| b.centre()),
         }
     }
 

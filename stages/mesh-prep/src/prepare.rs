@@ -351,7 +351,7 @@ struct Built {
 /// triangles. `None` if none is left.
 fn build_mesh(raw: &[RawTriangle], two_sided: &[bool], params: &Params) -> Option<Built> {
     let bounds = Aabb::around(raw.iter().flat_map(|t| t.corners));
-    let origin = 0.5 * (bounds.min + bounds.max);
+    let origin = bounds.centre();
     let diagonal = (bounds.max - bounds.min).length().max(f64::MIN_POSITIVE);
     let cell = params.weld_tolerance * diagonal;
     let mut statistics = MeshStatistics::default();

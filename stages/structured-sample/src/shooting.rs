@@ -586,27 +586,23 @@ impl Sender {
         let (triangles, areas): (Vec<[DVec3; 3]>, Vec<f64>) = polygon.triangles.iter().map(|t| triangle(samples, t)).unzip();
         let bounds = Aabb::around(triangles.iter().flatten().copied());
         let (normal, extent) = (samples[polygon.vertices[0] as usize].normal, (bounds.max - bounds.min).length());
-        let mut sender = Sender {
-            central: 0,
+        // Off the plane to the front, by more than f32 rounding of the
+        // ray's origin: a ray along the plane (to a sample at its edge,
+        // [`Self::off_plane`]) whose origin rounds behind it would cross
+        // the surface's own triangles.
+        let casting: Vec<CastingPoint> = casting_points(polygon, samples, polygon.vertices.len().min(occlusion_points.max(1))).into_iter().map(|c| CastingPoint { position: c.position + normal * (ON_PLANE * extent), ..c }).collect();
+        let centre = bounds.centre();
+        let central = casting.iter().enumerate().min_by(|a, b| a.1.position.distance(centre).total_cmp(&b.1.position.distance(centre))).map_or(0, |c| c.0);
+        Sender {
             surface: polygon.surface,
             groups: Groups::new(&triangles, &polygon.triangles, &areas, normal, samples),
             triangles,
             normal,
-            // Off the plane to the front, by more than f32 rounding of
-            // the ray's origin: a ray along the plane (to a sample at its
-            // edge, [`Self::off_plane`]) whose origin rounds behind it
-            // would cross the surface's own triangles.
-            casting: casting_points(polygon, samples, polygon.vertices.len().min(occlusion_points.max(1))).into_iter().map(|c| CastingPoint { position: c.position + normal * (ON_PLANE * extent), ..c }).collect(),
+            casting,
+            central,
             bounds,
             extent,
-        };
-        sender.central = sender.casting.iter().enumerate().min_by(|a, b| a.1.position.distance(sender.centre()).total_cmp(&b.1.position.distance(sender.centre()))).map_or(0, |c| c.0);
-        sender
-    }
-
-    /// Its bounding box's centre.
-    fn centre(&self) -> DVec3 {
-        (self.bounds.min + self.bounds.max) * 0.5
+        }
     }
 
     /// At `position` (unit `normal`, already off the sender's plane,
@@ -761,7 +757,7 @@ impl Sender {
             if r2 > 0.0 { d.dot(normal).max(0.0) * (-d.dot(self.normal)).max(0.0) / (r2 * r2) } else { 0.0 }
         };
         let clear = |c: &CastingPoint| rays.segment_clear(c.position, position + (c.position - position) * RAY_END_MARGIN, [c.triangle, triangle]);
-        if self.extent * FAR_SENDER < self.centre().distance(position) {
+        if self.extent * FAR_SENDER < self.bounds.centre().distance(position) {
             let central = &self.casting[self.central];
             if kernel(central.position) > 0.0 {
                 return (if clear(central) { 1.0 } else { 0.0 }, 1);
