@@ -27,6 +27,13 @@ impl Aabb {
         self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
     }
 
+    /// Whether the whole box lies strictly on the side of the plane through
+    /// `point` that `normal` points to: its lowest corner along `normal`,
+    /// `(centre - point) . normal - half . |normal|`, above the plane.
+    pub fn above(&self, point: DVec3, normal: DVec3) -> bool {
+        (self.centre() - point).dot(normal) > (0.5 * (self.max - self.min)).dot(normal.abs())
+    }
+
     /// Whether `p` is inside (the faces included).
     pub fn contains(&self, p: DVec3) -> bool {
         self.min.cmple(p).all() && p.cmple(self.max).all()
@@ -48,6 +55,12 @@ mod tests {
         let apart = Aabb { min: dvec3(1.0, 3.0, 2.0 + 1e-9), max: dvec3(5.0, 5.0, 5.0) };
         assert!(b.overlaps(&touching) && touching.overlaps(&b));
         assert!(!b.overlaps(&apart) && !apart.overlaps(&b));
+        // Above a plane: every corner, not only the centre.
+        let n = dvec3(1.0, 1.0, 0.0).normalize();
+        let corner = |p: DVec3| (p - dvec3(-3.0, -2.0, 0.0)).dot(n);
+        assert!(b.above(dvec3(-3.0, -2.0, 0.0), n) && corner(b.min) > 0.0);
+        assert!(!b.above(dvec3(-1.0, -2.0, 0.0), n) && b.above(dvec3(-1.0 - 1e-9, -2.0, 0.0), n));
+        assert!(!b.above(dvec3(0.0, 0.5, 1.0), DVec3::Z) && !b.above(dvec3(0.0, 0.0, 1.5), -DVec3::Z) && b.above(dvec3(0.0, 0.0, 2.0 + 1e-9), -DVec3::Z));
         let empty = Aabb::around(std::iter::empty());
         assert!(!empty.contains(DVec3::ZERO) && !empty.overlaps(&b));
     }

@@ -4,6 +4,8 @@
 //!   products, the edge angle of Lambert's factor, without libm's `atan2`.
 //! - [`form_factor`]: Lambert's point-to-polygon factor (paper 002 Eq. 3)
 //!   and area-averaged element factors by Dunavant quadrature.
+//! - [`far_field`]: Lambert's factor of a planar region far from the
+//!   point, by a four-point rule exact for quadratics.
 //! - [`sampling`]: deterministic per-work-item random streams, stratified
 //!   points on triangles, the radical inverse, the Sobol (0,2)-sequence
 //!   and Owen-scrambled Sobol points in four dimensions.
@@ -30,6 +32,7 @@ pub mod bounds;
 pub mod burial;
 pub mod camera;
 pub mod color;
+pub mod far_field;
 pub mod form_factor;
 pub mod geometry;
 pub mod photometry;
