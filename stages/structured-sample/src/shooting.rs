@@ -54,6 +54,7 @@ use crate::emitters::Polygon;
 use glam::DVec3;
 use radiometry::color::luminance;
 use radiometry::bounds::Aabb;
+use radiometry::far_field::FarRule;
 use radiometry::form_factor::{point_to_boundary, point_to_one_sided_polygon};
 use radiometry::rays::SceneRays;
 use rayon::prelude::*;
@@ -278,11 +279,13 @@ pub const GROUP_REACH: f64 = 4.0;
 /// ```
 ///
 /// with `F_ig` Lambert's factor from point `i` to group `g` (the sum of
-/// its triangles') and `V_i` the point's visible fraction: each group as
+/// its triangles'; from far, a four-point rule within a few 1e-3 of it,
+/// [`Groups::cut`]) and `V_i` the point's visible fraction: each group as
 /// if its radiosity were its mean, spread over it as Lambert's formula
-/// weighs it. Exact where the sender's radiosity is uniform (`E = V F u`)
-/// and for the single triangles; the cut is the whole sender at a point
-/// far from it; never negative where Lambert's factors are not.
+/// weighs it. Exact where the sender's radiosity is uniform (`E = V F u`,
+/// but for that rule) and for the single triangles; the cut is the whole
+/// sender at a point far from it; never negative where Lambert's factors
+/// are not.
 ///
 /// Why: a polygon that sends its mean from all of it lights what lies
 /// next to it with the light of its far side. The floor's polygon along
@@ -806,6 +809,9 @@ struct Group {
     /// counter-clockwise about the sender's normal, but those two of them
     /// share ([`point_to_boundary`]).
     boundary: Vec<[DVec3; 2]>,
+    /// Its four-point rule, from where it is far ([`Groups::factor`]);
+    /// none for a group without area.
+    rule: Option<FarRule>,
 }
 
 enum Content {
@@ -827,7 +833,7 @@ impl Groups {
                 .zip(corners)
                 .map(|(c, &k)| if (c[1] - c[0]).cross(c[2] - c[0]).dot(normal) < 0.0 { [k[0], k[2], k[1]] } else { k })
                 .collect();
-            groups.split(&mut order, 0, triangles, &wound, areas, samples);
+            groups.split(&mut order, 0, triangles, &wound, areas, normal, samples);
         }
         groups.order = order;
         groups
@@ -837,12 +843,13 @@ impl Groups {
     /// below it, its halves; its index and its boundary as sample-index
     /// edges.
     #[allow(clippy::too_many_arguments)]
-    fn split(&mut self, members: &mut [u32], first: u32, triangles: &[[DVec3; 3]], wound: &[[u32; 3]], areas: &[f64], samples: &[Collector]) -> (u32, Vec<[u32; 2]>) {
+    fn split(&mut self, members: &mut [u32], first: u32, triangles: &[[DVec3; 3]], wound: &[[u32; 3]], areas: &[f64], normal: DVec3, samples: &[Collector]) -> (u32, Vec<[u32; 2]>) {
         let at = self.groups.len() as u32;
         let bounds = Aabb::around(members.iter().flat_map(|&t| triangles[t as usize]));
         let area = members.iter().map(|&t| areas[t as usize]).sum();
         let count = members.len() as u32;
-        self.groups.push(Group { bounds, diameter: (bounds.max - bounds.min).length(), area, content: Content::Triangle(members[0]), first, count, boundary: Vec::new() });
+        let rule = FarRule::of(members.iter().map(|&t| (triangles[t as usize], areas[t as usize])), normal);
+        self.groups.push(Group { bounds, diameter: (bounds.max - bounds.min).length(), area, content: Content::Triangle(members[0]), first, count, boundary: Vec::new(), rule });
         let edges = if members.len() > 1 {
             let centroid = |t: u32| triangles[t as usize].iter().sum::<DVec3>() / 3.0;
             let spread = Aabb::around(members.iter().map(|&t| centroid(t)));
@@ -850,8 +857,8 @@ impl Groups {
             members.sort_by(|&a, &b| centroid(a)[axis].total_cmp(&centroid(b)[axis]).then(a.cmp(&b)));
             let half = members.len() / 2;
             let (low, high) = members.split_at_mut(half);
-            let (low, low_edges) = self.split(low, first, triangles, wound, areas, samples);
-            let (high, high_edges) = self.split(high, first + half as u32, triangles, wound, areas, samples);
+            let (low, low_edges) = self.split(low, first, triangles, wound, areas, normal, samples);
+            let (high, high_edges) = self.split(high, first + half as u32, triangles, wound, areas, normal, samples);
             self.groups[at as usize].content = Content::Halves(low, high);
             let reversed = |edges: &[[u32; 2]]| edges.iter().map(|e| [e[1], e[0]]).collect::<std::collections::HashSet<[u32; 2]>>();
             let (in_low, in_high) = (reversed(&low_edges), reversed(&high_edges));
@@ -879,7 +886,19 @@ impl Groups {
     /// The groups a point at `position` (unit `normal`) takes
     /// ([`Shaped`]), each with `F_g / A_g`, and the sum of their `F_g`:
     /// Lambert's factors of the sender's `triangles` (one-sided, facing
-    /// `front`).
+    /// `front`), by Lambert's formula ([`Self::factor`]) or, for a group
+    /// [`GROUP_REACH`] of its diameters or more away, by its four-point
+    /// rule where that takes it (radiometry's [`FarRule`]: the group's
+    /// area, centroid and second moments, exact for a quadratic kernel;
+    /// within 0.16% of Lambert's formula at four diameters in its test,
+    /// 0.027% at eight). A far group is taken whole, and its boundary had
+    /// the most edges of all: on the built-in Cornell box 134M of the 174M
+    /// edge terms (77%), each an `atan2`. Four kernel evaluations instead:
+    /// the stage 6.4 s -> 5.3 s, McGuire's `Original` 6.3 -> 5.4 s
+    /// (`Glossy` 11.8 -> 11.5 s: its senders are the sphere's small facets,
+    /// taken near; medians of 2 interleaved runs), every image within
+    /// 0.0004% rms of the one before (every pixel within 0.05%) and the
+    /// same against Mitsuba to the four digits the README gives.
     fn cut(&self, position: DVec3, normal: DVec3, triangles: &[[DVec3; 3]], front: DVec3) -> (f64, Terms) {
         // Nothing to take where the whole sender lies behind the point's
         // plane or the point behind the sender's.
@@ -891,10 +910,13 @@ impl Groups {
         while let Some(g) = open.pop() {
             let group = &self.groups[g as usize];
             let gap = (group.bounds.min - position).max(position - group.bounds.max).max(DVec3::ZERO).length();
+            let far = gap >= GROUP_REACH * group.diameter;
             match group.content {
-                Content::Halves(a, b) if gap < GROUP_REACH * group.diameter => open.extend([b, a]),
+                Content::Halves(a, b) if !far => open.extend([b, a]),
                 _ => {
-                    let factor = self.factor(group, position, normal, triangles, front);
+                    // A far group by its four points where they serve.
+                    let ruled = group.rule.as_ref().filter(|_| far).and_then(|rule| rule.factor(position, normal));
+                    let factor = ruled.unwrap_or_else(|| self.factor(group, position, normal, triangles, front));
                     total += factor;
                     if factor != 0.0 && group.area > 0.0 {
                         cut.push((g, factor / group.area));
@@ -1161,15 +1183,16 @@ mod tests {
     /// From farther than [`FAR_SENDER`] extents a sender is seen through
     /// one ray, from its casting point nearest its centre: a small
     /// occluder on the axis hides it all, and with none it is seen whole
-    /// (`F` is Lambert's factor of the square); nearer, each of its four
-    /// casting points casts, and the occluder hides one of them (`V`
-    /// 3/4, the kernel nearly alike at the four).
+    /// (`F` is Lambert's factor of the square, within 1e-5: from 8 of its
+    /// diameters [`FarRule`] takes it); nearer, each of its four casting
+    /// points casts, and the occluder hides one of them (`V` 3/4, the
+    /// kernel nearly alike at the four).
     #[test]
     fn a_far_sender_is_seen_through_one_ray() {
         let lambert = |h: f64| lambert_polygon([0.0; 3], [0.0, 0.0, 1.0], &[[-0.1, -0.1, h], [-0.1, 0.1, h], [0.1, 0.1, h], [0.1, -0.1, h]]).abs();
         for (h, rays) in [(2.2, 4), (2.35, 1)] {
             let (open, cast) = over_a_point(h, false);
-            assert!((open / lambert(h) - 1.0).abs() < 1e-9 && cast == rays, "h {h}: F V {open} against Lambert's {}, {cast} rays", lambert(h));
+            assert!((open / lambert(h) - 1.0).abs() < 1e-5 && cast == rays, "h {h}: F V {open} against Lambert's {}, {cast} rays", lambert(h));
         }
         assert_eq!(over_a_point(2.35, true), (0.0, 1));
         let (near, cast) = over_a_point(2.2, true);
@@ -1231,8 +1254,12 @@ mod tests {
     /// A sender of 18 triangles on a 4 x 4 grid of samples, every other one
     /// wound clockwise: at points above it (the groups' factors from their
     /// boundaries) and at a point whose plane cuts it (the groups it cuts
-    /// triangle by triangle), every group's factor in the cut, and their
-    /// sum, equal the sum of its triangles' Lambert factors, to 1e-12.
+    /// triangle by triangle), every group's factor by Lambert's formula
+    /// equals the sum of its triangles' Lambert factors, to 1e-12; in the
+    /// cut, the groups [`FarRule`] takes (from [`GROUP_REACH`] diameters)
+    /// are within 0.3% of it (radiometry's test: 0.16% at worst), the
+    /// others to 1e-12, and the cut's sum within 0.1%. The point 2.5 m
+    /// away takes some groups by the rule.
     #[test]
     fn a_groups_factor_from_its_boundary_is_its_triangles_sum() {
         let mut samples = Vec::new();
@@ -1251,17 +1278,27 @@ mod tests {
         }
         let polygon = Polygon { surface: 0, triangles, vertices: (0..16).collect(), area: 0.0 };
         let sender = Sender::new(&polygon, &samples, 16);
+        let mut ruled = 0;
         for (point, normal) in [(dvec3(0.4, 0.3, 0.5), -DVec3::Z), (dvec3(2.5, 0.4, 1.0), dvec3(-1.0, 0.2, -0.3).normalize()), (dvec3(0.5, 0.4, 0.3), dvec3(1.0, 0.0, -0.4).normalize())] {
             let factors: Vec<f64> = sender.triangles.iter().map(|t| point_to_one_sided_polygon(point, normal, t, DVec3::Z)).collect();
+            let summed = |group: &Group| sender.groups.order[group.first as usize..(group.first + group.count) as usize].iter().map(|&t| factors[t as usize]).sum::<f64>();
+            for group in &sender.groups.groups {
+                let lambert = sender.groups.factor(group, point, normal, &sender.triangles, DVec3::Z);
+                assert!((lambert - summed(group)).abs() < 1e-12, "{lambert} against {}", summed(group));
+            }
             let (total, terms) = sender.shape(point, normal);
-            assert!((total - factors.iter().sum::<f64>()).abs() < 1e-12, "{total} against {}", factors.iter().sum::<f64>());
+            let exact = factors.iter().sum::<f64>();
+            assert!((total / exact - 1.0).abs() < 1e-3, "{total} against {exact}");
             for (g, c) in terms {
                 let group = &sender.groups.groups[g as usize];
-                let members = &sender.groups.order[group.first as usize..(group.first + group.count) as usize];
-                let summed: f64 = members.iter().map(|&t| factors[t as usize]).sum();
-                assert!((c * group.area - summed).abs() < 1e-12, "group {g}: {} against {summed}", c * group.area);
+                let gap = (group.bounds.min - point).max(point - group.bounds.max).max(DVec3::ZERO).length();
+                let by_rule = gap >= GROUP_REACH * group.diameter && group.rule.as_ref().and_then(|r| r.factor(point, normal)).is_some();
+                ruled += usize::from(by_rule);
+                let error = (c * group.area - summed(group)).abs();
+                assert!(if by_rule { error < 3e-3 * summed(group) } else { error < 1e-12 }, "group {g}: {} against {}", c * group.area, summed(group));
             }
         }
+        assert!(ruled > 0, "no group was far enough for the rule");
     }
 
     /// A receiving triangle (facing down, longest edge 0.45 m) over a 1 m
@@ -1371,7 +1408,8 @@ mod tests {
     /// all of it (the shooting before [`Shaped`]) is 84% short, both as a
     /// shot brings it and as a point gathers it after the shooting
     /// ([`Sender::irradiance`]). With every triangle alike the two agree
-    /// to single precision at any point.
+    /// with Lambert's factor at any point, to 1e-4 ([`FarRule`] takes the
+    /// far groups).
     #[test]
     fn a_polygon_sends_each_triangles_own_light_to_what_lies_near_it() {
         let mut samples = Vec::new();
@@ -1402,7 +1440,7 @@ mod tests {
         let (uniform, _) = shoot_once(0, &polygons, &samples, &[[0.7; 3]; 32]);
         for (i, &r) in receivers.iter().enumerate() {
             let factor: f64 = polygons[0].triangles.iter().map(|t| lambert(t, r)).sum();
-            assert!((uniform[34 + i][1] / (0.7 * factor) - 1.0).abs() < 1e-6, "{r:?}: {} against {}", uniform[34 + i][1], 0.7 * factor);
+            assert!((uniform[34 + i][1] / (0.7 * factor) - 1.0).abs() < 1e-4, "{r:?}: {} against {}", uniform[34 + i][1], 0.7 * factor);
         }
     }
 
