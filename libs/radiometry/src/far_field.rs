@@ -32,12 +32,16 @@
 //! m)(v_i - m)^T`, `m` its centroid), and a region of triangles adds them
 //! about its own centroid (parallel axes).
 //!
+//! [`triangle_factor`] is the same for one triangle, by Dunavant's
+//! three-point rule of degree 2.
+//!
 //! Four kernel evaluations replace one `atan2` per boundary edge: the far
 //! groups' boundaries were 134M of the 174M edge terms structured-sample
 //! took on the built-in Cornell box (README, Structured sampling, **Far
 //! groups by four points**).
 
 use crate::bounds::Aabb;
+use crate::form_factor::point_kernel;
 use crate::geometry::frame_with_normal;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -140,6 +144,21 @@ impl FarRule {
     pub fn integral(&self, f: impl Fn(DVec3) -> f64) -> f64 {
         self.weight * self.points.iter().map(|&p| f(p)).sum::<f64>()
     }
+}
+
+/// Lambert's factor from `x` (unit normal `n`) to a triangle (`corners`,
+/// `area`, unit front normal `front`) by Dunavant's degree-2 rule: the
+/// point kernel at the three points `(4 v_a + v_b + v_c) / 6` (barycentric
+/// `(2/3, 1/6, 1/6)` and its turns), each weighing `A / 3`; exact for a
+/// quadratic over the triangle, as [`FarRule`] is for any region, with
+/// three points instead of four. The points lie inside the triangle, so
+/// the kernel keeps its clamps ([`point_kernel`]): where the triangle
+/// reaches behind the plane of `x`, or `x` behind the triangle's, the
+/// points there count for nothing, as the triangle's part there does.
+pub fn triangle_factor(x: DVec3, n: DVec3, corners: &[DVec3; 3], area: f64, front: DVec3) -> f64 {
+    let [a, b, c] = *corners;
+    let at = |p: DVec3| point_kernel(x, n, p, front);
+    area * (at((4.0 * a + b + c) / 6.0) + at((4.0 * b + c + a) / 6.0) + at((4.0 * c + a + b) / 6.0)) / (3.0 * PI)
 }
 
 #[cfg(test)]
@@ -308,6 +327,36 @@ mod tests {
             dvec3(a.sin(), 0.0, -a.cos())
         };
         assert!(rule.factor(x, tilted(1.9)).is_some() && rule.factor(x, tilted(2.1)).is_none());
+    }
+
+    /// A triangle's three points against Lambert's formula, from a point
+    /// on the normal through its centroid tilted 30 degrees off it and
+    /// from two off to the side, each facing the centroid and tilted from
+    /// it: at 2 of the triangle's radii (its farthest corner's distance
+    /// from the centroid) within 2% (measured 0.97%), at 4 within 0.2%
+    /// (0.10%); the centroid's kernel alone errs by 11% and 2.8% there.
+    /// Behind the triangle, or with the triangle behind the point, 0.
+    #[test]
+    fn a_triangles_three_points_meet_lamberts_factor_from_two_radii() {
+        let corners = [dvec3(0.0, 0.0, 0.0), dvec3(1.0, 0.1, 0.0), dvec3(0.3, 0.9, 0.0)];
+        let area = 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length();
+        let c = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let radius = corners.iter().map(|p| p.distance(c)).fold(0.0, f64::max);
+        for (reach, within, centroid_off) in [(2.0, 0.02, 0.08), (4.0, 0.002, 0.02)] {
+            let mut worst: (f64, f64) = (0.0, 0.0);
+            for dir in [dvec3(0.0, 0.0, 1.0), dvec3(0.5, 0.0, 0.866), dvec3(-0.3, 0.8, 0.52)] {
+                let x = c + dir.normalize() * reach * radius;
+                for n in [(c - x).normalize(), ((c - x).normalize() + dvec3(0.3, -0.2, 0.0)).normalize()] {
+                    let lambert = point_to_one_sided_polygon(x, n, &corners, DVec3::Z);
+                    let three = triangle_factor(x, n, &corners, area, DVec3::Z);
+                    let one = area * point_kernel(x, n, c, DVec3::Z) / PI;
+                    worst = (worst.0.max((three / lambert - 1.0).abs()), worst.1.max((one / lambert - 1.0).abs()));
+                }
+            }
+            assert!(worst.0 < within && worst.1 > centroid_off, "{reach} radii: three points {}, the centroid {}", worst.0, worst.1);
+        }
+        assert_eq!(triangle_factor(c - DVec3::Z, DVec3::Z, &corners, area, DVec3::Z), 0.0);
+        assert_eq!(triangle_factor(c + DVec3::Z, DVec3::Z, &corners, area, DVec3::Z), 0.0);
     }
 
     #[test]
