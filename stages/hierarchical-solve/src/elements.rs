@@ -7,13 +7,13 @@ use crate::detail::Detail;
 use crate::cluster_tree::ClusterTree;
 use crate::transmission::Transmission;
 use glam::DVec3;
-use radiometry::form_factor::{point_kernel, point_to_one_sided_polygon, triangle_to_polygon, Quadrature};
+use radiometry::far_field::triangle_factor;
+use radiometry::form_factor::{point_to_one_sided_polygon, triangle_to_polygon, Quadrature};
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
 use schemas::mesh::{Manifest, Mesh};
 use schemas::solution::{Node, NONE};
 use schemas::surface::Surface;
-use std::f64::consts::PI;
 
 /// What the irradiance averaged over a node is divided by to give its
 /// exposed part's ([`crate::exposure`]): its exposure, or 1 where it is
@@ -27,17 +27,25 @@ pub fn exposed(exposure: f64) -> f64 {
 }
 
 /// Distance, in radii of an element, beyond which its weight among its
-/// siblings is the point kernel at its centroid
-/// ([`Hierarchy::weight_to_element`]): a disc facing a point at this
-/// distance has a factor within 1/17 (5.9%) of the point kernel's, and
-/// siblings at about the same distance err alike, which their normalised
-/// weights cancel. On the built-in Cornell box (preview against Mitsuba,
-/// seeds 1-8) 4 instead of 8 left the relative RMSE at 1.551% against
-/// 1.547% at `EPS` 6e-4 (worst surface per seed 0.31-0.55% against
-/// 0.30-0.63%), 1.058% against 1.047% at 4e-4 and 0.859% against 0.851%
-/// at 2.5e-4 (the worst surfaces the same to 0.01%), and the solve took
-/// 6% less time on one thread (medians of 11 interleaved: 0.490 against
-/// 0.522 s at 6e-4, 0.755 against 0.806 s at 4e-4).
+/// siblings is Dunavant's three-point rule of the point kernel over it
+/// ([`Hierarchy::weight_to_element`], radiometry's
+/// `far_field::triangle_factor`), not Lambert's formula. Before, it was the
+/// point kernel at its centroid alone: a disc facing a point at this
+/// distance has a factor within 1/17 (5.9%) of that kernel's (a triangle
+/// in radiometry's test 2.8%, the three points 0.10%), and siblings at
+/// about the same distance err alike, which their normalised weights
+/// cancel; but a link into a cluster takes the factor its triangles'
+/// weights measure ([`crate::receivers`]), where nothing cancels. On the
+/// built-in Cornell box (preview against Mitsuba, seeds 1-8) the three
+/// points took the relative RMSE from 1.969%, 1.234% and 0.957% to
+/// 1.962%, 1.230% and 0.949% at `EPS` 1.5e-3, 1e-3 and 6.5e-4, in the
+/// same time (one thread, medians of 11 and 7 interleaved: 0.131 s and
+/// 0.214 s against 0.131 s and 0.215 s). From 2 radii they were faster
+/// still (0.128 s, 0.209 s) and as accurate over the Cornell box, but
+/// the tests' cluster links then measured their factors 0.2% to 0.5%
+/// off (0.97% at 2 radii in radiometry's test). 4 instead of 8 for the
+/// centroid (at `EPS` 6e-4, seeds 1-8): relative RMSE 1.551% against
+/// 1.547%, 6% less time.
 pub const FAR_PART: f64 = 4.0;
 
 /// One element.
@@ -146,22 +154,17 @@ impl Hierarchy {
     /// [`Hierarchy::factor_to_element`] where it weighs an element against
     /// its siblings (the parts of a sender or of a receiver, whose weights
     /// are normalised to sum to 1): beyond [`FAR_PART`] times the element's
-    /// radius `r` from `x`, the point kernel at its centroid `c`,
-    ///
-    /// ```text
-    /// A_e G(x, c) / pi  x  coverage
-    /// ```
-    ///
-    /// which differs from Lambert's factor by a relative `O((r / d)²)`,
-    /// about alike for siblings at about the same distance. Lambert's
-    /// formula (an `atan2` per edge) was a third of the time the last solve
-    /// spent weighing senders' parts on the Cornell box.
+    /// radius from `x`, Dunavant's three-point rule of the point kernel
+    /// over it (radiometry's `far_field::triangle_factor`, exact for a
+    /// quadratic kernel) times its coverage. Lambert's formula (an `atan2`
+    /// per edge) was a third of the time the last solve spent weighing
+    /// senders' parts on the Cornell box.
     pub fn weight_to_element(&self, x: DVec3, n: DVec3, e: u32) -> f64 {
         let el = &self.elements[e as usize];
         let c = self.centroid(e);
         let radius2 = el.points.iter().map(|p| p.distance_squared(c)).fold(0.0, f64::max);
         if c.distance_squared(x) > FAR_PART * FAR_PART * radius2 {
-            el.area * point_kernel(x, n, c, self.normal(e)) / PI * self.coverage(e)
+            triangle_factor(x, n, &el.points, el.area, self.normal(e)) * self.coverage(e)
         } else {
             self.factor_to_element(x, n, e)
         }
