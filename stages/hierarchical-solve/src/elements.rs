@@ -40,7 +40,7 @@ pub fn exposed(exposure: f64) -> f64 {
 /// points took the relative RMSE from 1.969%, 1.234% and 0.957% to
 /// 1.962%, 1.230% and 0.949% at `EPS` 1.5e-3, 1e-3 and 6.5e-4, in the
 /// same time (one thread, medians of 11 and 7 interleaved: 0.131 s and
-/// 0.214 s against 0.131 s and 0.215 s). From 2 radii they were faster
+/// 0.215 s against 0.131 s and 0.214 s). From 2 radii they were faster
 /// still (0.128 s, 0.209 s) and as accurate over the Cornell box, but
 /// the tests' cluster links then measured their factors 0.2% to 0.5%
 /// off (0.97% at 2 radii in radiometry's test). 4 instead of 8 for the
