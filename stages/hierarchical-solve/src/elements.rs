@@ -26,27 +26,36 @@ pub fn exposed(exposure: f64) -> f64 {
     }
 }
 
-/// Distance, in radii of an element, beyond which its weight among its
-/// siblings is Dunavant's three-point rule of the point kernel over it
-/// ([`Hierarchy::weight_to_element`], radiometry's
-/// `far_field::triangle_factor`), not Lambert's formula. Before, it was the
-/// point kernel at its centroid alone: a disc facing a point at this
-/// distance has a factor within 1/17 (5.9%) of that kernel's (a triangle
-/// in radiometry's test 2.8%, the three points 0.10%), and siblings at
-/// about the same distance err alike, which their normalised weights
-/// cancel; but a link into a cluster takes the factor its triangles'
-/// weights measure ([`crate::receivers`]), where nothing cancels. On the
-/// built-in Cornell box (preview against Mitsuba, seeds 1-8) the three
-/// points took the relative RMSE from 1.969%, 1.234% and 0.957% to
-/// 1.962%, 1.230% and 0.949% at `EPS` 1.5e-3, 1e-3 and 6.5e-4, in the
-/// same time (one thread, medians of 11 and 7 interleaved: 0.131 s and
-/// 0.215 s against 0.131 s and 0.214 s). From 2 radii they were faster
-/// still (0.128 s, 0.209 s) and as accurate over the Cornell box, but
-/// the tests' cluster links then measured their factors 0.2% to 0.5%
-/// off (0.97% at 2 radii in radiometry's test). 4 instead of 8 for the
-/// centroid (at `EPS` 6e-4, seeds 1-8): relative RMSE 1.551% against
-/// 1.547%, 6% less time.
+/// Distance, in radii of an element, beyond which its factor from a
+/// point is Dunavant's three-point rule of the point kernel over it rather
+/// than Lambert's formula where the factor is taken as it is: where a
+/// cluster receiver's triangles measure a link's factor
+/// ([`crate::receivers`]; [`Hierarchy::factor_beyond`]). The rule is
+/// within 0.10% of Lambert's factor at 4 radii in radiometry's test (the
+/// point kernel at the centroid alone, used here before, 2.8%; a disc
+/// facing the point, 5.9%). Beyond it too the receiver's slopes see a
+/// leaf as its centroid ([`crate::slopes`]). 4 instead of 8 for the
+/// centroid's kernel (at `EPS` 6e-4, seeds 1-8): relative RMSE 1.551%
+/// against 1.547%, 6% less time.
 pub const FAR_PART: f64 = 4.0;
+
+/// Distance, in radii of an element, beyond which its weight among its
+/// siblings (the parts of a sender or of a receiver, whose weights are
+/// normalised to sum to 1; [`Hierarchy::weight_to_element`]) is the
+/// three-point rule of [`FAR_PART`]: within 0.97% of Lambert's factor at 2
+/// radii, and siblings at about the same distance err alike, which their
+/// normalised weights cancel. From [`FAR_PART`] radii, with the centroid's
+/// kernel instead of the rule, the built-in Cornell box's preview over
+/// seeds 1-8 (against Mitsuba, relative RMSE) was 1.969%, 1.234% and
+/// 0.957% at `EPS` 1.5e-3, 1e-3 and 6.5e-4; with the rule from 4 radii
+/// 1.962%, 1.230% and 0.949% in the same time (one thread, medians of 11
+/// and 7 interleaved); from 2, 1.959%, 1.229% and 0.949%, in 2.2%, 3.5%
+/// and 2.5% less time than from 4 (0.130 s, 0.208 s and 0.354 s). The
+/// centroid's kernel from 3 and 2 radii had put the relative RMSE at 6e-4
+/// at 1.70% and 1.58% against 1.55%; the rule from 2 radii for a cluster
+/// link's measured factor put the tests' factors 0.2% to 0.5% off, hence
+/// [`FAR_PART`] there.
+pub const SIBLING_PART: f64 = 2.0;
 
 /// One element.
 #[derive(Clone, Debug)]
@@ -152,18 +161,23 @@ impl Hierarchy {
     }
 
     /// [`Hierarchy::factor_to_element`] where it weighs an element against
-    /// its siblings (the parts of a sender or of a receiver, whose weights
-    /// are normalised to sum to 1): beyond [`FAR_PART`] times the element's
-    /// radius from `x`, Dunavant's three-point rule of the point kernel
-    /// over it (radiometry's `far_field::triangle_factor`, exact for a
-    /// quadratic kernel) times its coverage. Lambert's formula (an `atan2`
-    /// per edge) was a third of the time the last solve spent weighing
-    /// senders' parts on the Cornell box.
+    /// its siblings: [`Hierarchy::factor_beyond`] from [`SIBLING_PART`]
+    /// radii. Lambert's formula (an `atan2` per edge) was a third of the
+    /// time the last solve spent weighing senders' parts on the Cornell
+    /// box.
     pub fn weight_to_element(&self, x: DVec3, n: DVec3, e: u32) -> f64 {
+        self.factor_beyond(x, n, e, SIBLING_PART)
+    }
+
+    /// [`Hierarchy::factor_to_element`], but beyond `radii` times the
+    /// element's radius from `x` by Dunavant's three-point rule of the point
+    /// kernel over it (radiometry's `far_field::triangle_factor`, exact for
+    /// a quadratic kernel) times its coverage.
+    pub fn factor_beyond(&self, x: DVec3, n: DVec3, e: u32, radii: f64) -> f64 {
         let el = &self.elements[e as usize];
         let c = self.centroid(e);
         let radius2 = el.points.iter().map(|p| p.distance_squared(c)).fold(0.0, f64::max);
-        if c.distance_squared(x) > FAR_PART * FAR_PART * radius2 {
+        if c.distance_squared(x) > radii * radii * radius2 {
             triangle_factor(x, n, &el.points, el.area, self.normal(e)) * self.coverage(e)
         } else {
             self.factor_to_element(x, n, e)

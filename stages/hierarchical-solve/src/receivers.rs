@@ -155,7 +155,7 @@
 //! were -18% to +235% off the unclustered solve at `EPS` 2e-4, the block
 //! +85% in the preview against Mitsuba (issue 10).
 
-use crate::elements::Hierarchy;
+use crate::elements::{Hierarchy, FAR_PART};
 use crate::links::{box_distance, Link};
 use crate::nodes::key;
 use crate::rows::Rows;
@@ -893,10 +893,13 @@ impl Part {
         }
     }
 
-    /// Factor from point `x` (normal `n`) to the part.
+    /// Factor from point `x` (normal `n`) to the part: taken as it is
+    /// (the link's measured factor, [`Measured`]), so an element part from
+    /// [`FAR_PART`] radii only by the three-point rule, not from
+    /// [`crate::elements::SIBLING_PART`] as a weight among siblings.
     fn factor(&self, h: &Hierarchy, x: glam::DVec3, n: glam::DVec3) -> f64 {
         match self {
-            Part::Element(e) => h.weight_to_element(x, n, *e),
+            Part::Element(e) => h.factor_beyond(x, n, *e, FAR_PART),
             Part::Points(area, points) => area * points.iter().map(|&(y, ny)| point_kernel(x, n, y, ny)).sum::<f64>() / (PI * points.len() as f64),
         }
     }
