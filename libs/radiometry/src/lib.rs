@@ -5,7 +5,8 @@
 //! - [`form_factor`]: Lambert's point-to-polygon factor (paper 002 Eq. 3)
 //!   and area-averaged element factors by Dunavant quadrature.
 //! - [`far_field`]: Lambert's factor of a planar region far from the
-//!   point, by a four-point rule exact for quadratics.
+//!   point, by a four-point rule exact for quadratics (three points for a
+//!   triangle).
 //! - [`sampling`]: deterministic per-work-item random streams, stratified
 //!   points on triangles, the radical inverse, the Sobol (0,2)-sequence
 //!   and Owen-scrambled Sobol points in four dimensions.
