@@ -21,6 +21,7 @@
 //! take a third coordinate, radical inverse in base 3, to pick the triangle.
 
 use glam::DVec3;
+use radiometry::far_field::triangle_factor;
 use radiometry::form_factor::point_to_one_sided_polygon;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::bounds::Aabb;
@@ -36,6 +37,19 @@ use std::sync::OnceLock;
 /// polygon: the point-to-area kernel summed over this many of its fixed
 /// samples.
 pub const CLUSTER_FACTOR_SAMPLES: usize = 32;
+
+/// Distance, in radii of an element sender (its farthest corner's from its
+/// centroid), beyond which [`Senders::form_factor`] takes Dunavant's
+/// three-point rule of the point kernel over it (radiometry's
+/// `far_field::triangle_factor`, exact for a quadratic kernel; within
+/// 0.10% of Lambert's factor at 4 radii in its test, 0.97% at 2) instead
+/// of Lambert's formula, an `atan2` per edge and about a quarter of the
+/// full gather's profile. On the built-in Cornell box's default solution
+/// the full gather took 4.25-4.28 s instead of 4.87-4.89 s (2 threads,
+/// two runs each), its image within 0.0041% rms of the one before;
+/// against Mitsuba 0.4624% relative RMSE against 0.4613% (at 8 radii 4.53
+/// s, within 0.0001%).
+pub const FAR_ELEMENT: f64 = 4.0;
 
 /// One fixed sample on a sender.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -305,7 +319,8 @@ impl<'a> Senders<'a> {
 
     /// Form factor from a differential area at `p` with unit normal
     /// `normal` to the sender: Lambert's closed form (002 Eq. 3) for an
-    /// element, 0 behind its plane (one-sided); for a cluster the point-to-area kernel
+    /// element, 0 behind its plane (one-sided), from [`FAR_ELEMENT`] of its
+    /// radii by Dunavant's three-point rule of the point kernel; for a cluster the point-to-area kernel
     /// `sum_k (A / K) cos+(theta_p) cos+(theta_k) / (pi r_k^2)` over its
     /// first [`CLUSTER_FACTOR_SAMPLES`] fixed samples (front faces only;
     /// the near singularity is cut at `r^2 >= A / K`, the area one sample
@@ -313,7 +328,17 @@ impl<'a> Senders<'a> {
     /// evaluations.
     pub fn form_factor(&self, node: Node, p: DVec3, normal: DVec3) -> (f64, u64) {
         match node {
-            Node::Element(e) => (point_to_one_sided_polygon(p, normal, &self.element_corners(e), self.triangles[self.solution.elements[e as usize].triangle as usize].normal), 1),
+            Node::Element(e) => {
+                let (corners, front) = (self.element_corners(e), self.triangles[self.solution.elements[e as usize].triangle as usize].normal);
+                let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+                let radius2 = corners.iter().map(|c| c.distance_squared(centroid)).fold(0.0, f64::max);
+                let factor = if centroid.distance_squared(p) > FAR_ELEMENT * FAR_ELEMENT * radius2 {
+                    triangle_factor(p, normal, &corners, 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length(), front)
+                } else {
+                    point_to_one_sided_polygon(p, normal, &corners, front)
+                };
+                (factor, 1)
+            }
             Node::Cluster(c) => {
                 let area = self.area(node);
                 let k = CLUSTER_FACTOR_SAMPLES;
