@@ -27,11 +27,24 @@ impl Aabb {
         self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
     }
 
+    /// The heights over the plane through `point` (along `normal`) of the
+    /// box's lowest and highest corners: `(centre - point) . normal -+
+    /// half . |normal|`, `half` the box's half extents.
+    pub fn heights(&self, point: DVec3, normal: DVec3) -> (f64, f64) {
+        let (height, span) = ((self.centre() - point).dot(normal), (0.5 * (self.max - self.min)).dot(normal.abs()));
+        (height - span, height + span)
+    }
+
     /// Whether the whole box lies strictly on the side of the plane through
-    /// `point` that `normal` points to: its lowest corner along `normal`,
-    /// `(centre - point) . normal - half . |normal|`, above the plane.
+    /// `point` that `normal` points to: its lowest corner above the plane
+    /// ([`Aabb::heights`]).
     pub fn above(&self, point: DVec3, normal: DVec3) -> bool {
-        (self.centre() - point).dot(normal) > (0.5 * (self.max - self.min)).dot(normal.abs())
+        self.heights(point, normal).0 > 0.0
+    }
+
+    /// The distance from `p` to the box (0 inside it).
+    pub fn distance(&self, p: DVec3) -> f64 {
+        (self.min - p).max(p - self.max).max(DVec3::ZERO).length()
     }
 
     /// Whether `p` is inside (the faces included).
@@ -61,6 +74,12 @@ mod tests {
         assert!(b.above(dvec3(-3.0, -2.0, 0.0), n) && corner(b.min) > 0.0);
         assert!(!b.above(dvec3(-1.0, -2.0, 0.0), n) && b.above(dvec3(-1.0 - 1e-9, -2.0, 0.0), n));
         assert!(!b.above(dvec3(0.0, 0.5, 1.0), DVec3::Z) && !b.above(dvec3(0.0, 0.0, 1.5), -DVec3::Z) && b.above(dvec3(0.0, 0.0, 2.0 + 1e-9), -DVec3::Z));
+        // Heights of the lowest and highest corners (the box spans 0..2 in z).
+        assert_eq!(b.heights(dvec3(5.0, 5.0, -1.0), DVec3::Z), (1.0, 3.0));
+        // Distance: inside 0, beside a face, off a corner.
+        assert_eq!(b.distance(dvec3(0.0, 0.0, 1.0)), 0.0);
+        assert_eq!(b.distance(dvec3(0.0, 0.0, 4.0)), 2.0);
+        assert_eq!(b.distance(dvec3(4.0, 7.0, 1.0)), 5.0);
         let empty = Aabb::around(std::iter::empty());
         assert!(!empty.contains(DVec3::ZERO) && !empty.overlaps(&b));
     }

@@ -127,9 +127,8 @@ impl FarRule {
     /// two thin triangles touching that plane, at four diameters, read 19%
     /// low clamped.
     pub fn factor(&self, x: DVec3, n: DVec3) -> Option<f64> {
-        let (centre, half) = (self.bounds.centre(), 0.5 * (self.bounds.max - self.bounds.min));
-        let (height, span) = ((centre - x).dot(n), half.dot(n.abs()));
-        let steady = height - span > 0.0 && height + span <= STEADY_COSINE * (height - span);
+        let (low, high) = self.bounds.heights(x, n);
+        let steady = low > 0.0 && high <= STEADY_COSINE * low;
         (steady && self.bounds.above(x, -self.front)).then(|| {
             self.integral(|p| {
                 let d = p - x;

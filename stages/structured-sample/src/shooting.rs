@@ -700,7 +700,7 @@ impl Sender {
     fn reach(&self, corners: [DVec3; 3]) -> f64 {
         let longest = (0..3).map(|i| (corners[(i + 1) % 3] - corners[i]).length()).fold(0.0, f64::max);
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let gap = (self.bounds.min - centroid).max(centroid - self.bounds.max).max(DVec3::ZERO).length();
+        let gap = self.bounds.distance(centroid);
         gap / longest
     }
 
@@ -909,7 +909,7 @@ impl Groups {
         let (mut cut, mut open, mut total) = (Vec::new(), vec![0u32], 0.0);
         while let Some(g) = open.pop() {
             let group = &self.groups[g as usize];
-            let gap = (group.bounds.min - position).max(position - group.bounds.max).max(DVec3::ZERO).length();
+            let gap = group.bounds.distance(position);
             let far = gap >= GROUP_REACH * group.diameter;
             match group.content {
                 Content::Halves(a, b) if !far => open.extend([b, a]),
@@ -1291,7 +1291,7 @@ mod tests {
             assert!((total / exact - 1.0).abs() < 1e-3, "{total} against {exact}");
             for (g, c) in terms {
                 let group = &sender.groups.groups[g as usize];
-                let gap = (group.bounds.min - point).max(point - group.bounds.max).max(DVec3::ZERO).length();
+                let gap = group.bounds.distance(point);
                 let by_rule = gap >= GROUP_REACH * group.diameter && group.rule.as_ref().and_then(|r| r.factor(point, normal)).is_some();
                 ruled += usize::from(by_rule);
                 let error = (c * group.area - summed(group)).abs();
