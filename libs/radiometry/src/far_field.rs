@@ -160,6 +160,16 @@ pub fn triangle_factor(x: DVec3, n: DVec3, corners: &[DVec3; 3], area: f64, fron
     area * (at((4.0 * a + b + c) / 6.0) + at((4.0 * b + c + a) / 6.0) + at((4.0 * c + a + b) / 6.0)) / (3.0 * PI)
 }
 
+/// Whether `x` lies farther than `radii` times a triangle's radius (its
+/// farthest corner's distance from its centroid) from its centroid: where
+/// the stages that weigh triangles take [`triangle_factor`] rather than
+/// Lambert's formula.
+pub fn beyond(x: DVec3, corners: &[DVec3; 3], radii: f64) -> bool {
+    let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+    let radius2 = corners.iter().map(|c| c.distance_squared(centroid)).fold(0.0, f64::max);
+    centroid.distance_squared(x) > radii * radii * radius2
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -354,6 +364,8 @@ mod tests {
             }
             assert!(worst.0 < within && worst.1 > centroid_off, "{reach} radii: three points {}, the centroid {}", worst.0, worst.1);
         }
+        // The far test: the centroid's distance against the radius.
+        assert!(!beyond(c + DVec3::Z * 1.99 * radius, &corners, 2.0) && beyond(c + DVec3::Z * 2.01 * radius, &corners, 2.0));
         assert_eq!(triangle_factor(c - DVec3::Z, DVec3::Z, &corners, area, DVec3::Z), 0.0);
         assert_eq!(triangle_factor(c + DVec3::Z, DVec3::Z, &corners, area, DVec3::Z), 0.0);
     }

@@ -21,7 +21,7 @@
 //! take a third coordinate, radical inverse in base 3, to pick the triangle.
 
 use glam::DVec3;
-use radiometry::far_field::triangle_factor;
+use radiometry::far_field::{beyond, triangle_factor};
 use radiometry::form_factor::point_to_one_sided_polygon;
 use radiometry::geometry::TriangleGeometry;
 use radiometry::bounds::Aabb;
@@ -330,9 +330,7 @@ impl<'a> Senders<'a> {
         match node {
             Node::Element(e) => {
                 let (corners, front) = (self.element_corners(e), self.triangles[self.solution.elements[e as usize].triangle as usize].normal);
-                let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-                let radius2 = corners.iter().map(|c| c.distance_squared(centroid)).fold(0.0, f64::max);
-                let factor = if centroid.distance_squared(p) > FAR_ELEMENT * FAR_ELEMENT * radius2 {
+                let factor = if beyond(p, &corners, FAR_ELEMENT) {
                     triangle_factor(p, normal, &corners, 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length(), front)
                 } else {
                     point_to_one_sided_polygon(p, normal, &corners, front)

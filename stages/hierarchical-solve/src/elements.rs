@@ -7,7 +7,7 @@ use crate::detail::Detail;
 use crate::cluster_tree::ClusterTree;
 use crate::transmission::Transmission;
 use glam::DVec3;
-use radiometry::far_field::triangle_factor;
+use radiometry::far_field::{beyond, triangle_factor};
 use radiometry::form_factor::{point_to_one_sided_polygon, triangle_to_polygon, Quadrature};
 use radiometry::geometry::TriangleGeometry;
 use radiometry::subdivision::{children, Corners, ROOT};
@@ -175,9 +175,7 @@ impl Hierarchy {
     /// a quadratic kernel) times its coverage.
     pub fn factor_beyond(&self, x: DVec3, n: DVec3, e: u32, radii: f64) -> f64 {
         let el = &self.elements[e as usize];
-        let c = self.centroid(e);
-        let radius2 = el.points.iter().map(|p| p.distance_squared(c)).fold(0.0, f64::max);
-        if c.distance_squared(x) > radii * radii * radius2 {
+        if beyond(x, &el.points, radii) {
             triangle_factor(x, n, &el.points, el.area, self.normal(e)) * self.coverage(e)
         } else {
             self.factor_to_element(x, n, e)
