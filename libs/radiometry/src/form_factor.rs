@@ -604,18 +604,31 @@ mod tests {
         assert!(((plain - exact) / exact).abs() > 1e-3, "the fixed rule alone would not do: {plain}");
     }
 
-    /// At a tolerance loose enough that the centroids' distance alone
-    /// would take the fixed rule, a floor touching a wall (Howell C-14, the
-    /// floor as two triangles: one sharing the edge, one a corner) still
-    /// takes a split: within 0.25% of the closed form, where the rule
-    /// alone is 0.35% to 0.8% over it (over in every case).
+    /// At a loose tolerance a floor touching a wall (Howell C-14, the
+    /// floor as two triangles: one sharing the edge, one a corner) takes
+    /// a split: within 0.25% of the closed form, where the rule alone is
+    /// 0.35% to 0.8% over it (over in every case). The narrow floor's
+    /// halves are far by their centroids at this tolerance, and took the
+    /// rule alone (+0.35%) before touching pairs were split.
     #[test]
     fn touching_pairs_take_a_split_at_any_tolerance() {
         let loose = Quadrature { depth: 3, tolerance: 0.05 };
+        let radius = |t: &[DVec3]| {
+            let c = t.iter().copied().sum::<DVec3>() / t.len() as f64;
+            (c, t.iter().map(|p| p.distance(c)).fold(0.0, f64::max))
+        };
         for (w, h, l) in [(1.0, 0.5, 2.0), (0.2, 1.0, 1.0), (1.0, 0.2, 1.0)] {
             let floor = [dvec3(0.0, 0.0, 0.0), dvec3(w, 0.0, 0.0), dvec3(w, l, 0.0), dvec3(0.0, l, 0.0)];
             let wall = [dvec3(0.0, 0.0, 0.0), dvec3(0.0, l, 0.0), dvec3(0.0, l, h), dvec3(0.0, 0.0, h)];
             let halves = [[floor[0], floor[1], floor[2]], [floor[0], floor[2], floor[3]]];
+            if w < 0.5 {
+                let (cw, rw) = radius(&wall);
+                let far = |t: &[DVec3; 3]| {
+                    let (c, r) = radius(t);
+                    c.distance(cw) > near_distance(loose.tolerance) * (r + rw)
+                };
+                assert!(halves.iter().all(far), "the narrow floor's halves are far at this tolerance");
+            }
             let exact = perpendicular_shared_edge(w, h, l);
             let split: f64 = halves.iter().map(|t| 0.5 * triangle_to_polygon(t, DVec3::Z, &wall, DVec3::X, loose).mean).sum();
             let plain: f64 = halves.iter().map(|t| 0.5 * rule(t, DVec3::Z, &OneSided { polygon: &wall, front: DVec3::X }).mean).sum();
