@@ -331,7 +331,7 @@ impl<'a> Senders<'a> {
             Node::Element(e) => {
                 let (corners, front) = (self.element_corners(e), self.triangles[self.solution.elements[e as usize].triangle as usize].normal);
                 let factor = if beyond(p, &corners, FAR_ELEMENT) {
-                    triangle_factor(p, normal, &corners, 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length(), front)
+                    triangle_factor(p, normal, &corners, self.area(node), front)
                 } else {
                     point_to_one_sided_polygon(p, normal, &corners, front)
                 };
