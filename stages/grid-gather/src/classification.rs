@@ -8,7 +8,8 @@
 //!    (luminance of the links' `Eu`), whether every link calls it fully
 //!    occluded (then it is skipped), whether one calls it partly occluded,
 //!    the largest visibility of its links, and the nearest occluder
-//!    distance. The receivers near the vertex are the triangles
+//!    distance (each link's visibility as its receiver's exposed part
+//!    sees it, [`crate::senders::Senders::exposed_visibility`]). The receivers near the vertex are the triangles
 //!    overlapping the cells ([`crate::senders::Senders::triangles_near`]):
 //!    a cluster receiver's own triangles lie anywhere in the scene.
 //! 2. `N_s = max(n_min, round(N I_s / sum_S I))` (Eq. 1) sample pairs: a
@@ -378,10 +379,11 @@ impl FullGather<'_> {
             let link: &Link = &self.senders.solution.links[l];
             let s = by_sender.entry(link.sender).or_insert(SenderLinks { irradiance: 0.0, all_occluded: true, partial: false, occluder: f64::INFINITY, most_visible: 0.0 });
             s.irradiance = s.irradiance.max(luminance(link.unoccluded_irradiance.map(f64::from)));
-            s.all_occluded &= link.visibility <= 0.0;
-            s.partial |= link.visibility > 0.0 && link.visibility < 1.0;
-            s.most_visible = s.most_visible.max(f64::from(link.visibility).clamp(0.0, 1.0));
-            if link.visibility < 1.0 {
+            let visibility = self.senders.exposed_visibility(l);
+            s.all_occluded &= visibility <= 0.0;
+            s.partial |= visibility > 0.0 && visibility < 1.0;
+            s.most_visible = s.most_visible.max(visibility);
+            if visibility < 1.0 {
                 s.occluder = s.occluder.min(f64::from(link.occluder_distance));
             }
         }

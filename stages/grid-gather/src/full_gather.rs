@@ -125,14 +125,16 @@ impl<'a> FullGather<'a> {
     /// `normal`, in leaf element `leaf`) from the links in `links`, for
     /// camera sample `pass` of its pixel: by the surface-based gather where
     /// the leaf is smaller than the grid's cells at `p` (and the
-    /// `surface_gather` parameter is on), else by the grid; 0 outside the
-    /// grid.
+    /// `surface_gather` parameter is on) and on a leaf the solver found
+    /// wholly buried (whose links' visibility says nothing of `p`, which
+    /// that gather then resamples, [`crate::surface_gather`]), else by the
+    /// grid; 0 outside the grid.
     #[allow(clippy::too_many_arguments)]
     pub fn irradiance(&self, p: DVec3, normal: DVec3, triangle: u32, leaf: u32, links: &[usize], pass: u32, work: &mut Work) -> [f64; 3] {
         let Some(location) = self.grid.locate(p) else { return [0.0; 3] };
         let contrast = self.contrast_at(&location);
         let leaf_size = self.senders.size(Node::Element(leaf));
-        if self.params.surface_gather && leaf_size < self.grid.spacing_at(p) {
+        if (self.params.surface_gather && leaf_size < self.grid.spacing_at(p)) || self.senders.exposure(leaf) <= 0.0 {
             return self.surface_irradiance(p, normal, triangle, leaf, links, contrast, pass, work);
         }
         self.interpolated_irradiance(p, normal, triangle, &location, links, pass, work)

@@ -160,8 +160,10 @@ impl Specular {
 /// hierarchical-solve gathered through mirrors and glass by virtual
 /// senders, which the solution's links do not carry), interpolated over
 /// the surfaces like the preview's radiosity ([`Gouraud::of`]): per
-/// channel `max(0, H_e - sum V E_unoccluded - E_lights)`, `H_e = (B_e - E)
-/// / rho_e` the leaf's irradiance (`rho_e` its texture average where
+/// channel `max(0, H_e - sum V E_unoccluded - E_lights)` (`V` as the
+/// receiver's exposed part sees it,
+/// [`crate::senders::Senders::exposed_visibility`], since `H_e` is the
+/// exposed part's), `H_e = (B_e - E) / rho_e` the leaf's irradiance (`rho_e` its texture average where
 /// `detail` has textures, [`Detail::irradiance`]; 0 where `rho_e` is 0,
 /// such a leaf reflects none of it). The full gather adds it to what it
 /// gathers from the links. The solver's radiosity also holds the
@@ -192,7 +194,7 @@ pub fn window_light(
             Some(detail) => detail.irradiance(e.triangle, corners, b, s.emission, s.reflectance),
             None => crate::detail::irradiance_of(b, s.emission, s.reflectance),
         };
-        let from_links = |c: usize| links.iter().map(|&l| f64::from(solution.links[l].visibility) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
+        let from_links = |c: usize| links.iter().map(|&l| senders.exposed_visibility(l) * f64::from(solution.links[l].unoccluded_irradiance[c])).sum::<f64>();
         std::array::from_fn(|c| if h[c] > 0.0 { (h[c] - from_links(c) - direct).max(0.0) } else { 0.0 })
     }, &[])
 }

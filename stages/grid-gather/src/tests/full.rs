@@ -55,7 +55,8 @@ fn room() -> Room {
         effects: Effects::default(),
         statistics: MeshStatistics::default(),
     };
-    let element = |t: u32, b: f32| Element::root(t, 1.0, [b; 3]);
+    // Their areas are the whole triangles': nothing is buried.
+    let element = |t: u32, b: f32| Element::root(t, mesh.triangles[t as usize].area, [b; 3]);
     // F of a 0.4 m square 1.5 m away, roughly A cos^2 / (pi r^2) = 0.023
     // per floor point: the links' values steer sample counts only.
     let link = |r: u32, s: u32| Link {
@@ -217,6 +218,7 @@ fn room_with_missed_occluder() -> Room {
         room.mesh.triangles.push(Triangle { vertices: [base, base + 1, base + 2], material: 0, object: 0, area: g.area as f32, normal: g.normal.as_vec3().to_array() });
         let mut element = room.solution.elements[0];
         element.triangle = room.solution.elements.len() as u32;
+        element.area = g.area as f32;
         element.radiosity = [0.0; 3];
         room.solution.elements.push(element);
     }
@@ -240,6 +242,27 @@ fn the_surface_gather_checks_links_the_solver_called_fully_visible() {
     let (e_checked, e_trusted) = (error(&checked), error(&trusted));
     assert!(e_checked < 0.05, "with leaf checks: relative RMSE {e_checked}");
     assert!(e_trusted > 10.0 * e_checked, "trusting the stale links: {e_trusted} against {e_checked} with checks");
+}
+
+/// The room as a solver would have it where it found no exposed point on
+/// the floor's leaves (their area 0, their links' `V` 0: every ray from
+/// their points blocked, as under a solid), while the camera sees them: a
+/// camera ray meets only exposed points, whose links the full gather must
+/// resample, as the brute-force gather does (within 1% of it), without
+/// the leaf check, which would find the light too, so that this is what is
+/// tested. Taken at their `V`, the floor was black. (The partly buried
+/// leaf's `V / x`: `tests/tests/buried_parts.rs`.)
+#[test]
+fn the_full_gather_resamples_a_leaf_the_solver_found_wholly_buried() {
+    let mut room = room();
+    for t in 0..2 {
+        room.solution.elements[t].area = 0.0;
+    }
+    room.solution.links.iter_mut().filter(|l| matches!(l.receiver, Node::Element(0 | 1))).for_each(|l| l.visibility = 0.0);
+    let (image, _) = run(&room, &Params { mode: Mode::Full, spp: 2, leaf_check_rays: 0, ..Params::default() });
+    let (reference, _) = run(&room, &Params { mode: Mode::Brute, spp: 2, brute_samples: 4, ..Params::default() });
+    let e = relative_rmse(&floor_values(&image), &floor_values(&reference));
+    assert!(e < 0.01, "relative RMSE {e} against the brute-force gather");
 }
 
 /// The image lattice ([`crate::lattice`]) per pixel, on the room at 96 x 64
