@@ -262,6 +262,7 @@ fn the_full_gather_resamples_a_leaf_the_solver_found_wholly_buried() {
     let (image, _) = run(&room, &Params { mode: Mode::Full, spp: 2, leaf_check_rays: 0, ..Params::default() });
     let (reference, _) = run(&room, &Params { mode: Mode::Brute, spp: 2, brute_samples: 4, ..Params::default() });
     let e = relative_rmse(&floor_values(&image), &floor_values(&reference));
+    eprintln!("wholly buried: relative RMSE {e:.2e}");
     assert!(e < 0.01, "relative RMSE {e} against the brute-force gather");
 }
 
