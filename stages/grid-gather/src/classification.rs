@@ -9,9 +9,10 @@
 //!    occluded (then it is skipped), whether one calls it partly occluded,
 //!    the largest visibility of its links, and the nearest occluder
 //!    distance (each link's visibility as its receiver's exposed part
-//!    sees it, [`crate::senders::Senders::exposed_visibility`]). The receivers near the vertex are the triangles
-//!    overlapping the cells ([`crate::senders::Senders::triangles_near`]):
-//!    a cluster receiver's own triangles lie anywhere in the scene.
+//!    sees it, [`crate::senders::Senders::exposed_visibility`]). The
+//!    receivers near the vertex are the triangles overlapping the cells
+//!    ([`crate::senders::Senders::triangles_near`]): a cluster receiver's
+//!    own triangles lie anywhere in the scene.
 //! 2. `N_s = max(n_min, round(N I_s / sum_S I))` (Eq. 1) sample pairs: a
 //!    uniform point `x_k` in the eight cells around the vertex and the
 //!    sender's fixed sample `y_k`. At each, the form factor without the
