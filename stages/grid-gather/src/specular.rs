@@ -163,9 +163,10 @@ impl Specular {
 /// channel `max(0, H_e - sum V E_unoccluded - E_lights)` (`V` as the
 /// receiver's exposed part sees it,
 /// [`crate::senders::Senders::exposed_visibility`], since `H_e` is the
-/// exposed part's), `H_e = (B_e - E) / rho_e` the leaf's irradiance (`rho_e` its texture average where
-/// `detail` has textures, [`Detail::irradiance`]; 0 where `rho_e` is 0,
-/// such a leaf reflects none of it). The full gather adds it to what it
+/// exposed part's), `H_e = (B_e - E) / rho_e` the leaf's irradiance
+/// (`rho_e` its texture average where `detail` has textures,
+/// [`Detail::irradiance`]; 0 where `rho_e` is 0, such a leaf reflects
+/// none of it). The full gather adds it to what it
 /// gathers from the links. The solver's radiosity also holds the
 /// goniometric lights' direct light, which the full gather adds per
 /// point: `lights`' irradiance `E_lights` at the leaf's centroid is taken
