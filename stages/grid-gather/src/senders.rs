@@ -327,11 +327,18 @@ impl<'a> Senders<'a> {
         let link = &self.solution.links[l];
         let v = f64::from(link.visibility).clamp(0.0, 1.0);
         match link.receiver {
-            Node::Element(e) => match self.exposure(e) {
-                x if x > 0.0 && x < 1.0 => (v / x).min(1.0),
-                _ => v,
-            },
+            Node::Element(e) => self.on_exposed_part(e, v),
             Node::Cluster(_) => v,
+        }
+    }
+
+    /// A visible fraction `v` measured from points over all of element `e`
+    /// (those buried count as blocked), as its exposed part sees it:
+    /// `min(1, v / x)` ([`Self::exposure`]), `v` where `x` is 0 or 1.
+    pub fn on_exposed_part(&self, e: u32, v: f64) -> f64 {
+        match self.exposure(e) {
+            x if x > 0.0 && x < 1.0 => (v / x).min(1.0),
+            _ => v,
         }
     }
 

@@ -159,7 +159,7 @@ impl FullGather<'_> {
                 }
                 // No ray of positive weight: nothing to contradict with.
                 let Some(v) = visible.fraction() else { continue };
-                let v = if partly_buried { (v / exposure).min(1.0) } else { v };
+                let v = self.senders.on_exposed_part(leaf, v);
                 if v != self.senders.exposed_visibility(l) {
                     check.contradicted.push(Contradiction { link: l, visibility: v });
                 }
